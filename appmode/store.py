@@ -1,0 +1,117 @@
+"""The board's non-volatile parameter store ("flash"), behind a small interface (§5).
+
+`load()` gives the saved parameters, or None with a warning when there are none or they
+cannot be read; it never raises. `save()` replaces them atomically.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Protocol
+
+from . import params
+
+FORMAT = "appmode-flash"
+VERSION = 1
+
+
+class Store(Protocol):
+    def load(self) -> tuple[tuple[int, ...] | None, str | None]:
+        """(saved values or None, warning or None)."""
+        ...
+
+    def save(self, values: Sequence[int]) -> None: ...
+
+
+class MemoryStore:
+    """Flash that lives as long as the object: the default for a simulated board."""
+
+    def __init__(self, values: Sequence[int] | None = None) -> None:
+        self.values = None if values is None else tuple(values)
+
+    def load(self) -> tuple[tuple[int, ...] | None, str | None]:
+        return self.values, None
+
+    def save(self, values: Sequence[int]) -> None:
+        self.values = tuple(values)
+
+
+class JsonFileStore:
+    """Flash in a JSON file, written atomically (temporary file, fsync, rename)."""
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        self.path = Path(path)
+
+    def load(self) -> tuple[tuple[int, ...] | None, str | None]:
+        try:
+            text = self.path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            return None, f"{self.path}: no saved parameters yet, using factory defaults"
+        except OSError as exc:
+            return None, f"{self.path}: cannot read ({exc.strerror}), using factory defaults"
+        try:
+            values = _parse(text)
+        except ValueError as exc:
+            return None, f"{self.path}: {exc}; using factory defaults"
+        return values, None
+
+    def save(self, values: Sequence[int]) -> None:
+        document = {
+            "format": FORMAT,
+            "version": VERSION,
+            "params": {p.name: v for p, v in zip(params.PARAMS, values, strict=True)},
+        }
+        text = json.dumps(document, indent=2) + "\n"
+        directory = self.path.parent
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", dir=directory)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as handle:
+                handle.write(text)
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.replace(tmp, self.path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        _fsync_directory(directory)
+
+
+def _fsync_directory(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _parse(text: str) -> tuple[int, ...]:
+    try:
+        document = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"not valid JSON (line {exc.lineno}: {exc.msg})") from None
+    if not isinstance(document, dict) or document.get("format") != FORMAT:
+        raise ValueError(f"not an {FORMAT} file")
+    if document.get("version") != VERSION:
+        raise ValueError(f"unsupported version {document.get('version')!r}")
+    saved = document.get("params")
+    if not isinstance(saved, dict):
+        raise ValueError("missing 'params' object")
+    values = []
+    for param in params.PARAMS:
+        value = saved.get(param.name)
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise ValueError(f"parameter {param.name} is missing or not an integer")
+        values.append(value)
+    error = params.values_error(values)
+    if error is not None:
+        raise ValueError(error)
+    return tuple(values)

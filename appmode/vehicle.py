@@ -1,0 +1,76 @@
+"""The simulated car's body: velocity response, pose, attitude and battery.
+
+Documented model (all constants here):
+
+- velocity follows its target as a first-order lag with time constant RESPONSE_TAU
+  (63 % of a step in 0.1 s, 95 % in 0.3 s), and snaps to the target within SNAP units;
+- yaw turns at YAW_GAIN degrees a second per unit of z (z = 500 turns 90 °/s), clockwise +;
+- pitch and roll lean with acceleration: TILT_GAIN degrees per unit/s² (nose up while
+  speeding up forward, right side down while speeding up to the right);
+- the battery starts full (12.60 V) and drains IDLE_DRAIN centivolts a second plus
+  LOAD_DRAIN per unit of speed; percent is (cV − 1110) × 2 / 3, capped to 0…100 (§3.2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+RESPONSE_TAU = 0.1
+SNAP = 0.5
+YAW_GAIN = 0.18
+TILT_GAIN = 0.002
+FULL_CV = 1260.0
+EMPTY_CV = 1110.0
+IDLE_DRAIN = 0.02
+LOAD_DRAIN = 0.00017
+
+
+def battery_percent(centivolts: float) -> int:
+    """§3.2: (cV − 1110) × 2 / 3 in whole percent, capped at 100 and floored at 0."""
+    return max(0, min(100, (round(centivolts) - round(EMPTY_CV)) * 2 // 3))
+
+
+def wrap_degrees(angle: float) -> int:
+    """Whole degrees in −179…180."""
+    return (round(angle) + 179) % 360 - 179
+
+
+@dataclass(slots=True)
+class Vehicle:
+    """Body state, advanced in fixed steps by `step`."""
+
+    vx: float = 0.0
+    vy: float = 0.0
+    vz: float = 0.0
+    heading: float = 0.0
+    east: float = 0.0
+    north: float = 0.0
+    pitch: float = 0.0
+    roll: float = 0.0
+    centivolts: float = FULL_CV
+
+    def step(self, target: tuple[float, float, float], dt: float) -> None:
+        """Advance by `dt` seconds toward the target velocity (x, y, z)."""
+        alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
+        old_x, old_y = self.vx, self.vy
+        self.vx = _approach(self.vx, target[0], alpha)
+        self.vy = _approach(self.vy, target[1], alpha)
+        self.vz = _approach(self.vz, target[2], alpha)
+        self.pitch = (self.vy - old_y) / dt * TILT_GAIN
+        self.roll = (self.vx - old_x) / dt * TILT_GAIN
+        self.heading = (self.heading + self.vz * YAW_GAIN * dt) % 360.0
+        rad = math.radians(self.heading)
+        self.east += (self.vx * math.cos(rad) + self.vy * math.sin(rad)) * dt
+        self.north += (self.vy * math.cos(rad) - self.vx * math.sin(rad)) * dt
+        speed = abs(self.vx) + abs(self.vy) + abs(self.vz)
+        self.centivolts = max(0.0, self.centivolts - (IDLE_DRAIN + LOAD_DRAIN * speed) * dt)
+
+    @property
+    def battery(self) -> int:
+        return battery_percent(self.centivolts)
+
+
+def _approach(value: float, target: float, alpha: float) -> float:
+    value += (target - value) * alpha
+    return target if abs(target - value) < SNAP else value
