@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from . import params, protocol
-from .escaping import escape
 from .directions import PAGE_LETTERS, Page, motion_for, target_velocity
+from .escaping import escape
 from .store import MemoryStore, Store
 from .vehicle import Vehicle, wrap_degrees
 
@@ -143,9 +143,7 @@ class Board:
         else:
             v = self.vehicle
             yaw = -v.heading if self._mode("gyro_reverse") else v.heading
-            record = protocol.Attitude(
-                round(v.pitch), round(v.roll), wrap_degrees(yaw), v.battery
-            )
+            record = protocol.Attitude(round(v.pitch), round(v.roll), wrap_degrees(yaw), v.battery)
         self._show_a = not self._show_a
         self._outbox += protocol.encode(record)
 

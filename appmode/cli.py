@@ -57,10 +57,15 @@ def build_parser() -> argparse.ArgumentParser:
         description="Boot the simulated board, drive a scripted route (page switch, "
         "directions, stop, parameter set and read) and print each command and decoded record.",
     )
-    demo.add_argument("--drive", choices=DRIVE_NAMES, default="mecanum",
-                      help="drive type of the simulated board (default: mecanum)")
-    demo.add_argument("--fast", action="store_true",
-                      help="run on virtual time instead of real time")
+    demo.add_argument(
+        "--drive",
+        choices=DRIVE_NAMES,
+        default="mecanum",
+        help="drive type of the simulated board (default: mecanum)",
+    )
+    demo.add_argument(
+        "--fast", action="store_true", help="run on virtual time instead of real time"
+    )
     demo.set_defaults(handler=_cmd_demo)
 
     decode = sub.add_parser(
@@ -70,8 +75,13 @@ def build_parser() -> argparse.ArgumentParser:
         "object per record or command, and one per undecodable run of bytes.",
     )
     decode.add_argument("file", nargs="?", help="file to read (default: standard input)")
-    decode.add_argument("--from", dest="source", choices=("host", "board"), default="board",
-                        help="who sent the bytes (default: board, i.e. board→host records)")
+    decode.add_argument(
+        "--from",
+        dest="source",
+        choices=("host", "board"),
+        default="board",
+        help="who sent the bytes (default: board, i.e. board→host records)",
+    )
     decode.set_defaults(handler=_cmd_decode)
     return parser
 

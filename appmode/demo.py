@@ -46,8 +46,9 @@ def run_demo(
         if sleep is not None:
             sleep(max(0.0, started + now - time.monotonic()))
         for event in decoder.feed(board.poll(now)):
-            records += isinstance(event, protocol.Velocity | protocol.Attitude |
-                                  protocol.ParamsRecord)
+            records += isinstance(
+                event, protocol.Velocity | protocol.Attitude | protocol.ParamsRecord
+            )
             out.write(f"{now:6.3f} < {escape(event.raw):<40} {describe(event)}\n")
         while schedule and schedule[0][0] <= now + 1e-9:
             _, command = schedule.pop(0)

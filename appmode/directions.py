@@ -52,8 +52,16 @@ DIRECTION_PAGE: dict[str, Motion] = {
     letter: MOTIONS[name]
     for letter, name in zip(
         LETTERS,
-        ("forward", "front-right", "right", "rear-right",
-         "backward", "rear-left", "left", "front-left"),
+        (
+            "forward",
+            "front-right",
+            "right",
+            "rear-right",
+            "backward",
+            "rear-left",
+            "left",
+            "front-left",
+        ),
         strict=True,
     )
 }

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Union
 
 from . import params
 from .directions import LETTERS, PAGE_LETTERS
@@ -28,7 +27,7 @@ SEPARATOR = COLON
 
 
 def _raw() -> bytes:
-    return field(default=b"", compare=False, repr=False)  # type: ignore[no-any-return]
+    return field(default=b"", compare=False, repr=False)
 
 
 # ---------------------------------------------------------------- host → board commands
@@ -114,8 +113,8 @@ class BadFrame:
     reason: str
 
 
-Command = Union[Move, Stop, SwitchPage, ReadParams, SaveParams, SetParam]
-HostEvent = Union[Command, Noise, BadFrame]
+Command = Move | Stop | SwitchPage | ReadParams | SaveParams | SetParam
+HostEvent = Command | Noise | BadFrame
 
 
 def _separator_warning(separator: int) -> str | None:
@@ -188,9 +187,9 @@ class Garbage:
     raw: bytes
 
 
-Record = Union[Velocity, Attitude, ParamsRecord, OtherRecord]
-BoardEvent = Union[Record, Malformed, Garbage]
-Event = Union[HostEvent, BoardEvent]
+Record = Velocity | Attitude | ParamsRecord | OtherRecord
+BoardEvent = Record | Malformed | Garbage
+Event = HostEvent | BoardEvent
 ERRORS = (Noise, BadFrame, Malformed, Garbage)
 """Event types that carry bytes which decoded to nothing."""
 
@@ -284,6 +283,9 @@ def _parse_frame(raw: bytes) -> HostEvent:
 class HostDecoder:
     """host→board bytes → commands (§2). A frame over 50 bytes is discarded whole."""
 
+    LIMIT = max(MAX_FRAME, MAX_RUN)
+    """Most bytes ever held between calls."""
+
     def __init__(self) -> None:
         self._buf = bytearray()
         self._skip_len = 0  # bytes of an over-long frame already reported
@@ -355,8 +357,10 @@ class HostDecoder:
         """Report what is held at the end of the stream (an unterminated frame)."""
         if not self._buf:
             return []
-        reason = _overlong(self._skip_len + len(self._buf)) if self._skip_len else (
-            "unterminated frame at end of stream"
+        reason = (
+            _overlong(self._skip_len + len(self._buf))
+            if self._skip_len
+            else ("unterminated frame at end of stream")
         )
         self._skip_len = 0
         raw = bytes(self._buf)
@@ -391,10 +395,11 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
         return OtherRecord(chr(letter), values, terminated, raw)
     if len(values) != size:
         return Malformed(raw, f"{chr(letter)} record has {len(values)} fields, expected {size}")
+    a, b, c, d = values[:4]
     if letter == 0x41:
-        return Velocity(*values, terminated=terminated, raw=raw)
+        return Velocity(a, b, c, d, terminated, raw)
     if letter == 0x42:
-        return Attitude(*values, terminated=terminated, raw=raw)
+        return Attitude(a, b, c, d, terminated, raw)
     error = params.values_error(values)
     if error is not None:
         return Malformed(raw, f"C record: {error}")
@@ -403,6 +408,9 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
 
 class BoardDecoder:
     """board→host bytes → records (§3). A missing `$` is tolerated."""
+
+    LIMIT = max(MAX_RECORD, MAX_RUN)
+    """Most bytes ever held between calls."""
 
     def __init__(self) -> None:
         self._buf = bytearray()
@@ -440,7 +448,9 @@ class BoardDecoder:
                 out.append(_parse_record(raw, raw[1 : close - pos], end == close + 2))
                 pos = end
             elif n - pos >= MAX_RECORD:
-                out.append(Malformed(bytes(buf[pos:limit]), f"over {MAX_RECORD} bytes without '}}'"))
+                out.append(
+                    Malformed(bytes(buf[pos:limit]), f"over {MAX_RECORD} bytes without '}}'")
+                )
                 pos = limit
             else:
                 break

@@ -14,38 +14,51 @@ def to_json(event: p.Event) -> dict[str, Any]:
     """One JSON-ready object: `kind`, the integer values, and `raw` (escaped bytes)."""
     body: dict[str, Any]
     if isinstance(event, p.Velocity):
-        body = {"kind": "velocity", "x": event.x, "y": event.y, "z": event.z,
-                "extra": event.extra}
+        body = {"kind": "velocity", "x": event.x, "y": event.y, "z": event.z, "extra": event.extra}
     elif isinstance(event, p.Attitude):
-        body = {"kind": "attitude", "pitch": event.pitch, "roll": event.roll,
-                "yaw": event.yaw, "battery": event.battery}
+        body = {
+            "kind": "attitude",
+            "pitch": event.pitch,
+            "roll": event.roll,
+            "yaw": event.yaw,
+            "battery": event.battery,
+        }
     elif isinstance(event, p.ParamsRecord):
         body = {"kind": "params", **event.as_dict()}
     elif isinstance(event, p.OtherRecord):
         body = {"kind": "record", "letter": event.letter, "values": list(event.values)}
     elif isinstance(event, p.Move):
-        body = {"kind": "move", "direction": event.direction, "letter": event.letter,
-                "numeric": event.numeric}
+        body = {
+            "kind": "move",
+            "direction": event.direction,
+            "letter": event.letter,
+            "numeric": event.numeric,
+        }
     elif isinstance(event, p.Stop):
         body = {"kind": "stop"}
     elif isinstance(event, p.SwitchPage):
-        body = {"kind": "page", "letter": event.letter,
-                "page": PAGE_LETTERS[event.letter].value, "mode": PAGE_NAMES[event.letter]}
+        body = {
+            "kind": "page",
+            "letter": event.letter,
+            "page": PAGE_LETTERS[event.letter].value,
+            "mode": PAGE_NAMES[event.letter],
+        }
     elif isinstance(event, (p.ReadParams, p.SaveParams)):
         kind = "read_params" if isinstance(event, p.ReadParams) else "save_params"
         body = {"kind": kind}
         if event.warning is not None:
             body["warning"] = event.warning
     elif isinstance(event, p.SetParam):
-        body = {"kind": "set_param", "index": event.index, "name": event.name,
-                "value": event.value}
+        body = {"kind": "set_param", "index": event.index, "name": event.name, "value": event.value}
     elif isinstance(event, p.Noise):
         body = {"kind": "noise"}
     elif isinstance(event, p.Garbage):
         body = {"kind": "garbage"}
     else:
-        body = {"kind": "bad_frame" if isinstance(event, p.BadFrame) else "malformed",
-                "reason": event.reason}
+        body = {
+            "kind": "bad_frame" if isinstance(event, p.BadFrame) else "malformed",
+            "reason": event.reason,
+        }
     if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord, p.OtherRecord)) and (
         not event.terminated
     ):
@@ -59,14 +72,16 @@ def describe(event: p.Event) -> str:
     if isinstance(event, p.Velocity):
         return f"velocity x={event.x} y={event.y} z={event.z}"
     if isinstance(event, p.Attitude):
-        return (f"attitude pitch={event.pitch} roll={event.roll} yaw={event.yaw} "
-                f"battery={event.battery}%")
+        return (
+            f"attitude pitch={event.pitch} roll={event.roll} yaw={event.yaw} "
+            f"battery={event.battery}%"
+        )
     if isinstance(event, p.ParamsRecord):
         return "params " + " ".join(f"{k}={v}" for k, v in event.as_dict().items())
     if isinstance(event, p.OtherRecord):
         return f"record {event.letter} {list(event.values)}"
     if isinstance(event, p.Move):
-        return f"move {event.direction} ({event.letter})"
+        return f"move {event.letter} (direction {event.direction})"
     if isinstance(event, p.Stop):
         return "stop"
     if isinstance(event, p.SwitchPage):

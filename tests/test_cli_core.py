@@ -1,0 +1,63 @@
+"""The command line: `appmode decode` (design.md contract) and `appmode demo`."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+
+def appmode(*args: str, stdin: bytes = b"") -> subprocess.CompletedProcess[bytes]:
+    return subprocess.run(
+        [sys.executable, "-m", "appmode", *args],
+        input=stdin,
+        capture_output=True,
+        timeout=60,
+        check=False,
+    )
+
+
+def test_decode_example_from_the_issue() -> None:
+    done = appmode("decode", stdin=b"{A1:2:3:0}$xx{B-5:0:90:87}$")
+    assert done.returncode == 0, done.stderr
+    objects = [json.loads(line) for line in done.stdout.decode().splitlines()]
+    assert objects == [
+        {"kind": "velocity", "x": 1, "y": 2, "z": 3, "extra": 0, "raw": "{A1:2:3:0}$"},
+        {"kind": "garbage", "raw": "xx"},
+        {
+            "kind": "attitude",
+            "pitch": -5,
+            "roll": 0,
+            "yaw": 90,
+            "battery": 87,
+            "raw": "{B-5:0:90:87}$",
+        },
+    ]
+
+
+def test_decode_host_stream_groups_noise_runs(tmp_path: Path) -> None:
+    capture = tmp_path / "host.bin"
+    capture.write_bytes(b"JA\r\n\x00{0:800}{Q\x03P}{9:1}Z")
+    done = appmode("decode", "--from", "host", str(capture))
+    kinds = [json.loads(line)["kind"] for line in done.stdout.decode().splitlines()]
+    assert kinds == ["page", "move", "noise", "set_param", "read_params", "bad_frame", "stop"]
+
+
+def test_decode_missing_file_is_one_line_error() -> None:
+    done = appmode("decode", "/nonexistent/capture.bin")
+    assert done.returncode == 2
+    assert done.stderr.decode().strip() == (
+        "appmode: error: cannot read /nonexistent/capture.bin: No such file or directory"
+    )
+
+
+def test_demo_prints_the_route_and_records() -> None:
+    done = appmode("demo", "--fast", "--drive", "diff")
+    assert done.returncode == 0, done.stderr
+    text = done.stdout.decode()
+    assert text.startswith("SIMULATED board (diff drive)")
+    assert "> {Q:P}" in text and "< {C500:10000:20:0:10:10:10:0:2}$" in text
+    assert "< {C800:" in text, "the route's set is read back"
+    assert "velocity x=0 y=500 z=0" in text, "forward at max speed on a differential drive"
+    assert text.count("< {A") > 20 and text.count("< {B") > 20
