@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 from collections.abc import Callable, Sequence
 
 from . import __version__
 from .errors import AppmodeError
-from .params import DRIVE_NAMES, DriveType
+from .params import DRIVE_NAMES, PARAMS, DriveType
 
 Handler = Callable[[argparse.Namespace], int]
 
@@ -33,6 +34,56 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     run_demo(sys.stdout, DriveType.from_cli_name(args.drive), None if args.fast else _sleep)
     return 0
+
+
+def _cmd_board(args: argparse.Namespace) -> int:
+    from .serve import run_board
+
+    return run_board(
+        use_pty=args.pty,
+        listen=args.listen,
+        device=args.port,
+        drive=args.drive,
+        flash=args.flash,
+        pace=not args.no_pace,
+        record=args.record,
+        quiet=args.quiet,
+    )
+
+
+def _cmd_send(args: argparse.Namespace) -> int:
+    from .hostcmds import run_send
+
+    return run_send(
+        args.url,
+        args.tokens,
+        listen=args.listen,
+        raw=args.raw,
+        as_json=args.json,
+        record=args.record,
+        out=sys.stdout,
+    )
+
+
+def _cmd_params(args: argparse.Namespace) -> int:
+    from .hostcmds import run_params
+
+    return run_params(
+        args.url, args.set, save=args.save, as_json=args.json, record=args.record, out=sys.stdout
+    )
+
+
+def _cmd_monitor(args: argparse.Namespace) -> int:
+    from .hostcmds import run_monitor
+
+    return run_monitor(
+        args.url,
+        as_json=args.json,
+        duration=args.duration,
+        count=args.count,
+        record=args.record,
+        out=sys.stdout,
+    )
 
 
 def _sleep(seconds: float) -> None:
@@ -83,13 +134,128 @@ def build_parser() -> argparse.ArgumentParser:
         help="who sent the bytes (default: board, i.e. board→host records)",
     )
     decode.set_defaults(handler=_cmd_decode)
+
+    board = sub.add_parser(
+        "board",
+        help="serve the simulated board on a pseudo-terminal, TCP or a serial port",
+        description="Serve the simulated board so that any serial program (the phone app "
+        "through a Bluetooth module, miniterm, appmode itself) can talk to it. Prints "
+        "'port: URL' for clients to open, then logs what it receives until Ctrl-C.",
+    )
+    where = board.add_mutually_exclusive_group()
+    where.add_argument(
+        "--pty", action="store_true", help="serve on a new pseudo-terminal (the default)"
+    )
+    where.add_argument(
+        "--listen",
+        metavar="HOST:PORT",
+        help="serve on TCP, one client at a time (host 127.0.0.1 by default; "
+        "port 0 picks a free one)",
+    )
+    where.add_argument(
+        "--port",
+        metavar="DEV",
+        help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
+    )
+    board.add_argument(
+        "--drive", choices=DRIVE_NAMES, help="drive type (default: the saved one, else omni)"
+    )
+    board.add_argument(
+        "--flash",
+        metavar="FILE",
+        help="keep saved parameters in this JSON file (default: in memory)",
+    )
+    board.add_argument(
+        "--no-pace",
+        action="store_true",
+        help="send as fast as the link takes, not at the 9600-bps line rate",
+    )
+    _add_record(board)
+    board.add_argument(
+        "--quiet", "-q", action="store_true", help="do not log what the board receives"
+    )
+    board.set_defaults(handler=_cmd_board)
+
+    send = sub.add_parser(
+        "send",
+        help="send letters and frames to a board and print what comes back",
+        description="Send tokens in order and print the records that come back. Tokens: "
+        "letters (A-H drive, I J K pages, Z stop; 'JAZ' sends three), frames ({Q:P}, "
+        "{Q:W}, {0:800}), escaped bytes (\\x01) and waits (wait:0.5). Z is always sent "
+        "last, so the car is never left moving.",
+    )
+    _add_url(send)
+    send.add_argument("tokens", nargs="+", metavar="TOKEN", help="what to send")
+    send.add_argument(
+        "--listen",
+        type=float,
+        default=0.3,
+        metavar="SECONDS",
+        help="how long to print replies after the last token (default 0.3)",
+    )
+    send.add_argument(
+        "--raw", action="store_true", help="send frames even if the board would reject them"
+    )
+    send.add_argument("--json", action="store_true", help="print JSON Lines")
+    _add_record(send)
+    send.set_defaults(handler=_cmd_send)
+
+    prm = sub.add_parser(
+        "params",
+        help="read, set (verified) and save the nine parameters",
+        description="Read the nine parameters; with --set, set each and verify it by reading "
+        "back; with --save, save them to the board's flash. Names: "
+        + ", ".join(p.name for p in PARAMS)
+        + " (or their numbers 0-8).",
+    )
+    _add_url(prm)
+    prm.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="set a parameter (repeatable), e.g. --set max_speed=800",
+    )
+    prm.add_argument("--save", action="store_true", help="save to flash ({Q:W})")
+    prm.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_record(prm)
+    prm.set_defaults(handler=_cmd_params)
+
+    mon = sub.add_parser(
+        "monitor",
+        help="print decoded records as they arrive",
+        description="Print each record as it arrives (and each undecodable run of bytes), "
+        "until Ctrl-C. Link losses are reported on stderr and the link is reopened.",
+    )
+    _add_url(mon)
+    mon.add_argument("--json", action="store_true", help="print JSON Lines")
+    mon.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
+    mon.add_argument("--count", type=int, metavar="N", help="stop after N records")
+    _add_record(mon)
+    mon.set_defaults(handler=_cmd_monitor)
     return parser
+
+
+def _add_url(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "url",
+        metavar="URL",
+        help="the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
+        "rfc2217://HOST:PORT, loop:// or sim:// (the simulated board)",
+    )
+
+
+def _add_record(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--record", metavar="FILE", help="record the session as a transcript (flushed line by line)"
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler: Handler = args.handler
+    signal.signal(signal.SIGTERM, _interrupt)
     try:
         return handler(args)
     except AppmodeError as exc:
@@ -103,6 +269,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    """SIGTERM ends a command the way Ctrl-C does: cleanly, the car stopped."""
+    raise KeyboardInterrupt
 
 
 if __name__ == "__main__":

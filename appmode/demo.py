@@ -8,9 +8,8 @@ from typing import TextIO
 
 from . import protocol
 from .board import Board
-from .escaping import escape
 from .params import DriveType
-from .render import describe
+from .render import describe, line
 
 ROUTE: tuple[tuple[float, protocol.Command], ...] = (
     (0.00, protocol.ReadParams()),
@@ -49,12 +48,12 @@ def run_demo(
             records += isinstance(
                 event, protocol.Velocity | protocol.Attitude | protocol.ParamsRecord
             )
-            out.write(f"{now:6.3f} < {escape(event.raw):<40} {describe(event)}\n")
+            out.write(line(now, "<", event.raw, describe(event)) + "\n")
         while schedule and schedule[0][0] <= now + 1e-9:
             _, command = schedule.pop(0)
             data = protocol.encode(command)
             board.receive(data, now)
-            out.write(f"{now:6.3f} > {escape(data):<40} {describe(command)}\n")
+            out.write(line(now, ">", data, describe(command)) + "\n")
         out.flush()
         now = round(now + 0.05, 3)
     return records

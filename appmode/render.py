@@ -112,3 +112,21 @@ def coalesce(events: Iterable[p.Event]) -> Iterator[p.Event]:
             yield event
     if pending is not None:
         yield pending
+
+
+def line(time: float, direction: str, raw: bytes, text: str) -> str:
+    """`  1.234 < {A0:0:0:0}$   velocity …`: one event of a session, for people."""
+    return f"{time:7.3f} {direction} {escape(raw):<34} {text}"
+
+
+def params_table(values: tuple[int, ...]) -> str:
+    """The nine parameters as an aligned table with their ranges and defaults."""
+    from .params import PARAMS
+
+    rows = [f"{'n':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
+    for param, value in zip(PARAMS, values, strict=True):
+        rows.append(
+            f"{param.index:>2}  {param.name:<18} {value:>10}  "
+            f"{param.range_text:<14} {param.default:>7}"
+        )
+    return "\n".join(rows)

@@ -115,3 +115,8 @@ def _parse(text: str) -> tuple[int, ...]:
     if error is not None:
         raise ValueError(error)
     return tuple(values)
+
+
+def open_store(flash: str | None) -> Store:
+    """The store for a board: a JSON file when `flash` names one, else in memory."""
+    return JsonFileStore(flash) if flash else MemoryStore()

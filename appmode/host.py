@@ -1,0 +1,201 @@
+"""The host over a link: read, set and save parameters, send, and follow records.
+
+Synchronous and thread-free: every call reads what the board has sent meanwhile. When
+the link is lost the host says so (a LinkStatus event), retries the same URL every
+RETRY seconds, and says so again when it is back. Closing sends `Z` first.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable, Iterator
+from types import TracebackType
+
+import serial
+
+from . import params, protocol
+from .client import HostState, LinkStatus
+from .errors import AppmodeError
+from .link import open_link
+from .wire import Tap
+
+RETRY = 0.5
+READ_TIMEOUT = 0.5
+TRIES = 3
+
+Event = protocol.BoardEvent | LinkStatus
+
+
+class LinkLost(AppmodeError):
+    """The link is down; the host is trying to get it back."""
+
+
+class Host:
+    """A session with one board."""
+
+    def __init__(
+        self, url: str, tap: Tap | None = None, clock: Callable[[], float] = time.monotonic
+    ) -> None:
+        self.url = url
+        self.tap = tap
+        self.state = HostState()
+        self._clock = clock
+        self._origin = clock()
+        self._port: serial.SerialBase | None = open_link(url)
+        self._lost_at = 0.0
+        self._pending: list[Event] = []
+
+    # ------------------------------------------------------------ link
+
+    def now(self) -> float:
+        """Seconds since the session started."""
+        return self._clock() - self._origin
+
+    @property
+    def connected(self) -> bool:
+        return self._port is not None
+
+    def _lost(self, exc: Exception) -> None:
+        if self._port is not None:
+            with contextlib.suppress(serial.SerialException, OSError):
+                self._port.close()
+        self._port = None
+        self._lost_at = self.now()
+        self.state.reset_decoder()
+        self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
+
+    def _reconnect(self) -> None:
+        if self.now() - self._lost_at < RETRY:
+            return
+        self._lost_at = self.now()
+        try:
+            self._port = open_link(self.url)
+        except AppmodeError:
+            return
+        self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
+
+    def send(self, data: bytes) -> None:
+        """Write bytes to the board; LinkLost if the link is down."""
+        if self._port is None:
+            self._reconnect()
+        if self._port is None:
+            raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
+        try:
+            self._port.write(data)
+        except (serial.SerialException, OSError) as exc:
+            self._lost(exc)
+            raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
+        self.state.sent(data)
+        if self.tap is not None:
+            self.tap(">", self.now(), data)
+
+    def send_command(self, command: protocol.Command) -> None:
+        self.send(protocol.encode(command))
+
+    def poll(self, timeout: float) -> list[Event]:
+        """What arrives within `timeout` seconds (returns as soon as something does)."""
+        deadline = self.now() + timeout
+        while True:
+            events = self._read_once()
+            if events or self.now() >= deadline:
+                return events
+            if self._port is None:
+                time.sleep(min(RETRY / 5, max(0.0, deadline - self.now())))
+
+    def _read_once(self) -> list[Event]:
+        if self._port is None:
+            self._reconnect()
+        events = self._take_pending()
+        if self._port is None:
+            return events
+        try:
+            data = self._port.read(max(1, self._port.in_waiting))
+        except (serial.SerialException, OSError) as exc:
+            self._lost(exc)
+            return events + self._take_pending()
+        if data:
+            now = self.now()
+            if self.tap is not None:
+                self.tap("<", now, data)
+            events += self.state.feed(data, now)
+        return events
+
+    def _take_pending(self) -> list[Event]:
+        events, self._pending = self._pending, []
+        return events
+
+    def events(self, duration: float | None = None) -> Iterator[Event]:
+        """Records, errors and link changes as they arrive, for `duration` seconds."""
+        end = None if duration is None else self.now() + duration
+        while end is None or self.now() < end:
+            step = 0.2 if end is None else max(0.0, min(0.2, end - self.now()))
+            yield from self.poll(step)
+
+    # ------------------------------------------------------------ parameters
+
+    def read_params(self, timeout: float = READ_TIMEOUT, tries: int = TRIES) -> tuple[int, ...]:
+        """Send `{Q:P}` and wait for the C record, retrying; AppmodeError if none comes."""
+        for _ in range(tries):
+            seen = self.state.params_seen
+            try:
+                self.send_command(protocol.ReadParams())
+            except LinkLost:
+                self.poll(timeout)
+                continue
+            end = self.now() + timeout
+            while self.now() < end:
+                self.poll(end - self.now())
+                if self.state.params_seen > seen and self.state.params is not None:
+                    return self.state.params.values
+        raise AppmodeError(
+            f"no parameters from {self.url}: sent {{Q:P}} {tries} times and no C record came "
+            f"back within {timeout:g} s; check the board is on, the port and baud rate "
+            f"(9600), and that no other program is using the port"
+        )
+
+    def set_param(self, index: int, value: int, tries: int = TRIES) -> tuple[int, ...]:
+        """Set a parameter and verify it by reading back; returns the parameters read."""
+        params.check_value(index, value)
+        got: int | None = None
+        for _ in range(tries):
+            self.send_command(protocol.SetParam(index, value))
+            values = self.read_params()
+            if values[index] == value:
+                return values
+            got = values[index]
+        name = params.PARAMS[index].name
+        raise AppmodeError(
+            f"{name} reads {got} after setting it to {value} {tries} times: the board did not "
+            f"take the value"
+        )
+
+    def save(self) -> None:
+        """Send `{Q:W}`: the board saves its running parameters to flash."""
+        self.send_command(protocol.SaveParams())
+
+    # ------------------------------------------------------------ end
+
+    def close(self) -> None:
+        """Stop the car (`Z` is the last byte sent), then close the port."""
+        if self._port is None:
+            return
+        try:
+            self.send(b"Z")
+            self._port.flush()
+        except (AppmodeError, serial.SerialException, OSError):
+            pass
+        if self._port is not None:
+            self._port.close()
+            self._port = None
+
+    def __enter__(self) -> Host:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()

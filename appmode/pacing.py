@@ -1,0 +1,76 @@
+"""A one-way serial line, with no I/O: bytes go in at a time and come out paced.
+
+At `baud` with 10 bits a byte (8N1), a byte pushed at time t is delivered when its
+stop bit is done. Deadlines are computed from each burst's start (`start + (i+1) * byte
+time`), never by adding a sleep per byte, so rounding errors do not accumulate. With
+no baud the line is instantaneous.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+BITS_PER_BYTE = 10
+
+
+def byte_time(baud: int | None) -> float:
+    """Seconds one byte takes on the wire; 0 for an unpaced line."""
+    return BITS_PER_BYTE / baud if baud else 0.0
+
+
+class Line:
+    """Bytes pushed at a time, delivered at the line's rate, in order."""
+
+    def __init__(self, baud: int | None) -> None:
+        self.byte_time = byte_time(baud)
+        self._bursts: deque[tuple[float, bytes]] = deque()  # (first byte's start, data)
+        self._taken = 0  # bytes of the first burst already delivered
+        self._free_at = float("-inf")
+
+    def __len__(self) -> int:
+        return sum(len(d) for _, d in self._bursts) - self._taken
+
+    def push(self, data: bytes, now: float) -> None:
+        """Queue `data`, sent from `now` or when the line is free, whichever is later."""
+        if not data:
+            return
+        start = max(now, self._free_at)
+        self._bursts.append((start, bytes(data)))
+        self._free_at = start + len(data) * self.byte_time
+
+    def next_due(self) -> float | None:
+        """When the next byte is delivered, or None when the line is idle."""
+        if not self._bursts:
+            return None
+        start, _ = self._bursts[0]
+        return start + (self._taken + 1) * self.byte_time
+
+    def take(self, now: float) -> bytes:
+        """Every byte delivered by `now`."""
+        return b"".join(data for _, data in self.take_timed(now))
+
+    def take_timed(self, now: float) -> list[tuple[float, bytes]]:
+        """Bytes delivered by `now`, each run with its delivery time.
+
+        On a paced line a run is one byte; on an instantaneous line, one burst.
+        """
+        out: list[tuple[float, bytes]] = []
+        step = self.byte_time
+        while self._bursts:
+            start, data = self._bursts[0]
+            if step == 0.0:
+                if start > now:
+                    break
+                out.append((start, data[self._taken :]))
+                self._bursts.popleft()
+                self._taken = 0
+                continue
+            due = min(len(data), int((now - start) / step + 1e-9))
+            for i in range(self._taken, due):
+                out.append((start + (i + 1) * step, data[i : i + 1]))
+            if due < len(data):
+                self._taken = max(self._taken, due)
+                break
+            self._bursts.popleft()
+            self._taken = 0
+        return out

@@ -1,0 +1,262 @@
+"""`appmode board`: serve the simulated board on a pseudo-terminal, TCP, or a real port.
+
+One thread, one selector. The board keeps running (and keeps its state) whatever the
+client does: a pty's other end closing, a TCP client leaving, nobody listening.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import pty
+import selectors
+import socket
+import sys
+import termios
+import time
+import tty
+from collections.abc import Callable
+from functools import partial
+
+import serial
+
+from .board import Board
+from .errors import AppmodeError
+from .link import BAUD, explain_open_error, parse_device
+from .params import DriveType
+from .store import open_store
+from .transcript import Recorder
+from .wire import Tap, Wire
+
+Log = Callable[[str], None]
+READ_SIZE = 4096
+
+
+class PtyEndpoint:
+    """A new pseudo-terminal; clients open its slave path like a serial port.
+
+    The server holds the slave open itself, so the master never sees EIO when a client
+    closes, and the path stays the same for the next client.
+    """
+
+    def __init__(self, sel: selectors.BaseSelector, log: Log) -> None:
+        self._master, self._slave = pty.openpty()
+        tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
+        os.set_blocking(self._master, False)
+        self.url = os.ttyname(self._slave)
+        sel.register(self._master, selectors.EVENT_READ, self._read)
+
+    def _read(self) -> bytes:
+        try:
+            return os.read(self._master, READ_SIZE)
+        except (BlockingIOError, InterruptedError):
+            return b""
+
+    def write(self, data: bytes) -> None:
+        try:
+            os.write(self._master, data)
+        except BlockingIOError:
+            # Nobody is reading: drop what is queued, as a UART talks to nobody.
+            termios.tcflush(self._slave, termios.TCIFLUSH)
+
+    def close(self) -> None:
+        os.close(self._master)
+        os.close(self._slave)
+
+
+class TcpEndpoint:
+    """A TCP listener serving one client at a time; others are refused while it stays."""
+
+    def __init__(self, sel: selectors.BaseSelector, log: Log, host: str, port: int) -> None:
+        self._sel = sel
+        self._log = log
+        try:
+            self._listener = socket.create_server((host, port))
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                raise AppmodeError(
+                    f"TCP port {host}:{port} is already in use: pick another with --listen "
+                    f"HOST:PORT (port 0 picks a free one), or stop the program using it"
+                ) from None
+            raise AppmodeError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
+        self._listener.setblocking(False)
+        bound_host, bound_port = self._listener.getsockname()[:2]
+        self.url = f"socket://{bound_host}:{bound_port}"
+        self._client: socket.socket | None = None
+        sel.register(self._listener, selectors.EVENT_READ, self._accept)
+
+    def _accept(self) -> bytes:
+        try:
+            conn, peer = self._listener.accept()
+        except (BlockingIOError, InterruptedError):
+            return b""
+        if self._client is not None:
+            self._log(f"refused a client from {peer[0]}:{peer[1]}: one client at a time")
+            conn.close()
+            return b""
+        conn.setblocking(False)
+        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._client = conn
+        self._sel.register(conn, selectors.EVENT_READ, self._read)
+        self._log(f"client connected from {peer[0]}:{peer[1]}")
+        return b""
+
+    def _read(self) -> bytes:
+        assert self._client is not None
+        try:
+            data = self._client.recv(READ_SIZE)
+        except (BlockingIOError, InterruptedError):
+            return b""
+        except OSError as exc:
+            self._drop(f"client connection lost ({exc.strerror})")
+            return b""
+        if not data:
+            self._drop("client disconnected")
+        return data
+
+    def write(self, data: bytes) -> None:
+        if self._client is None:
+            return
+        try:
+            self._client.send(data)
+        except BlockingIOError:
+            pass  # the client is not reading: the bytes are lost, as on a real line
+        except OSError as exc:
+            self._drop(f"client connection lost ({exc.strerror})")
+
+    def _drop(self, why: str) -> None:
+        if self._client is not None:
+            self._sel.unregister(self._client)
+            self._client.close()
+            self._client = None
+            self._log(f"{why}; waiting for the next client")
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+        self._listener.close()
+
+
+class SerialEndpoint:
+    """A real serial port (a USB-UART, with a Bluetooth module for the phone app)."""
+
+    def __init__(self, sel: selectors.BaseSelector, log: Log, device: str) -> None:
+        path, baud = parse_device(device)
+        try:
+            self._port = serial.Serial(path, baudrate=baud, timeout=0, exclusive=True)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise AppmodeError(explain_open_error(path, exc)) from None
+        self.url = path
+        self.baud = baud
+        sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
+
+    def _read(self) -> bytes:
+        data: bytes = self._port.read(max(1, self._port.in_waiting))
+        return data
+
+    def write(self, data: bytes) -> None:
+        self._port.write(data)
+
+    def close(self) -> None:
+        self._port.close()
+
+
+Endpoint = PtyEndpoint | TcpEndpoint | SerialEndpoint
+
+
+def parse_listen(text: str) -> tuple[str, int]:
+    """`PORT` or `HOST:PORT` (host 127.0.0.1 by default)."""
+    host, _, port = text.rpartition(":")
+    if not port.isdigit() or int(port) > 65535:
+        raise AppmodeError(f"--listen {text!r}: expected HOST:PORT or PORT, e.g. 127.0.0.1:5000")
+    return host.strip("[]") or "127.0.0.1", int(port)
+
+
+def serve(
+    make_endpoint: Callable[[selectors.BaseSelector, Log], Endpoint],
+    board: Board,
+    *,
+    pace: bool,
+    log: Log,
+    announce: Callable[[str], None],
+    tap: Tap | None = None,
+    banner: str = "",
+) -> None:
+    """Serve `board` until interrupted (KeyboardInterrupt); `announce` gets the port line."""
+    sel = selectors.DefaultSelector()
+    endpoint = make_endpoint(sel, log)
+    baud = getattr(endpoint, "baud", BAUD)
+    wire = Wire(board, baud if pace else None, tap)
+    origin = time.monotonic()
+    announce(f"port: {endpoint.url}")
+    if banner:
+        log(banner)
+    for note in board.take_notes():
+        log(note.text)
+    try:
+        while True:
+            out = wire.pump(time.monotonic() - origin)
+            if out:
+                endpoint.write(out)
+            for note in board.take_notes():
+                log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
+            timeout = max(0.0, wire.next_wakeup() - (time.monotonic() - origin))
+            for key, _ in sel.select(timeout):
+                data = key.data()
+                if data:
+                    wire.write(data, time.monotonic() - origin)
+    finally:
+        endpoint.close()
+        sel.close()
+
+
+def run_board(
+    *,
+    use_pty: bool,
+    listen: str | None,
+    device: str | None,
+    drive: str | None,
+    flash: str | None,
+    pace: bool,
+    record: str | None,
+    quiet: bool,
+) -> int:
+    """The `appmode board` command: build the board and serve it until interrupted."""
+
+    def log(text: str) -> None:
+        if not quiet:
+            print(f"board: {text}", file=sys.stderr, flush=True)
+
+    def announce(text: str) -> None:
+        print(text, flush=True)
+
+    make: Callable[[selectors.BaseSelector, Log], Endpoint]
+    if listen is not None:
+        host, port = parse_listen(listen)
+        make = partial(_tcp, host=host, port=port)
+    elif device is not None:
+        make = partial(_serial, device=device)
+    else:
+        make = PtyEndpoint
+    board = Board(open_store(flash), drive=DriveType.from_cli_name(drive) if drive else None)
+    banner = (
+        f"simulated board, {board.drive_type.cli_name} drive, flash {flash or 'in memory'}, "
+        f"{'paced at the line rate' if pace else 'not paced'}"
+    )
+    recorder = Recorder.create(record) if record else None
+    try:
+        serve(make, board, pace=pace, log=log, announce=announce, tap=recorder, banner=banner)
+    except KeyboardInterrupt:
+        log("stopped")
+    finally:
+        if recorder is not None:
+            recorder.close()
+    return 0
+
+
+def _tcp(sel: selectors.BaseSelector, log: Log, *, host: str, port: int) -> Endpoint:
+    return TcpEndpoint(sel, log, host, port)
+
+
+def _serial(sel: selectors.BaseSelector, log: Log, *, device: str) -> Endpoint:
+    return SerialEndpoint(sel, log, device)

@@ -1,0 +1,1 @@
+"""pyserial URL handlers: `serial.serial_for_url("sim://")` once appmode is imported."""
