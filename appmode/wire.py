@@ -16,6 +16,8 @@ from .pacing import Line
 Tap = Callable[[str, float, bytes], None]
 MAX_LAG = 1.0
 """Seconds behind after which the board catches up in one step instead of slot by slot."""
+MAX_BACKLOG = 960
+"""Bytes queued to the host (1 s at 9600 bps) beyond which new records are dropped."""
 
 
 class Wire:
@@ -26,6 +28,7 @@ class Wire:
         self.to_board = Line(baud)
         self.to_host = Line(baud)
         self.tap = tap
+        self.dropped = 0
 
     def write(self, data: bytes, now: float) -> None:
         """Host bytes sent at `now`."""
@@ -47,7 +50,9 @@ class Wire:
         return self.to_host.take(now)
 
     def _send(self, data: bytes, when: float) -> None:
-        if data:
+        if data and len(self.to_host) > MAX_BACKLOG:
+            self.dropped += len(data)  # the line cannot carry it: bounded, like a UART FIFO
+        elif data:
             if self.tap is not None:
                 self.tap("<", when, data)
             self.to_host.push(data, when)

@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+import tty
 from pathlib import Path
 
 import pytest
@@ -151,3 +152,25 @@ def test_tcp_port_in_use_is_one_line() -> None:
     assert done.returncode == 2
     assert f"TCP port 127.0.0.1:{port} is already in use" in done.stderr
     assert done.stderr.count("\n") == 1
+
+
+def test_board_serves_on_a_real_port_like_a_bluetooth_module() -> None:
+    """--port DEV: the test holds the far end of a pty, as the phone app would."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    path = os.ttyname(slave)
+    try:
+        with board_process("--port", path, "--quiet") as board:
+            assert board.url == path
+            os.write(master, b"{Q:P}")
+            received = b""
+            end = time.monotonic() + 3
+            while b"{C" not in received or not received.endswith(b"$"):
+                if time.monotonic() > end:
+                    break
+                if select.select([master], [], [], 0.1)[0]:
+                    received += os.read(master, 4096)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert b"{C500:10000:20:0:10:10:10:0:0}$" in received

@@ -51,7 +51,7 @@ def test_unpaced_line_delivers_at_once() -> None:
 
 def test_wire_output_never_exceeds_the_line_rate() -> None:
     wire = Wire(Board(), 9600)
-    wire.to_host.push(b"x" * 4000, 0.0)  # a backlog: the line is saturated for 4.2 s
+    wire.to_host.push(b"x" * 6000, 0.0)  # a backlog: the line is saturated for 6.25 s
     delivered = 0
     for ms in range(1, 5001):
         delivered += len(wire.pump(ms / 1000))
@@ -81,3 +81,13 @@ def test_wire_catches_up_after_a_stall_without_a_flood() -> None:
     wire.pump(0.0)
     out = wire.pump(3600.0)
     assert len(out) < 2000
+
+
+def test_wire_backlog_to_the_host_is_bounded() -> None:
+    wire = Wire(Board(), 9600)
+    wire.write(b"".join(b"{%d:4294967295}" % n for n in range(2, 8)), 0.0)
+    for k in range(2000):  # a C record (up to 100 bytes) asked for in every 50 ms slot
+        wire.write(b"{Q:P}", k * 0.05)
+        wire.pump(k * 0.05 + 0.01)
+    assert len(wire.to_host) <= 960 + 128
+    assert wire.dropped > 0

@@ -1,0 +1,55 @@
+"""Paced throughput of `appmode board --pty` as a fraction of 960 bytes/s.
+
+The board's output is saturated by asking for a long C record (all Kp/Ki/Kd at their
+maximum: about 100 bytes) in every 50 ms slot, twice what the line carries. A client
+counts the bytes it receives over the window. Target: at least 99.5 %, never above 100 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import serial
+
+from common import board
+
+LINE_RATE = 960.0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--seconds", type=float, default=10.0, help="measuring window")
+    args = parser.parse_args()
+    with board("--pty") as url:
+        port = serial.Serial(url, 9600, timeout=0.01)
+        port.write(b"".join(b"{%d:4294967295}" % n for n in range(2, 8)))
+        next_ask = time.monotonic()
+        start = end = None
+        received = 0
+        warmup = time.monotonic() + 1.0
+        while True:
+            now = time.monotonic()
+            if now >= next_ask:
+                port.write(b"{Q:P}")
+                next_ask += 0.025
+            data = port.read(4096)
+            now = time.monotonic()
+            if now < warmup or not data:
+                continue
+            if start is None:
+                start = now
+                continue
+            received += len(data)
+            end = now
+            if end - start >= args.seconds:
+                break
+        port.close()
+    assert start is not None and end is not None
+    rate = received / (end - start)
+    print(f"paced throughput over a pty: {rate:.1f} bytes/s over {end - start:.1f} s "
+          f"= {rate / LINE_RATE * 100:.2f} % of {LINE_RATE:.0f} bytes/s (target >= 99.5 %, <= 100 %)")
+
+
+if __name__ == "__main__":
+    main()
