@@ -12,8 +12,11 @@ from contextlib import contextmanager
 @contextmanager
 def board(*args: str) -> Iterator[str]:
     """Run `appmode board ARGS`; yield the URL it prints."""
-    proc = subprocess.Popen([sys.executable, "-m", "appmode", "board", "--quiet", *args],
-                            stdout=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "board", "--quiet", *args],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline()
@@ -32,5 +35,7 @@ def percentile(values: list[float], q: float) -> float:
 
 def summary_ms(values: list[float]) -> str:
     ms = [v * 1000 for v in values]
-    return (f"median {statistics.median(ms):.3f} ms, p99 {percentile(ms, 99):.3f} ms, "
-            f"max {max(ms):.3f} ms (n={len(ms)})")
+    return (
+        f"median {statistics.median(ms):.3f} ms, p99 {percentile(ms, 99):.3f} ms, "
+        f"max {max(ms):.3f} ms (n={len(ms)})"
+    )

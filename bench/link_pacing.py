@@ -11,7 +11,6 @@ import argparse
 import time
 
 import serial
-
 from common import board
 
 LINE_RATE = 960.0
@@ -47,8 +46,11 @@ def main() -> None:
         port.close()
     assert start is not None and end is not None
     rate = received / (end - start)
-    print(f"paced throughput over a pty: {rate:.1f} bytes/s over {end - start:.1f} s "
-          f"= {rate / LINE_RATE * 100:.2f} % of {LINE_RATE:.0f} bytes/s (target >= 99.5 %, <= 100 %)")
+    share = rate / LINE_RATE * 100
+    print(
+        f"paced throughput over a pty: {rate:.1f} bytes/s over {end - start:.1f} s "
+        f"= {share:.2f} % of {LINE_RATE:.0f} bytes/s (target >= 99.5 %, <= 100 %)"
+    )
 
 
 if __name__ == "__main__":

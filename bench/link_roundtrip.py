@@ -13,10 +13,11 @@ import math
 import random
 import time
 
+from common import board, summary_ms
+
 import appmode  # noqa: F401 - registers sim://
 from appmode.link import open_link
 from appmode.protocol import BoardDecoder, ParamsRecord
-from common import board, summary_ms
 
 SLOT = 0.05
 
@@ -57,8 +58,9 @@ def main() -> None:
     for label, option in (("pty", ("--pty",)), ("TCP", ("--listen", "0"))):
         with board(*option, "--no-pace") as url:
             extra = measure(url, args.trials)
-        print(f"{{Q:P}} -> C over {label}, beyond the next slot: {summary_ms(extra)} "
-              f"(target < 2 ms)")
+        print(
+            f"{{Q:P}} -> C over {label}, beyond the next slot: {summary_ms(extra)} (target < 2 ms)"
+        )
 
 
 if __name__ == "__main__":
