@@ -9,6 +9,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from . import __version__
+from .driving import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from .errors import AppmodeError
 from .params import DRIVE_NAMES, PARAMS, DriveType
 
@@ -34,6 +35,22 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     run_demo(sys.stdout, DriveType.from_cli_name(args.drive), None if args.fast else _sleep)
     return 0
+
+
+def _cmd_drive(args: argparse.Namespace) -> int:
+    from .console import run_drive
+    from .driving import HoldToDrive
+    from .session import Session
+
+    interactive = sys.stdin.isatty() and sys.stdout.isatty()
+    driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
+    session = Session(args.url, driving, args.record,
+                      on_message=None if interactive else _print_message)
+    return run_drive(session, interactive, sys.stdin, sys.stdout)
+
+
+def _print_message(text: str) -> None:
+    print(text, flush=True)
 
 
 def _cmd_board(args: argparse.Namespace) -> int:
@@ -101,6 +118,29 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"appmode {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
+
+    drive = sub.add_parser(
+        "drive",
+        help="drive and tune a car from the keyboard (the main job)",
+        description="The driving console: a live status panel, arrow keys and a 3x3 key grid "
+        "(q w e / a s d / z x c) to drive, space to stop, and a command line (:) for "
+        "everything else. With no URL it drives the embedded simulated board. When stdin "
+        "is not a terminal, commands are read from it line by line (try: help). Whatever "
+        "ends the session, the last byte sent is Z.",
+    )
+    drive.add_argument("url", nargs="?", default="sim://", metavar="URL",
+                       help="the board (default: sim://, the simulated board); see "
+                       "'appmode params -h' for URL forms")
+    drive.add_argument("--hold-first", type=float, default=FIRST_TIMEOUT, metavar="S",
+                       help="stop this long after a first key press with no repeat; longer "
+                       f"than the OS auto-repeat delay (default {FIRST_TIMEOUT})")
+    drive.add_argument("--hold-repeat", type=float, default=REPEAT_TIMEOUT, metavar="S",
+                       help="stop this long after the last auto-repeat "
+                       f"(default {REPEAT_TIMEOUT})")
+    drive.add_argument("--latched", action="store_true",
+                       help="a direction stays until stop (key l toggles it)")
+    _add_record(drive)
+    drive.set_defaults(handler=_cmd_drive)
 
     demo = sub.add_parser(
         "demo",

@@ -10,6 +10,7 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from . import protocol
+from .query import Outcome, ParamQuery
 
 RATE_WINDOW = 1.0
 
@@ -62,27 +63,56 @@ class HostState:
         self.velocity: protocol.Velocity | None = None
         self.attitude: protocol.Attitude | None = None
         self.params: protocol.ParamsRecord | None = None
-        self.params_seen = 0  # C records received so far
+        self.query: ParamQuery | None = None
+        self._outbox = bytearray()
 
-    def feed(self, data: bytes, now: float) -> list[protocol.BoardEvent]:
+    def feed(self, data: bytes, now: float) -> list[protocol.BoardEvent | Outcome]:
+        """Decode board bytes; returns the events, and the outcome of a query they end."""
         self.stats.bytes_in += len(data)
-        events = self.decoder.feed(data)
-        for event in events:
-            self._apply(event, now)
+        events: list[protocol.BoardEvent | Outcome] = []
+        for event in self.decoder.feed(data):
+            events.append(event)
+            outcome = self._apply(event, now)
+            if outcome is not None:
+                events.append(outcome)
         return events
 
     def sent(self, data: bytes) -> None:
         self.stats.bytes_out += len(data)
 
+    def start_query(self, query: ParamQuery, now: float) -> None:
+        """Begin a parameter read or set; its bytes wait in the outbox."""
+        self.query = query
+        self._outbox += query.start(now)
+
+    def tick(self, now: float) -> Outcome | None:
+        """Let time pass: a query may resend (into the outbox) or fail."""
+        if self.query is None:
+            return None
+        data, outcome = self.query.on_time(now)
+        return self._step(data, outcome)
+
+    def take_outbox(self) -> bytes:
+        """Bytes the state wants sent."""
+        data = bytes(self._outbox)
+        self._outbox.clear()
+        return data
+
+    def _step(self, data: bytes, outcome: Outcome | None) -> Outcome | None:
+        self._outbox += data
+        if outcome is not None:
+            self.query = None
+        return outcome
+
     def reset_decoder(self) -> None:
         """Forget a partial record (after the link was lost)."""
         self.decoder = protocol.BoardDecoder()
 
-    def _apply(self, event: protocol.BoardEvent, now: float) -> None:
+    def _apply(self, event: protocol.BoardEvent, now: float) -> Outcome | None:
         if isinstance(event, protocol.ERRORS):
             self.stats.errors += 1
             self.stats.discarded += len(event.raw)
-            return
+            return None
         self.stats.count_record(now)
         if isinstance(event, protocol.Velocity):
             self.velocity = event
@@ -90,4 +120,6 @@ class HostState:
             self.attitude = event
         elif isinstance(event, protocol.ParamsRecord):
             self.params = event
-            self.params_seen += 1
+            if self.query is not None:
+                return self._step(*self.query.on_params(event.values, now))
+        return None

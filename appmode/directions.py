@@ -78,8 +78,25 @@ BUTTON_PAGE: dict[str, Motion] = {
     "H": MOTIONS["front-right"],
 }
 
-GRID: tuple[tuple[str, str, str], ...] = (("H", "A", "B"), ("G", "Z", "C"), ("F", "E", "D"))
+Grid = tuple[tuple[str, str, str], ...]
+GRID: Grid = (("H", "A", "B"), ("G", "Z", "C"), ("F", "E", "D"))
 """The direction page's keys as laid out on the phone screen."""
+BUTTON_GRID: Grid = (("B", "A", "H"), ("G", "Z", "C"), ("F", "E", "D"))
+"""The button page's letters by where their motion points: front-left is B (§4)."""
+
+
+def grid_for(page: Page) -> Grid:
+    """The letters of a page laid out by direction of motion (row 0 = front)."""
+    return GRID if page is Page.DIRECTION else BUTTON_GRID
+
+
+def letter_name(page: Page, letter: str) -> str:
+    """What a letter does on a page: 'forward', 'rotate-cw', 'stop'."""
+    if letter == STOP_LETTER:
+        return "stop"
+    motion = motion_for(page, LETTERS.index(letter) + 1)
+    assert motion is not None
+    return motion.name
 
 
 def motion_for(page: Page, direction: int) -> Motion | None:

@@ -1,8 +1,9 @@
 """The host over a link: read, set and save parameters, send, and follow records.
 
-Synchronous and thread-free: every call reads what the board has sent meanwhile. When
-the link is lost the host says so (a LinkStatus event), retries the same URL every
-RETRY seconds, and says so again when it is back. Closing sends `Z` first.
+Thread-free: every call reads what the board has sent meanwhile and lets the host state
+(`client.HostState`) resend or give up on a parameter query. When the link is lost the
+host says so (a LinkStatus event), retries the same URL every RETRY seconds, and says so
+again when it is back. Closing sends `Z` first.
 """
 
 from __future__ import annotations
@@ -18,13 +19,12 @@ from . import params, protocol
 from .client import HostState, LinkStatus
 from .errors import AppmodeError
 from .link import open_link
+from .query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, QueryFailed
 from .wire import Tap
 
 RETRY = 0.5
-READ_TIMEOUT = 0.5
-TRIES = 3
 
-Event = protocol.BoardEvent | LinkStatus
+Event = protocol.BoardEvent | LinkStatus | Outcome
 
 
 class LinkLost(AppmodeError):
@@ -97,29 +97,44 @@ class Host:
         """What arrives within `timeout` seconds (returns as soon as something does)."""
         deadline = self.now() + timeout
         while True:
-            events = self._read_once()
+            events = self._read_once(block=True)
             if events or self.now() >= deadline:
                 return events
             if self._port is None:
                 time.sleep(min(RETRY / 5, max(0.0, deadline - self.now())))
 
-    def _read_once(self) -> list[Event]:
+    def poll_nowait(self) -> list[Event]:
+        """What has arrived, without waiting."""
+        return self._read_once(block=False)
+
+    def _read_once(self, block: bool) -> list[Event]:
         if self._port is None:
             self._reconnect()
         events = self._take_pending()
-        if self._port is None:
-            return events
-        try:
-            data = self._port.read(max(1, self._port.in_waiting))
-        except (serial.SerialException, OSError) as exc:
-            self._lost(exc)
-            return events + self._take_pending()
-        if data:
-            now = self.now()
-            if self.tap is not None:
-                self.tap("<", now, data)
-            events += self.state.feed(data, now)
+        if self._port is not None:
+            try:
+                waiting = self._port.in_waiting
+                data = self._port.read(max(1, waiting)) if block or waiting else b""
+            except (serial.SerialException, OSError) as exc:
+                self._lost(exc)
+                data = b""
+            events += self._take_pending()
+            if data:
+                now = self.now()
+                if self.tap is not None:
+                    self.tap("<", now, data)
+                events += self.state.feed(data, now)
+        outcome = self.state.tick(self.now())
+        if outcome is not None:
+            events.append(outcome)
+        self._flush_outbox()
         return events
+
+    def _flush_outbox(self) -> None:
+        data = self.state.take_outbox()
+        if data:
+            with contextlib.suppress(LinkLost):  # the query times out and retries
+                self.send(data)
 
     def _take_pending(self) -> list[Event]:
         events, self._pending = self._pending, []
@@ -134,41 +149,29 @@ class Host:
 
     # ------------------------------------------------------------ parameters
 
-    def read_params(self, timeout: float = READ_TIMEOUT, tries: int = TRIES) -> tuple[int, ...]:
+    def start_query(self, query: ParamQuery) -> None:
+        """Begin a read or set without waiting; its outcome comes with the events."""
+        self.state.start_query(query, self.now())
+        self._flush_outbox()
+
+    def query(self, query: ParamQuery) -> tuple[int, ...]:
+        """Run a read or set to its end; AppmodeError if it fails."""
+        self.start_query(query)
+        while True:
+            for event in self.poll(query.timeout):
+                if isinstance(event, QueryDone):
+                    return event.values
+                if isinstance(event, QueryFailed):
+                    raise AppmodeError(event.text)
+
+    def read_params(self, timeout: float = TIMEOUT, tries: int = TRIES) -> tuple[int, ...]:
         """Send `{Q:P}` and wait for the C record, retrying; AppmodeError if none comes."""
-        for _ in range(tries):
-            seen = self.state.params_seen
-            try:
-                self.send_command(protocol.ReadParams())
-            except LinkLost:
-                self.poll(timeout)
-                continue
-            end = self.now() + timeout
-            while self.now() < end:
-                self.poll(end - self.now())
-                if self.state.params_seen > seen and self.state.params is not None:
-                    return self.state.params.values
-        raise AppmodeError(
-            f"no parameters from {self.url}: sent {{Q:P}} {tries} times and no C record came "
-            f"back within {timeout:g} s; check the board is on, the port and baud rate "
-            f"(9600), and that no other program is using the port"
-        )
+        return self.query(ParamQuery(None, timeout, tries, self.url))
 
     def set_param(self, index: int, value: int, tries: int = TRIES) -> tuple[int, ...]:
         """Set a parameter and verify it by reading back; returns the parameters read."""
         params.check_value(index, value)
-        got: int | None = None
-        for _ in range(tries):
-            self.send_command(protocol.SetParam(index, value))
-            values = self.read_params()
-            if values[index] == value:
-                return values
-            got = values[index]
-        name = params.PARAMS[index].name
-        raise AppmodeError(
-            f"{name} reads {got} after setting it to {value} {tries} times: the board did not "
-            f"take the value"
-        )
+        return self.query(ParamQuery((index, value), TIMEOUT, tries, self.url))
 
     def save(self) -> None:
         """Send `{Q:W}`: the board saves its running parameters to flash."""
@@ -180,11 +183,9 @@ class Host:
         """Stop the car (`Z` is the last byte sent), then close the port."""
         if self._port is None:
             return
-        try:
+        with contextlib.suppress(AppmodeError, serial.SerialException, OSError):
             self.send(b"Z")
             self._port.flush()
-        except (AppmodeError, serial.SerialException, OSError):
-            pass
         if self._port is not None:
             self._port.close()
             self._port = None

@@ -12,6 +12,7 @@ from .client import LinkStatus
 from .errors import AppmodeError
 from .host import Event, Host
 from .protocol import HostDecoder
+from .query import QueryDone, QueryFailed
 from .render import describe, line, params_table, to_json
 from .tokens import Wait, parse_token
 from .transcript import Recorder
@@ -25,6 +26,8 @@ def _open_host(stack: ExitStack, url: str, record: str | None) -> Host:
 def _show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:
     if isinstance(event, LinkStatus):
         print(f"appmode: {event.text}", file=sys.stderr, flush=True)
+        return
+    if isinstance(event, (QueryDone, QueryFailed)):
         return
     if as_json:
         out.write(json.dumps({"t": round(host.now(), 3), **to_json(event)}) + "\n")
