@@ -44,8 +44,9 @@ def _cmd_drive(args: argparse.Namespace) -> int:
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
-    session = Session(args.url, driving, args.record,
-                      on_message=None if interactive else _print_message)
+    session = Session(
+        args.url, driving, args.record, on_message=None if interactive else _print_message
+    )
     return run_drive(session, interactive, sys.stdin, sys.stdout)
 
 
@@ -128,17 +129,32 @@ def build_parser() -> argparse.ArgumentParser:
         "is not a terminal, commands are read from it line by line (try: help). Whatever "
         "ends the session, the last byte sent is Z.",
     )
-    drive.add_argument("url", nargs="?", default="sim://", metavar="URL",
-                       help="the board (default: sim://, the simulated board); see "
-                       "'appmode params -h' for URL forms")
-    drive.add_argument("--hold-first", type=float, default=FIRST_TIMEOUT, metavar="S",
-                       help="stop this long after a first key press with no repeat; longer "
-                       f"than the OS auto-repeat delay (default {FIRST_TIMEOUT})")
-    drive.add_argument("--hold-repeat", type=float, default=REPEAT_TIMEOUT, metavar="S",
-                       help="stop this long after the last auto-repeat "
-                       f"(default {REPEAT_TIMEOUT})")
-    drive.add_argument("--latched", action="store_true",
-                       help="a direction stays until stop (key l toggles it)")
+    drive.add_argument(
+        "url",
+        nargs="?",
+        default="sim://",
+        metavar="URL",
+        help="the board (default: sim://, the simulated board); see "
+        "'appmode params -h' for URL forms",
+    )
+    drive.add_argument(
+        "--hold-first",
+        type=float,
+        default=FIRST_TIMEOUT,
+        metavar="S",
+        help="stop this long after a first key press with no repeat; longer "
+        f"than the OS auto-repeat delay (default {FIRST_TIMEOUT})",
+    )
+    drive.add_argument(
+        "--hold-repeat",
+        type=float,
+        default=REPEAT_TIMEOUT,
+        metavar="S",
+        help=f"stop this long after the last auto-repeat (default {REPEAT_TIMEOUT})",
+    )
+    drive.add_argument(
+        "--latched", action="store_true", help="a direction stays until stop (key l toggles it)"
+    )
     _add_record(drive)
     drive.set_defaults(handler=_cmd_drive)
 

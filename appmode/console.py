@@ -52,14 +52,18 @@ def build_app(
 ) -> Application[None]:
     """The console's Application over a started session."""
     history = InMemoryHistory()
-    command = Buffer(multiline=False, completer=_completer(), history=history,
-                     complete_while_typing=True)
-    status = Window(FormattedTextControl(lambda: status_fragments(session), focusable=True),
-                    wrap_lines=False)
-    messages = Window(FormattedTextControl(lambda: "\n".join(session.messages)),
-                      height=MESSAGES, wrap_lines=True)
-    command_line = VSplit([Window(FormattedTextControl(":"), width=1),
-                           Window(BufferControl(command), height=1)])
+    command = Buffer(
+        multiline=False, completer=_completer(), history=history, complete_while_typing=True
+    )
+    status = Window(
+        FormattedTextControl(lambda: status_fragments(session), focusable=True), wrap_lines=False
+    )
+    messages = Window(
+        FormattedTextControl(lambda: "\n".join(session.messages)), height=MESSAGES, wrap_lines=True
+    )
+    command_line = VSplit(
+        [Window(FormattedTextControl(":"), width=1), Window(BufferControl(command), height=1)]
+    )
     typing = Condition(lambda: app.layout.has_focus(command))
     driving = ~typing
     keys = KeyBindings()
@@ -76,8 +80,9 @@ def build_app(
     keys.add(" ", filter=driving)(lambda e: session.stop())
     for letter in "IJK":
         keys.add(letter.lower(), filter=driving)(lambda e, x=letter: session.switch_page(x))
-    keys.add("l", filter=driving)(lambda e: session.run(
-        "latch off" if session.driving.latched else "latch on"))
+    keys.add("l", filter=driving)(
+        lambda e: session.run("latch off" if session.driving.latched else "latch on")
+    )
     keys.add("+", filter=driving)(lambda e: session.run("speed +100"))
     keys.add("=", filter=driving)(lambda e: session.run("speed +100"))
     keys.add("-", filter=driving)(lambda e: session.run("speed -100"))
@@ -113,12 +118,19 @@ def build_app(
         event.app.exit()
 
     layout = Layout(
-        HSplit([status, Window(height=1, char="─"), messages,
-                ConditionalContainer(command_line, filter=typing)]),
+        HSplit(
+            [
+                status,
+                Window(height=1, char="─"),
+                messages,
+                ConditionalContainer(command_line, filter=typing),
+            ]
+        ),
         focused_element=status,
     )
-    app: Application[None] = Application(layout=layout, key_bindings=keys, full_screen=True,
-                                         input=input, output=output)
+    app: Application[None] = Application(
+        layout=layout, key_bindings=keys, full_screen=True, input=input, output=output
+    )
     return app
 
 
@@ -126,10 +138,15 @@ async def run_app(app: Application[None], session: Session) -> None:
     """Run the console until quit; the link is read every REFRESH seconds."""
 
     async def ticker() -> None:
-        while True:
-            session.tick()
-            app.invalidate()
-            await asyncio.sleep(REFRESH)
+        # A failure here must end the console (and so stop the car), not leave it
+        # running without release emulation behind prompt_toolkit's "Press ENTER".
+        try:
+            while True:
+                session.tick()
+                app.invalidate()
+                await asyncio.sleep(REFRESH)
+        except Exception as exc:
+            app.exit(exception=exc)
 
     def start_ticker() -> None:
         app.create_background_task(ticker())
@@ -142,12 +159,19 @@ async def run_app(app: Application[None], session: Session) -> None:
         loop.remove_signal_handler(signal.SIGTERM)
 
 
-def run_drive(session: Session, interactive: bool, script: TextIO, out: TextIO) -> int:
+def run_drive(
+    session: Session,
+    interactive: bool,
+    script: Iterable[str],
+    out: TextIO,
+    input: Input | None = None,
+    output: Output | None = None,
+) -> int:
     """Start the session, run the console (or script mode), and always close it: `Z` last."""
     try:
         session.start()
         if interactive:
-            asyncio.run(run_app(build_app(session), session))
+            asyncio.run(run_app(build_app(session, input, output), session))
         else:
             run_script(session, script, out)
     finally:

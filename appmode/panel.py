@@ -46,8 +46,13 @@ def status_fragments(session: Session) -> Fragments:
         last = "no record yet" if age is None else f"last record {age:.2f} s ago"
         stale = age is None or age > 1.0
         out.append(("fg:ansired bold" if stale else "fg:ansigreen", " link up"))
-        out.append(("", f"   {stats.rate(now):4.1f} records/s · in {stats.bytes_in} B · "
-                        f"out {stats.bytes_out} B · errors {stats.errors} · {last}\n"))
+        out.append(
+            (
+                "",
+                f"   {stats.rate(now):4.1f} records/s · in {stats.bytes_in} B · "
+                f"out {stats.bytes_out} B · errors {stats.errors} · {last}\n",
+            )
+        )
     else:
         out.append(("reverse bold fg:ansired", " LINK LOST — retrying; keys do nothing "))
         out.append(("", "\n"))
@@ -84,8 +89,7 @@ def status_fragments(session: Session) -> Fragments:
     if record is None:
         out.append(("", " not read yet (p reads them)\n"))
     else:
-        pairs = [f"{p.name} {value}" for p, value in zip(params.PARAMS, record.values,
-                                                          strict=True)]
+        pairs = [f"{p.name} {value}" for p, value in zip(params.PARAMS, record.values, strict=True)]
         for row in range(0, len(pairs), 3):
             prefix = " " if row == 0 else "           "
             out.append(("", prefix + " · ".join(pairs[row : row + 3]) + "\n"))
