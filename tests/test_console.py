@@ -63,7 +63,7 @@ def test_holding_up_drives_and_letting_go_stops(
     tmp_path: Path, quit_key: tuple[str, float]
 ) -> None:
     hold = [(UP, 0.03)] * 25  # the terminal's auto-repeat: ~33 presses a second
-    session, record, typed = run_console(tmp_path, [*hold, ("", 0.6), quit_key])
+    _, record, typed = run_console(tmp_path, [*hold, ("", 0.6), quit_key])
     lines = sent(record)
     payloads = [p for _, p in lines]
     assert payloads[:2] == ["J", "{Q:P}"], "the console starts on the direction page"
