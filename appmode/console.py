@@ -56,7 +56,9 @@ def build_app(
         multiline=False, completer=_completer(), history=history, complete_while_typing=True
     )
     status = Window(
-        FormattedTextControl(lambda: status_fragments(session), focusable=True), wrap_lines=False
+        FormattedTextControl(lambda: status_fragments(session), focusable=True),
+        wrap_lines=False,
+        dont_extend_height=True,
     )
     messages = Window(
         FormattedTextControl(lambda: "\n".join(session.messages)), height=MESSAGES, wrap_lines=True

@@ -19,8 +19,8 @@ ARROWS = {"up": (0, 1), "down": (2, 1), "left": (1, 0), "right": (1, 2)}
 GLYPHS = (("↖", "↑", "↗"), ("←", "■", "→"), ("↙", "↓", "↘"))
 BAR = 20
 KEYS_HELP = (
-    "arrows or q w e / a s d / z x c drive · space stop · i j k page · l latch · "
-    "+ - speed · p params · : command · ? help · Ctrl-C quit"
+    "arrows or q w e / a s d / z x c drive (hold) · space stop · i j k page · l latch\n"
+    " + - speed · p params · : command line · ? help · Ctrl-C quit"
 )
 
 

@@ -22,6 +22,6 @@ def test_readme_opens_with_two_setup_commands() -> None:
     block = re.search(r"```sh\n(.*?)```", README.read_text(), re.S)
     assert block is not None
     assert block.group(1).splitlines() == [
-        "pip install . && appmode demo",
+        "pip install . && appmode drive",
         "pip install '.[test]' && pytest",
     ]
