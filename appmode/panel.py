@@ -4,13 +4,15 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from prompt_toolkit.formatted_text import StyleAndTextTuples
+
 from . import params
 from .directions import grid_for, letter_name
 
 if TYPE_CHECKING:
     from .session import Session
 
-Fragments = list[tuple[str, str]]
+Fragments = StyleAndTextTuples
 
 KEY_GRID = (("q", "w", "e"), ("a", "s", "d"), ("z", "x", "c"))
 """Keys laid out like the phone's 3×3 grid: row 0 is the front."""
@@ -110,4 +112,4 @@ def status_fragments(session: Session) -> Fragments:
 
 def status_text(session: Session) -> str:
     """The panel as plain text."""
-    return "".join(text for _, text in status_fragments(session)).rstrip("\n")
+    return "".join(fragment[1] for fragment in status_fragments(session)).rstrip("\n")
