@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -78,3 +80,43 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
     assert "A" in sent and "{0:800}" in sent
     assert sent[-1] == "Z", sent[-5:]
+
+
+def test_sigterm_ends_the_console_with_z_last(tmp_path: Path) -> None:
+    record = tmp_path / "drive.transcript"
+    command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched --record {record}"
+    tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+    try:
+        wait_screen(r"params\s+max_speed 500")
+        tmux("send-keys", "-t", SESSION, "w")
+        wait_screen(r"in force\s+A forward")
+        pid = int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+        os.kill(pid, signal.SIGTERM)
+        end = time.monotonic() + 5
+        while time.monotonic() < end and _alive():
+            time.sleep(0.05)
+        assert not _alive()
+    finally:
+        subprocess.run(["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False)
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert "A" in sent and sent[-1] == "Z"
+
+
+def test_sigterm_ends_script_mode_with_z_last(tmp_path: Path) -> None:
+    record = tmp_path / "script.transcript"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "drive", "--record", str(record)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None and proc.stdout is not None
+    proc.stdin.write(b"drive A\n")
+    proc.stdin.flush()
+    end = time.monotonic() + 10
+    while time.monotonic() < end and (not record.exists() or " > A" not in record.read_text()):
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(10)
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert "A" in sent and sent[-1] == "Z"
