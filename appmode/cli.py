@@ -104,6 +104,38 @@ def _cmd_monitor(args: argparse.Namespace) -> int:
     )
 
 
+def _cmd_conform(args: argparse.Namespace) -> int:
+    from .conform import run_conform
+
+    return run_conform(args.paths, args.board, args.junit, sys.stdout)
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from .replay import run_replay
+
+    return run_replay(args.file, args.to, args.side, args.speed, args.loop)
+
+
+def _cmd_tap(args: argparse.Namespace) -> int:
+    from .tap import run_tap
+
+    return run_tap(args.app, args.board, args.record, args.quiet)
+
+
+def _cmd_dump(args: argparse.Namespace) -> int:
+    from .dump import run_dump
+
+    return run_dump(args.file, "json" if args.json else "csv" if args.csv else "text", sys.stdout)
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from .dump import run_plot
+
+    run_plot(args.file, args.output)
+    print(f"wrote {args.output}", file=sys.stderr)
+    return 0
+
+
 def _sleep(seconds: float) -> None:
     import time
 
@@ -289,6 +321,74 @@ def build_parser() -> argparse.ArgumentParser:
     mon.add_argument("--count", type=int, metavar="N", help="stop after N records")
     _add_record(mon)
     mon.set_defaults(handler=_cmd_monitor)
+
+    conform = sub.add_parser(
+        "conform",
+        help="run transcripts as conformance tests against a board",
+        description="Send each transcript's '>' lines at their times and match its '<' lines "
+        "against what the board sends ('*' matches any field; unmentioned telemetry is "
+        "ignored). Without --board: the embedded simulated board on virtual time (no "
+        "waiting). With --board URL: in real time against any board. One line per "
+        "transcript; exit status 1 if any fails.",
+    )
+    conform.add_argument("paths", nargs="*", metavar="FILE|DIR",
+                         help="transcripts, or directories searched for *.transcript "
+                         "(default: ./transcripts)")
+    conform.add_argument("--board", metavar="URL",
+                         help="run in real time against this board instead")
+    conform.add_argument("--junit", metavar="FILE", help="also write a JUnit XML report")
+    conform.set_defaults(handler=_cmd_conform)
+
+    replay = sub.add_parser(
+        "replay",
+        help="play one side of a transcript to a port",
+        description="Play the host's lines ('>', driving a board) or the board's lines ('<', "
+        "feeding an app) to a port, each at its time from the start. As the host the replay "
+        "ends with Z.",
+    )
+    replay.add_argument("file", metavar="FILE", help="the transcript")
+    replay.add_argument("--to", required=True, metavar="URL", help="where to play it")
+    replay.add_argument("--side", choices=("host", "board"), default="host",
+                        help="which side to play (default: host)")
+    replay.add_argument("--speed", type=float, default=1.0, metavar="X",
+                        help="time factor: 2 plays twice as fast (default 1)")
+    replay.add_argument("--loop", type=int, default=1, metavar="N",
+                        help="play it N times (default 1)")
+    replay.set_defaults(handler=_cmd_replay)
+
+    tap = sub.add_parser(
+        "tap",
+        help="sit between an app and a board, recording both directions",
+        description="Forward bytes both ways between the app side and the board side and "
+        "record them, timestamped, as a transcript. APP may be 'pty': a new pseudo-terminal "
+        "for the app to open (its path is printed as 'port: …'). On exit the board gets Z.",
+    )
+    tap.add_argument("app", metavar="URL_APP", help="the app's side (or 'pty')")
+    tap.add_argument("board", metavar="URL_BOARD", help="the board's side")
+    tap.add_argument("--record", required=True, metavar="FILE", help="the transcript to write")
+    tap.add_argument("--quiet", "-q", action="store_true", help="no status lines")
+    tap.set_defaults(handler=_cmd_tap)
+
+    dump = sub.add_parser(
+        "dump",
+        help="decode a transcript",
+        description="Decode every command and record of a transcript: text, JSON Lines or CSV.",
+    )
+    dump.add_argument("file", metavar="FILE", help="the transcript")
+    fmt = dump.add_mutually_exclusive_group()
+    fmt.add_argument("--json", action="store_true", help="JSON Lines")
+    fmt.add_argument("--csv", action="store_true", help="CSV with a header row")
+    dump.set_defaults(handler=_cmd_dump)
+
+    plot = sub.add_parser(
+        "plot",
+        help="draw a transcript's telemetry (needs matplotlib)",
+        description="Draw velocities, attitude and battery over time, with the commands "
+        "marked, to a PNG. Needs the plot extra: pip install 'appmode[plot]'.",
+    )
+    plot.add_argument("file", metavar="FILE", help="the transcript")
+    plot.add_argument("-o", "--output", required=True, metavar="PNG", help="the image to write")
+    plot.set_defaults(handler=_cmd_plot)
     return parser
 
 

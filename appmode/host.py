@@ -41,8 +41,8 @@ class Host:
         self.tap = tap
         self.state = HostState()
         self._clock = clock
-        self._origin = clock()
         self._port: serial.SerialBase | None = open_link(url)
+        self._origin = clock()  # after opening: an in-process sim:// board booted just now
         self._lost_at = 0.0
         self._pending: list[Event] = []
 

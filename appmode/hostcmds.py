@@ -14,12 +14,17 @@ from .host import Event, Host
 from .protocol import HostDecoder
 from .query import QueryDone, QueryFailed
 from .render import describe, line, params_table, to_json
+from .simport import sim_directives
 from .tokens import Wait, parse_token
 from .transcript import Recorder
 
 
 def _open_host(stack: ExitStack, url: str, record: str | None) -> Host:
-    recorder = stack.enter_context(closing(Recorder.create(record))) if record else None
+    recorder = (
+        stack.enter_context(closing(Recorder.create(record, 0.0, sim_directives(url))))
+        if record
+        else None
+    )
     return stack.enter_context(Host(url, tap=recorder))
 
 

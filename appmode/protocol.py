@@ -190,10 +190,22 @@ class Garbage:
 Record = Velocity | Attitude | ParamsRecord | OtherRecord
 BoardEvent = Record | Malformed | Garbage
 Event = HostEvent | BoardEvent
+RECORDS = (Velocity, Attitude, ParamsRecord, OtherRecord)
 ERRORS = (Noise, BadFrame, Malformed, Garbage)
 """Event types that carry bytes which decoded to nothing."""
 
 # ---------------------------------------------------------------- encoding
+
+
+def record_fields(record: Record) -> tuple[str, tuple[int, ...]]:
+    """A record as (letter, field values)."""
+    if isinstance(record, Velocity):
+        return "A", (record.x, record.y, record.z, record.extra)
+    if isinstance(record, Attitude):
+        return "B", (record.pitch, record.roll, record.yaw, record.battery)
+    if isinstance(record, ParamsRecord):
+        return "C", record.values
+    return record.letter, record.values
 
 
 def _ints(values: tuple[int, ...] | list[int]) -> bytes:

@@ -204,7 +204,11 @@ def serve(
             for key, _ in sel.select(timeout):
                 data = key.data()
                 if data:
-                    wire.write(data, time.monotonic() - origin)
+                    now = time.monotonic() - origin
+                    out = wire.pump(now)  # what was due before these bytes came
+                    if out:
+                        endpoint.write(out)
+                    wire.write(data, now)
     finally:
         endpoint.close()
         sel.close()

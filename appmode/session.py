@@ -22,6 +22,7 @@ from .link import is_simulated
 from .panel import status_text
 from .protocol import HostDecoder, Move, Noise, Stop, SwitchPage
 from .query import ParamQuery, QueryDone, QueryFailed
+from .simport import sim_directives
 from .tokens import Wait, parse_token
 from .transcript import Recorder
 
@@ -208,7 +209,7 @@ class Session:
     def start_recording(self, path: str) -> None:
         if self.recorder is not None:
             self.recorder.close()
-        self.recorder = Recorder.create(path, origin=self.host.now())
+        self.recorder = Recorder.create(path, self.host.now(), sim_directives(self.url))
         self.say(f"recording to {path}")
 
     def stop_recording(self) -> None:

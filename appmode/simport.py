@@ -37,6 +37,14 @@ def parse_sim_url(url: str) -> dict[str, str]:
     return options
 
 
+def sim_directives(url: str) -> tuple[str, ...]:
+    """Transcript directives that describe a sim:// board, for replaying its sessions."""
+    if not url.lower().startswith("sim://"):
+        return ()
+    drive = parse_sim_url(url).get("drive")
+    return (f"board drive={drive}",) if drive else ()
+
+
 def _flag(name: str, text: str) -> bool:
     if text.lower() in ("1", "true", "yes", "on"):
         return True

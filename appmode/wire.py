@@ -39,6 +39,16 @@ class Wire:
 
     def pump(self, now: float) -> bytes:
         """Run the board to `now`; the bytes delivered to the host by then."""
+        self.run(now)
+        return self.to_host.take(now)
+
+    def pump_timed(self, now: float) -> list[tuple[float, bytes]]:
+        """Like pump, with each run of bytes' delivery time."""
+        self.run(now)
+        return self.to_host.take_timed(now)
+
+    def run(self, now: float) -> None:
+        """Run the board to `now`: its input delivered, its records on the line."""
         board = self.board
         if now - board.next_slot() > MAX_LAG:  # stalled (suspend, debugger): catch up at once
             self._deliver(now)
@@ -47,7 +57,6 @@ class Wire:
             self._deliver(slot)
             self._send(board.poll(slot), slot)
         self._deliver(now)
-        return self.to_host.take(now)
 
     def _send(self, data: bytes, when: float) -> None:
         if data and len(self.to_host) > MAX_BACKLOG:

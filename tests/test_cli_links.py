@@ -79,7 +79,7 @@ def test_board_record_writes_a_v1_transcript(tmp_path: Path) -> None:
         assert run("send", board.url, "J", "A", "wait:0.2").returncode == 0
     lines = record.read_text().splitlines()
     assert lines[0] == "# appmode transcript v1"
-    pattern = re.compile(r"^\d+\.\d{3} [<>] \S+$")
+    pattern = re.compile(r"^\d+\.\d{4} [<>] \S+$")
     assert all(pattern.match(text) for text in lines[1:]), lines
     directions = [text.split()[1:] for text in lines[1:]]
     assert [">", "J"] in directions and [">", "A"] in directions
