@@ -331,11 +331,15 @@ def build_parser() -> argparse.ArgumentParser:
         "waiting). With --board URL: in real time against any board. One line per "
         "transcript; exit status 1 if any fails.",
     )
-    conform.add_argument("paths", nargs="*", metavar="FILE|DIR",
-                         help="transcripts, or directories searched for *.transcript "
-                         "(default: ./transcripts)")
-    conform.add_argument("--board", metavar="URL",
-                         help="run in real time against this board instead")
+    conform.add_argument(
+        "paths",
+        nargs="*",
+        metavar="FILE|DIR",
+        help="transcripts, or directories searched for *.transcript (default: ./transcripts)",
+    )
+    conform.add_argument(
+        "--board", metavar="URL", help="run in real time against this board instead"
+    )
     conform.add_argument("--junit", metavar="FILE", help="also write a JUnit XML report")
     conform.set_defaults(handler=_cmd_conform)
 
@@ -348,12 +352,22 @@ def build_parser() -> argparse.ArgumentParser:
     )
     replay.add_argument("file", metavar="FILE", help="the transcript")
     replay.add_argument("--to", required=True, metavar="URL", help="where to play it")
-    replay.add_argument("--side", choices=("host", "board"), default="host",
-                        help="which side to play (default: host)")
-    replay.add_argument("--speed", type=float, default=1.0, metavar="X",
-                        help="time factor: 2 plays twice as fast (default 1)")
-    replay.add_argument("--loop", type=int, default=1, metavar="N",
-                        help="play it N times (default 1)")
+    replay.add_argument(
+        "--side",
+        choices=("host", "board"),
+        default="host",
+        help="which side to play (default: host)",
+    )
+    replay.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        metavar="X",
+        help="time factor: 2 plays twice as fast (default 1)",
+    )
+    replay.add_argument(
+        "--loop", type=int, default=1, metavar="N", help="play it N times (default 1)"
+    )
     replay.set_defaults(handler=_cmd_replay)
 
     tap = sub.add_parser(

@@ -87,8 +87,14 @@ def run_live(transcript: Transcript, url: str, progress: Progress | None = None)
                     f"at {url} reports {name} (system_mode {values[params.SYSTEM_MODE]}): set it "
                     f"with appmode params {url} --set system_mode=…, or skip this transcript"
                 )
-                return Result(transcript.path, transcript.title, False, 0.0,
-                              time.perf_counter() - started, message)
+                return Result(
+                    transcript.path,
+                    transcript.title,
+                    False,
+                    0.0,
+                    time.perf_counter() - started,
+                    message,
+                )
         origin = host.now()
         shown = -1
         while not check.done:
@@ -126,12 +132,21 @@ def collect(paths: list[str]) -> list[Path]:
 
 def write_junit(path: str, results: list[Result]) -> None:
     """A JUnit XML report, written whole or not at all."""
-    suite = ET.Element("testsuite", name="appmode conform", tests=str(len(results)),
-                       failures=str(sum(not r.passed for r in results)),
-                       time=f"{sum(r.wall for r in results):.3f}")
+    suite = ET.Element(
+        "testsuite",
+        name="appmode conform",
+        tests=str(len(results)),
+        failures=str(sum(not r.passed for r in results)),
+        time=f"{sum(r.wall for r in results):.3f}",
+    )
     for result in results:
-        case = ET.SubElement(suite, "testcase", classname="appmode.conform", name=result.path,
-                             time=f"{result.wall:.3f}")
+        case = ET.SubElement(
+            suite,
+            "testcase",
+            classname="appmode.conform",
+            name=result.path,
+            time=f"{result.wall:.3f}",
+        )
         if result.failure is not None:
             failure = ET.SubElement(case, "failure", message=result.failure.splitlines()[0])
             failure.text = result.failure
@@ -164,9 +179,11 @@ def run_conform(paths: list[str], board: str | None, junit: str | None, out: Tex
                 print("\r\033[K", end="", file=sys.stderr, flush=True)
         results.append(result)
         verdict = "PASS" if result.passed else "FAIL"
-        clock = "virtual " if board is None else ""
-        out.write(f"{verdict}  {result.path}  ({result.seconds:.2f} s {clock}time, "
-                  f"{result.wall:.3f} s)\n")
+        if board is None:
+            timing = f"{result.seconds:.2f} s of virtual time in {result.wall:.3f} s"
+        else:
+            timing = f"{result.wall:.2f} s"
+        out.write(f"{verdict}  {result.path}  ({timing})\n")
         if result.failure is not None:
             out.write(f"      {result.failure}\n")
         out.flush()

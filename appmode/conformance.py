@@ -6,7 +6,10 @@ any integer. A record matches an expectation only once every `>` line before it 
 file has been sent, and within `tolerance` seconds of its time (default TOLERANCE). Other
 records are ignored — unless `@strict on`, when each record must match the next
 expectation. `<` lines that are not records (bytes that decoded to nothing) expect
-nothing. `@board drive=…` names the drive type the transcript needs.
+nothing. `@board drive=…` names the drive type the transcript needs. `@align` makes the
+next expectation match whenever it comes (after its sends, by its time + tolerance), and
+shifts the times of the expectations after it by how early or late it came: timing is
+then checked against the board's own rhythm.
 """
 
 from __future__ import annotations
@@ -59,6 +62,8 @@ class Expectation:
     strict: bool
     after: float
     """Time of the last `>` line before it in the file: it cannot be matched earlier."""
+    align: bool = False
+    """`@align` before it: its match time becomes the time base of the lines after it."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,21 +80,28 @@ class Check:
     expectations: list[Expectation] = field(default_factory=list)
     needs: BoardNeeds = field(default_factory=BoardNeeds)
     failure: str | None = None
+    offset: float = 0.0
+    """Shift of expectation times, set by an `@align` match."""
     sent: int = 0
     matched: int = 0
     closest: dict[str, tuple[float, str]] = field(default_factory=dict)
     """Per letter, the unmatched record nearest the expectation's time: what came instead."""
 
     def __post_init__(self) -> None:
-        tolerance, strict, last_send = TOLERANCE, False, 0.0
+        tolerance, strict, last_send, align = TOLERANCE, False, 0.0, False
         for item in self.transcript.items:
-            if isinstance(item, Directive):
+            if isinstance(item, Directive) and item.name == "align":
+                align = True
+            elif isinstance(item, Directive):
                 tolerance, strict = self._directive(item, tolerance, strict)
             elif item.direction == ">":
                 self.sends.append(item)
                 last_send = max(last_send, item.time)
             elif (pattern := parse_pattern(item.text)) is not None:
-                self.expectations.append(Expectation(item, pattern, tolerance, strict, last_send))
+                self.expectations.append(
+                    Expectation(item, pattern, tolerance, strict, last_send, align)
+                )
+                align = False
         self.sends.sort(key=lambda e: e.time)
 
     def _directive(self, item: Directive, tolerance: float, strict: bool) -> tuple[float, bool]:
@@ -149,7 +161,7 @@ class Check:
             times.append(self.sends[self.sent].time)
         if self.matched < len(self.expectations):
             exp = self.expectations[self.matched]
-            times.append(exp.entry.time + exp.tolerance)
+            times.append(self._deadline(exp))
         return min(times) if times else None
 
     def on_record(self, record: protocol.Record, now: float) -> None:
@@ -160,20 +172,26 @@ class Check:
         shown = escape(record.raw) if record.raw else escape(protocol.encode(record))
         if not self._active(exp):
             return  # what comes before the commands it answers is not an answer
-        if now < exp.entry.time - exp.tolerance:
+        if not exp.align and now < self._time(exp) - exp.tolerance:
             if exp.strict:
                 self._fail(exp, f"got {shown} at {now:.3f} s, too early (strict)")
             return
         if exp.pattern.matches(record):
+            if exp.align:
+                self.offset = now - exp.entry.time
             self.matched += 1
             self.closest.clear()
             return
         if exp.strict:
             self._fail(exp, f"got {shown} at {now:.3f} s instead (strict)")
             return
-        distance = abs(now - exp.entry.time)
+        distance = abs(now - self._time(exp))
         if letter not in self.closest or distance < self.closest[letter][0]:
             self.closest[letter] = (distance, f"{shown} at {now:.3f} s")
+
+    def _time(self, exp: Expectation) -> float:
+        """When the expectation is due: its time, shifted by the last @align match."""
+        return exp.entry.time + (0.0 if exp.align else self.offset)
 
     def _active(self, exp: Expectation) -> bool:
         """Every `>` line before the expectation has been sent."""
@@ -183,13 +201,16 @@ class Check:
         if self.done or self.matched >= len(self.expectations):
             return
         exp = self.expectations[self.matched]
-        if now >= exp.entry.time + exp.tolerance:
+        if now >= self._deadline(exp):
             seen = self.closest.get(exp.pattern.letter)
             what = f"got {seen[1]} instead" if seen else f"no {exp.pattern.letter} record came"
-            self._fail(exp, f"nothing matched by {exp.entry.time + exp.tolerance:.3f} s; {what}")
+            self._fail(exp, f"nothing matched by {self._deadline(exp):.3f} s; {what}")
+
+    def _deadline(self, exp: Expectation) -> float:
+        return self._time(exp) + exp.tolerance
 
     def _fail(self, exp: Expectation, what: str) -> None:
         self.failure = (
             f"{self.transcript.path}:{exp.entry.lineno}: expected {exp.pattern.text} at "
-            f"{exp.entry.time:.3f} s (±{exp.tolerance:g} s); {what}"
+            f"{self._time(exp):.3f} s (±{exp.tolerance:g} s); {what}"
         )

@@ -15,16 +15,42 @@ from .errors import AppmodeError
 from .render import describe, line, to_json
 from .transcript import Transcript, read_transcript
 
-CSV_FIELDS = ("t", "dir", "kind", "x", "y", "z", "pitch", "roll", "yaw", "battery",
-              "max_speed", "max_position", "position_kp", "position_ki", "position_kd",
-              "velocity_kp", "velocity_ki", "gyro_compensation", "system_mode",
-              "letter", "direction", "index", "name", "value", "reason", "raw")
+CSV_FIELDS = (
+    "t",
+    "dir",
+    "kind",
+    "x",
+    "y",
+    "z",
+    "pitch",
+    "roll",
+    "yaw",
+    "battery",
+    "max_speed",
+    "max_position",
+    "position_kp",
+    "position_ki",
+    "position_kd",
+    "velocity_kp",
+    "velocity_ki",
+    "gyro_compensation",
+    "system_mode",
+    "letter",
+    "direction",
+    "index",
+    "name",
+    "value",
+    "reason",
+    "raw",
+)
 
 
 def decoded(transcript: Transcript) -> Iterator[tuple[float, str, protocol.Event]]:
     """(time, direction, event) for every command and record of the transcript."""
     decoders: dict[str, protocol.HostDecoder | protocol.BoardDecoder] = {
-        ">": protocol.HostDecoder(), "<": protocol.BoardDecoder()}
+        ">": protocol.HostDecoder(),
+        "<": protocol.BoardDecoder(),
+    }
     last = {">": 0.0, "<": 0.0}
     for entry in transcript.entries:
         last[entry.direction] = entry.time
@@ -58,11 +84,11 @@ def run_plot(path: str, output: str) -> int:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise AppmodeError(
-            "appmode plot needs matplotlib: pip install 'appmode[plot]'") from None
+        raise AppmodeError("appmode plot needs matplotlib: pip install 'appmode[plot]'") from None
     transcript = read_transcript(path)
-    series: dict[str, list[Any]] = {k: [] for k in ("tA", "x", "y", "z", "tB", "pitch",
-                                                    "roll", "yaw", "battery")}
+    series: dict[str, list[Any]] = {
+        k: [] for k in ("tA", "x", "y", "z", "tB", "pitch", "roll", "yaw", "battery")
+    }
     commands: list[tuple[float, str]] = []
     for t, direction, event in decoded(transcript):
         if isinstance(event, protocol.Velocity):
@@ -79,8 +105,11 @@ def run_plot(path: str, output: str) -> int:
         raise AppmodeError(f"{path} has no A or B records to plot")
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(11, 8), constrained_layout=True)
     vel, att, bat = axes
-    for k, label in (("x", "x (lateral, right +)"), ("y", "y (forward +)"),
-                     ("z", "z (rotation, cw +)")):
+    for k, label in (
+        ("x", "x (lateral, right +)"),
+        ("y", "y (forward +)"),
+        ("z", "z (rotation, cw +)"),
+    ):
         vel.plot(series["tA"], series[k], label=label, drawstyle="steps-post")
     vel.set_ylabel("velocity (board unit)")
     for k in ("pitch", "roll", "yaw"):
@@ -95,8 +124,16 @@ def run_plot(path: str, output: str) -> int:
         for t, _ in commands:
             ax.axvline(t, color="grey", linestyle=":", linewidth=0.8)
     for t, text in commands:
-        vel.annotate(text, (t, 1.0), xycoords=("data", "axes fraction"), fontsize=8,
-                     rotation=90, va="top", ha="right", color="dimgrey")
+        vel.annotate(
+            text,
+            (t, 1.0),
+            xycoords=("data", "axes fraction"),
+            fontsize=8,
+            rotation=90,
+            va="top",
+            ha="right",
+            color="dimgrey",
+        )
     vel.legend(loc="lower right", fontsize=8)
     att.legend(loc="lower right", fontsize=8)
     fig.suptitle(f"{Path(path).name} — {transcript.title or 'telemetry'}", fontsize=11)

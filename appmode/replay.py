@@ -73,13 +73,25 @@ def run_replay(path: str, url: str, side: str, speed: float, loops: int) -> int:
     show = _progress(path) if sys.stderr.isatty() else None
     if side == "host":
         with Host(url) as host:
-            late = play(items, host.send, speed=speed, loops=loops,
-                        idle=lambda: _discard(host.poll_nowait), progress=show)
+            late = play(
+                items,
+                host.send,
+                speed=speed,
+                loops=loops,
+                idle=lambda: _discard(host.poll_nowait),
+                progress=show,
+            )
     else:
         port = open_link(url)
         try:
-            late = play(items, port.write, speed=speed, loops=loops,
-                        idle=lambda: _discard(lambda: port.read(port.in_waiting)), progress=show)
+            late = play(
+                items,
+                port.write,
+                speed=speed,
+                loops=loops,
+                idle=lambda: _discard(lambda: port.read(port.in_waiting)),
+                progress=show,
+            )
         except (serial.SerialException, OSError) as exc:
             raise AppmodeError(f"lost {url} during the replay: {exc}") from None
         finally:
@@ -87,8 +99,11 @@ def run_replay(path: str, url: str, side: str, speed: float, loops: int) -> int:
     if show is not None:
         print(file=sys.stderr)
     worst = max(late) * 1000
-    print(f"replayed {len(late)} {'commands' if side == 'host' else 'records'} from {path} "
-          f"as the {side} to {url}; latest send {worst:.2f} ms after its time", file=sys.stderr)
+    print(
+        f"replayed {len(late)} {'commands' if side == 'host' else 'records'} from {path} "
+        f"as the {side} to {url}; latest send {worst:.2f} ms after its time",
+        file=sys.stderr,
+    )
     return 0
 
 
@@ -100,7 +115,12 @@ def _progress(path: str) -> Callable[[float, float], None]:
     def show(done: float, total: float) -> None:
         share = 0.0 if total <= 0 else min(1.0, done / total)
         bar = "#" * round(share * 30)
-        print(f"\r\033[Kreplay {path} [{bar:<30}] {done:6.1f} / {total:.1f} s  "
-              f"ETA {max(0.0, total - done):5.1f} s", end="", file=sys.stderr, flush=True)
+        print(
+            f"\r\033[Kreplay {path} [{bar:<30}] {done:6.1f} / {total:.1f} s  "
+            f"ETA {max(0.0, total - done):5.1f} s",
+            end="",
+            file=sys.stderr,
+            flush=True,
+        )
 
     return show

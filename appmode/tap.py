@@ -102,8 +102,11 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
         threading.Thread(target=forward, args=(board, app, "<", "board side"), daemon=True),
     ]
     if not quiet:
-        print(f"tap: {app_url} <-> {board_url}, recording to {record} (Ctrl-C to stop)",
-              file=sys.stderr, flush=True)
+        print(
+            f"tap: {app_url} <-> {board_url}, recording to {record} (Ctrl-C to stop)",
+            file=sys.stderr,
+            flush=True,
+        )
     for thread in threads:
         thread.start()
     try:
@@ -122,8 +125,9 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
         app.close()
         recorder.close()
     if not quiet:
-        print(f"tap: {counts['>']} bytes app->board, {counts['<']} bytes board->app",
-              file=sys.stderr)
+        print(
+            f"tap: {counts['>']} bytes app->board, {counts['<']} bytes board->app", file=sys.stderr
+        )
     for error in errors:
         print(f"tap: stopped: {error}", file=sys.stderr)
     return 1 if errors else 0

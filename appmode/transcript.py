@@ -71,6 +71,7 @@ DIRECTIVES = {
     "board": "options for the board under test: @board drive=omni|mecanum|diff|diff-gyro",
     "tolerance": "how early or late a '<' line may be matched, in seconds: @tolerance 0.3",
     "strict": "@strict on: every record must match the next '<' line (none ignored)",
+    "align": "@align: time the '<' lines after the next one from when it is matched",
 }
 
 
@@ -122,8 +123,9 @@ def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
         where = f"{path}:{lineno}"
         stripped = line.strip()
         if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
-            raise TranscriptError(f"{where}: {stripped[2:]!r} is not a version this appmode "
-                                  f"reads (it reads v1)")
+            raise TranscriptError(
+                f"{where}: {stripped[2:]!r} is not a version this appmode reads (it reads v1)"
+            )
         if not stripped:
             continue
         if stripped.startswith("#"):
@@ -144,8 +146,9 @@ def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
 def _entry(line: str, lineno: int, where: str) -> Entry:
     parts = line.split(" ", 2)
     if len(parts) != 3 or not parts[2]:
-        raise TranscriptError(f"{where}: expected 'TIME DIR PAYLOAD' (e.g. 0.050 > {{Q:P}}), "
-                              f"got {line!r}")
+        raise TranscriptError(
+            f"{where}: expected 'TIME DIR PAYLOAD' (e.g. 0.050 > {{Q:P}}), got {line!r}"
+        )
     time_text, direction, payload = parts
     try:
         time = float(time_text)
@@ -154,8 +157,9 @@ def _entry(line: str, lineno: int, where: str) -> Entry:
     if not time >= 0 or not time < float("inf"):
         raise TranscriptError(f"{where}: time {time_text!r} is not seconds >= 0")
     if direction not in (">", "<"):
-        raise TranscriptError(f"{where}: direction {direction!r} must be '>' (host to board) "
-                              f"or '<' (board to host)")
+        raise TranscriptError(
+            f"{where}: direction {direction!r} must be '>' (host to board) or '<' (board to host)"
+        )
     try:
         data = unescape(payload)
     except ValueError as exc:
