@@ -81,7 +81,7 @@ def run_live(transcript: Transcript, url: str, progress: Progress | None = None)
             values = host.read_params()
             have = params.drive_type(values[params.SYSTEM_MODE])
             if have is not check.needs.drive:
-                name = have.cli_name if have else "invalid"
+                name = have.cli_name if have is not None else "invalid"
                 message = (
                     f"{transcript.path}: needs a {check.needs.drive.cli_name} drive; the board "
                     f"at {url} reports {name} (system_mode {values[params.SYSTEM_MODE]}): set it "

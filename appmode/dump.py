@@ -134,8 +134,8 @@ def run_plot(path: str, output: str) -> int:
             ha="right",
             color="dimgrey",
         )
-    vel.legend(loc="lower right", fontsize=8)
-    att.legend(loc="lower right", fontsize=8)
+    vel.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    att.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.suptitle(f"{Path(path).name} — {transcript.title or 'telemetry'}", fontsize=11)
     directory = os.path.dirname(os.path.abspath(output))
     fd, tmp = tempfile.mkstemp(suffix=".png", dir=directory)

@@ -23,6 +23,7 @@ class Recorder:
 
     def __init__(self, out: TextIO, origin: float = 0.0, directives: tuple[str, ...] = ()) -> None:
         self._out = out
+        self._owned = False  # a stream given by the caller stays open
         self._origin = origin
         self._decoders: dict[str, protocol.HostDecoder | protocol.BoardDecoder] = {
             ">": protocol.HostDecoder(),
@@ -44,7 +45,9 @@ class Recorder:
             raise AppmodeError(
                 f"cannot write transcript {os.fspath(path)}: {exc.strerror}"
             ) from None
-        return cls(out, origin, directives)
+        recorder = cls(out, origin, directives)
+        recorder._owned = True
+        return recorder
 
     def __call__(self, direction: str, time: float, data: bytes) -> None:
         self._last[direction] = time
@@ -56,13 +59,14 @@ class Recorder:
         self._out.flush()
 
     def close(self) -> None:
-        """Write what the decoders still hold, and close the file."""
+        """Write what the decoders still hold, and close the file (if it opened it)."""
         if self._out.closed:
             return
         for direction, decoder in self._decoders.items():
             for event in decoder.flush():
                 self._line(self._last[direction], direction, event.raw)
-        self._out.close()
+        if self._owned:
+            self._out.close()
 
 
 # ---------------------------------------------------------------- reading
