@@ -19,7 +19,7 @@ import pytest
 import serial
 
 from appmode.replay import plan, play
-from appmode.transcript import read_transcript
+from appmode.transcript import parse_transcript, read_transcript
 
 from .processes import ROOT, board_process, run
 
@@ -59,19 +59,13 @@ def test_play_keeps_absolute_deadlines_on_a_virtual_clock() -> None:
 
 
 def test_plan_speed_and_loops() -> None:
-    entries = [(e.time, e.direction, e.data) for e in read_transcript_from_text(SESSION).entries]
+    entries = [(e.time, e.direction, e.data) for e in parse_transcript(SESSION).entries]
     assert [d for _, d in plan(entries, "host")] == [b"J", b"A", b"Z"]
-    assert [d for _, d in plan(entries, "board")][0] == b"{A0:0:0:0}$"
+    assert next(d for _, d in plan(entries, "board")) == b"{A0:0:0:0}$"
     times: list[float] = []
     start = time.monotonic()
     play(plan(entries, "host"), lambda d: times.append(time.monotonic() - start), speed=2, loops=2)
     assert [round(t, 2) for t in times] == [0.0, 0.1, 0.3, 0.3, 0.4, 0.6]
-
-
-def read_transcript_from_text(text: str):  # type: ignore[no-untyped-def]
-    from appmode.transcript import parse_transcript
-
-    return parse_transcript(text)
 
 
 def test_replay_as_host_drives_a_board_and_ends_with_z(tmp_path: Path) -> None:

@@ -93,7 +93,7 @@ def test_malformed_lines_name_file_and_line(tmp_path: Path, line: str, message: 
 def test_other_versions_and_unreadable_files() -> None:
     with pytest.raises(TranscriptError, match="v2' is not a version this appmode reads"):
         parse_transcript("# appmode transcript v2\n", "x.transcript")
-    with pytest.raises(AppmodeError, match="cannot read transcript /no/such.transcript"):
+    with pytest.raises(AppmodeError, match=r"cannot read transcript /no/such\.transcript"):
         read_transcript("/no/such.transcript")
 
 
