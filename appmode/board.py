@@ -9,6 +9,7 @@ give the same bytes, whatever the pattern of `poll` calls.
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 from . import params, protocol
@@ -22,6 +23,8 @@ SLOT_TICKS = 5
 SLOT = TICK * SLOT_TICKS
 MAX_CATCH_UP = 200
 """Ticks run one by one when the board falls behind; beyond that it skips ahead."""
+MAX_NOTES = 1000
+"""Log lines kept until taken: an edge that never reads them costs bounded memory."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,7 +48,7 @@ class Board:
         centivolts: float | None = None,
     ) -> None:
         self.store: Store = store if store is not None else MemoryStore()
-        self.notes: list[Note] = []
+        self.notes: deque[Note] = deque(maxlen=MAX_NOTES)
         saved, warning = self.store.load()
         if warning is not None:
             self._note(now, "warning", warning)
@@ -109,7 +112,8 @@ class Board:
         return out
 
     def take_notes(self) -> list[Note]:
-        notes, self.notes = self.notes, []
+        notes = list(self.notes)
+        self.notes.clear()
         return notes
 
     # ------------------------------------------------------------ firmware

@@ -15,7 +15,7 @@ from . import params, protocol
 from .board import Board
 from .conformance import Check
 from .errors import AppmodeError
-from .host import Host
+from .host import Host, LinkLost
 from .store import MemoryStore
 from .transcript import SUFFIX, Transcript, read_transcript
 from .wire import Wire
@@ -99,8 +99,12 @@ def run_live(transcript: Transcript, url: str, progress: Progress | None = None)
         shown = -1
         while not check.done:
             now = host.now() - origin
-            for data in check.due(now):
-                host.send(data)
+            try:
+                for data in check.due(now):
+                    host.send(data)
+            except LinkLost as exc:
+                check.failure = f"{transcript.path}: at {now:.3f} s: {exc}"
+                break
             due = check.next_time()
             wait = 0.05 if due is None else max(0.0, min(0.05, due - now))
             for event in host.poll(wait):

@@ -12,7 +12,6 @@ import pty
 import selectors
 import socket
 import sys
-import termios
 import time
 import tty
 from collections.abc import Callable
@@ -30,6 +29,38 @@ from .wire import Tap, Wire
 
 Log = Callable[[str], None]
 READ_SIZE = 4096
+OUTBOX = 4096
+RETRY_WRITE = 0.002
+"""Seconds before writing again what the OS would not take."""
+INPUT_BACKLOG = 256
+"""Bytes received but not yet on the simulated line beyond which the server stops reading:
+the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
+by a real line."""
+
+
+class Outbox:
+    """Bytes the OS would not take yet (a full pty or socket buffer): kept, in order, and
+    retried; beyond OUTBOX bytes the oldest are dropped, as when nobody reads a UART."""
+
+    def __init__(self) -> None:
+        self._data = bytearray()
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def clear(self) -> None:
+        self._data.clear()
+
+    def send(self, data: bytes, write: Callable[[bytes], int]) -> None:
+        self._data += data
+        if len(self._data) > OUTBOX:
+            del self._data[: len(self._data) - OUTBOX]
+        while self._data:
+            try:
+                written = write(bytes(self._data))
+            except (BlockingIOError, InterruptedError):
+                return
+            del self._data[:written]
 
 
 class PtyEndpoint:
@@ -43,6 +74,7 @@ class PtyEndpoint:
         self._master, self._slave = pty.openpty()
         tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
         os.set_blocking(self._master, False)
+        self._out = Outbox()
         self.url = os.ttyname(self._slave)
         sel.register(self._master, selectors.EVENT_READ, self._read)
 
@@ -53,11 +85,11 @@ class PtyEndpoint:
             return b""
 
     def write(self, data: bytes) -> None:
-        try:
-            os.write(self._master, data)
-        except BlockingIOError:
-            # Nobody is reading: drop what is queued, as a UART talks to nobody.
-            termios.tcflush(self._slave, termios.TCIFLUSH)
+        self._out.send(data, lambda chunk: os.write(self._master, chunk))
+
+    @property
+    def backlog(self) -> int:
+        return len(self._out)
 
     def close(self) -> None:
         os.close(self._master)
@@ -83,6 +115,7 @@ class TcpEndpoint:
         bound_host, bound_port = self._listener.getsockname()[:2]
         self.url = f"socket://{bound_host}:{bound_port}"
         self._client: socket.socket | None = None
+        self._out = Outbox()
         sel.register(self._listener, selectors.EVENT_READ, self._accept)
 
     def _accept(self) -> bytes:
@@ -117,14 +150,18 @@ class TcpEndpoint:
     def write(self, data: bytes) -> None:
         if self._client is None:
             return
+        client = self._client
         try:
-            self._client.send(data)
-        except BlockingIOError:
-            pass  # the client is not reading: the bytes are lost, as on a real line
+            self._out.send(data, client.send)
         except OSError as exc:
             self._drop(f"client connection lost ({exc.strerror})")
 
+    @property
+    def backlog(self) -> int:
+        return len(self._out)
+
     def _drop(self, why: str) -> None:
+        self._out.clear()
         if self._client is not None:
             self._sel.unregister(self._client)
             self._client.close()
@@ -155,7 +192,10 @@ class SerialEndpoint:
         return data
 
     def write(self, data: bytes) -> None:
-        self._port.write(data)
+        if data:
+            self._port.write(data)
+
+    backlog = 0  # pyserial's write blocks until the OS has the bytes
 
     def close(self) -> None:
         self._port.close()
@@ -196,11 +236,16 @@ def serve(
     try:
         while True:
             out = wire.pump(time.monotonic() - origin)
-            if out:
+            if out or endpoint.backlog:
                 endpoint.write(out)
             for note in board.take_notes():
                 log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
             timeout = max(0.0, wire.next_wakeup() - (time.monotonic() - origin))
+            if endpoint.backlog:
+                timeout = min(timeout, RETRY_WRITE)
+            if len(wire.to_board) > INPUT_BACKLOG:
+                time.sleep(timeout)
+                continue
             for key, _ in sel.select(timeout):
                 data = key.data()
                 if data:
@@ -253,6 +298,7 @@ def run_board(
     except KeyboardInterrupt:
         log("stopped")
     finally:
+        board.store.close()
         if recorder is not None:
             recorder.close()
     return 0

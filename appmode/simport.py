@@ -16,11 +16,14 @@ import serial
 from serial import SerialBase, SerialException
 
 from .board import Board
+from .errors import AppmodeError
 from .params import DriveType
 from .store import open_store
 from .wire import Wire
 
 OPTIONS = ("drive", "flash", "pace", "baud")
+WRITE_BUFFER = 4096
+"""Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
 USAGE = "sim://[?drive=omni|mecanum|diff|diff-gyro][&flash=FILE][&pace=1|0][&baud=9600]"
 
 
@@ -80,7 +83,11 @@ class SimSerial(SerialBase):  # type: ignore[misc]
                 raise SerialException(f"sim:// option baud={options['baud']!r}: use a number")
             self._baudrate = int(options["baud"])
         pace = _flag("pace", options.get("pace", "1"))
-        self.board = Board(open_store(options.get("flash")), drive=drive)
+        try:
+            store = open_store(options.get("flash"))
+        except AppmodeError as exc:
+            raise SerialException(str(exc)) from None
+        self.board = Board(store, drive=drive)
         self._wire = Wire(self.board, self._baudrate if pace else None)
         self._rx.clear()
         self._origin = time.monotonic()
@@ -89,6 +96,8 @@ class SimSerial(SerialBase):  # type: ignore[misc]
     def close(self) -> None:
         self.is_open = False
         self._wire = None
+        if self.board is not None:
+            self.board.store.close()
 
     def _reconfigure_port(self, force_update: bool = False) -> None:
         """Settings change nothing in the simulation (the line rate is fixed at open)."""
@@ -130,6 +139,9 @@ class SimSerial(SerialBase):  # type: ignore[misc]
     def write(self, data: bytes) -> int:
         wire = self._pump()
         payload = serial.to_bytes(data)
+        while len(wire.to_board) > WRITE_BUFFER:  # the line is slower than the writer
+            time.sleep(max(0.0, wire.next_wakeup() - self._now()))
+            wire = self._pump()
         wire.write(payload, self._now())
         return len(payload)
 

@@ -6,6 +6,7 @@ cannot be read; it never raises. `save()` replaces them atomically.
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import tempfile
@@ -14,6 +15,7 @@ from pathlib import Path
 from typing import Protocol
 
 from . import params
+from .errors import AppmodeError
 
 FORMAT = "appmode-flash"
 VERSION = 1
@@ -25,6 +27,10 @@ class Store(Protocol):
         ...
 
     def save(self, values: Sequence[int]) -> None: ...
+
+    def close(self) -> None:
+        """Release the store (a file lock)."""
+        ...
 
 
 class MemoryStore:
@@ -39,12 +45,44 @@ class MemoryStore:
     def save(self, values: Sequence[int]) -> None:
         self.values = tuple(values)
 
+    def close(self) -> None:
+        """Nothing to release."""
+
 
 class JsonFileStore:
     """Flash in a JSON file, written atomically (temporary file, fsync, rename)."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
+        self._lock: int | None = None
+
+    def lock(self) -> None:
+        """Take the file for this board alone; AppmodeError if another board has it.
+
+        The lock is an flock on FILE.lock, held until `close` or the process ends.
+        """
+        lock_path = f"{self.path}.lock"
+        try:
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise AppmodeError(f"cannot use flash file {self.path}: {exc.strerror}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.read(fd, 32).decode(errors="replace").strip() or "another process"
+            os.close(fd)
+            raise AppmodeError(
+                f"flash file {self.path} is in use by another board (pid {holder}): give "
+                f"each board its own --flash file, or stop the other one"
+            ) from None
+        os.ftruncate(fd, 0)
+        os.write(fd, str(os.getpid()).encode())
+        self._lock = fd
+
+    def close(self) -> None:
+        if self._lock is not None:
+            os.close(self._lock)
+            self._lock = None
 
     def load(self) -> tuple[tuple[int, ...] | None, str | None]:
         try:
@@ -118,5 +156,10 @@ def _parse(text: str) -> tuple[int, ...]:
 
 
 def open_store(flash: str | None) -> Store:
-    """The store for a board: a JSON file when `flash` names one, else in memory."""
-    return JsonFileStore(flash) if flash else MemoryStore()
+    """The store for a running board: a locked JSON file when `flash` names one, else
+    in memory. AppmodeError if another board holds the file."""
+    if not flash:
+        return MemoryStore()
+    store = JsonFileStore(flash)
+    store.lock()
+    return store

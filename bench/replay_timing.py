@@ -39,8 +39,10 @@ def python_can_lateness(times: list[float]) -> list[float] | None:
 
 def row(name: str, lateness: list[float]) -> str:
     ms = [x * 1000 for x in lateness]
-    return (f"{name:<22} {statistics.median(ms):>9.3f} {percentile(ms, 99):>9.3f} "
-            f"{max(ms):>9.3f} {ms[-1]:>11.3f}")
+    return (
+        f"{name:<22} {statistics.median(ms):>9.3f} {percentile(ms, 99):>9.3f} "
+        f"{max(ms):>9.3f} {ms[-1]:>11.3f}"
+    )
 
 
 def main() -> None:
@@ -49,8 +51,10 @@ def main() -> None:
     parser.add_argument("--spacing", type=float, default=0.010, metavar="S")
     args = parser.parse_args()
     times = [k * args.spacing for k in range(args.events)]
-    print(f"replay of {args.events} events at {args.spacing * 1000:g} ms spacing "
-          f"({times[-1]:.0f} s each); lateness against the recorded schedule, in ms")
+    print(
+        f"replay of {args.events} events at {args.spacing * 1000:g} ms spacing "
+        f"({times[-1]:.0f} s each); lateness against the recorded schedule, in ms"
+    )
     print(f"{'':<22} {'median':>9} {'p99':>9} {'max':>9} {'drift(end)':>11}")
     print(row("appmode play", appmode_lateness(times)), flush=True)
     can_result = python_can_lateness(times)
