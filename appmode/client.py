@@ -10,9 +10,10 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from . import protocol
-from .query import Outcome, ParamQuery
+from .query import Outcome, ParamQuery, QueryFailed
 
 RATE_WINDOW = 1.0
+DEGRADED_WINDOW = 5.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -34,11 +35,24 @@ class LinkStats:
     discarded: int = 0
     last_record: float | None = None
     _recent: deque[float] = field(default_factory=deque)
+    _error_times: deque[float] = field(default_factory=deque)
 
     def rate(self, now: float) -> float:
         """Records a second over the last RATE_WINDOW seconds."""
         self._expire(now)
         return len(self._recent) / RATE_WINDOW
+
+    def recent_errors(self, now: float) -> int:
+        """Errors in the last DEGRADED_WINDOW seconds: the link is degraded while > 0."""
+        while self._error_times and self._error_times[0] <= now - DEGRADED_WINDOW:
+            self._error_times.popleft()
+        return len(self._error_times)
+
+    def count_error(self, now: float, size: int) -> None:
+        self.errors += 1
+        self.discarded += size
+        self._error_times.append(now)
+        self.recent_errors(now)
 
     def since_last(self, now: float) -> float | None:
         return None if self.last_record is None else now - self.last_record
@@ -64,6 +78,7 @@ class HostState:
         self.attitude: protocol.Attitude | None = None
         self.params: protocol.ParamsRecord | None = None
         self.query: ParamQuery | None = None
+        self._errors_at_start = 0
         self._outbox = bytearray()
 
     def feed(self, data: bytes, now: float) -> list[protocol.BoardEvent | Outcome]:
@@ -83,6 +98,7 @@ class HostState:
     def start_query(self, query: ParamQuery, now: float) -> None:
         """Begin a parameter read or set; its bytes wait in the outbox."""
         self.query = query
+        self._errors_at_start = self.stats.errors
         self._outbox += query.start(now)
 
     def tick(self, now: float) -> Outcome | None:
@@ -102,6 +118,12 @@ class HostState:
         self._outbox += data
         if outcome is not None:
             self.query = None
+            garbled = self.stats.errors - self._errors_at_start
+            if isinstance(outcome, QueryFailed) and garbled:
+                outcome = QueryFailed(
+                    f"{outcome.text} ({garbled} garbled records or bytes "
+                    f"came meanwhile: the link is noisy)"
+                )
         return outcome
 
     def reset_decoder(self) -> None:
@@ -110,8 +132,9 @@ class HostState:
 
     def _apply(self, event: protocol.BoardEvent, now: float) -> Outcome | None:
         if isinstance(event, protocol.ERRORS):
-            self.stats.errors += 1
-            self.stats.discarded += len(event.raw)
+            self.stats.count_error(now, len(event.raw))
+            if self.query is not None and event.raw.startswith(b"{C"):
+                return self._step(*self.query.on_garbled(now))
             return None
         self.stats.count_record(now)
         if isinstance(event, protocol.Velocity):

@@ -35,13 +35,18 @@ class Host:
     """A session with one board."""
 
     def __init__(
-        self, url: str, tap: Tap | None = None, clock: Callable[[], float] = time.monotonic
+        self,
+        url: str,
+        tap: Tap | None = None,
+        clock: Callable[[], float] = time.monotonic,
+        opener: Callable[[str], serial.SerialBase] = open_link,
     ) -> None:
         self.url = url
         self.tap = tap
         self.state = HostState()
         self._clock = clock
-        self._port: serial.SerialBase | None = open_link(url)
+        self._opener = opener
+        self._port: serial.SerialBase | None = opener(url)
         self._origin = clock()  # after opening: an in-process sim:// board booted just now
         self._lost_at = 0.0
         self._pending: list[Event] = []
@@ -55,6 +60,11 @@ class Host:
     @property
     def connected(self) -> bool:
         return self._port is not None
+
+    @property
+    def link(self) -> serial.SerialBase | None:
+        """The open port (None while the link is down)."""
+        return self._port
 
     def _lost(self, exc: Exception) -> None:
         if self._port is not None:
@@ -70,7 +80,7 @@ class Host:
             return
         self._lost_at = self.now()
         try:
-            self._port = open_link(self.url)
+            self._port = self._opener(self.url)
         except AppmodeError:
             return
         self._pending.append(LinkStatus(True, f"link to {self.url} is back"))

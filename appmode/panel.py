@@ -47,7 +47,11 @@ def status_fragments(session: Session) -> Fragments:
         age = stats.since_last(now)
         last = "no record yet" if age is None else f"last record {age:.2f} s ago"
         stale = age is None or age > 1.0
-        out.append(("fg:ansired bold" if stale else "fg:ansigreen", " link up"))
+        recent = stats.recent_errors(now)
+        if recent:
+            out.append(("reverse bold fg:ansiyellow", f" link DEGRADED: {recent} errors in 5 s "))
+        else:
+            out.append(("fg:ansired bold" if stale else "fg:ansigreen", " link up"))
         out.append(
             (
                 "",

@@ -3,11 +3,13 @@
 `sim://?drive=mecanum&flash=board.json&pace=0` — options: `drive` (omni, mecanum, diff,
 diff-gyro; default: what the flash holds, else omni), `flash` (a JSON parameter file;
 default: in memory), `pace` (1: bytes move at the real 9600-bps rate, the default; 0:
-instantly), `baud`. There is no thread: the board runs whenever the port is used.
+instantly), `baud`, `faults` (a faulty link both ways, see appmode.faults). There is no
+thread: the board runs whenever the port is used.
 """
 
 from __future__ import annotations
 
+import random
 import time
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
@@ -17,14 +19,18 @@ from serial import SerialBase, SerialException
 
 from .board import Board
 from .errors import AppmodeError
+from .faults import FaultSpec, FaultyLine
 from .params import DriveType
 from .store import open_store
 from .wire import Wire
 
-OPTIONS = ("drive", "flash", "pace", "baud")
+OPTIONS = ("drive", "flash", "pace", "baud", "faults")
 WRITE_BUFFER = 4096
 """Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
-USAGE = "sim://[?drive=omni|mecanum|diff|diff-gyro][&flash=FILE][&pace=1|0][&baud=9600]"
+USAGE = (
+    "sim://[?drive=omni|mecanum|diff|diff-gyro][&flash=FILE][&pace=1|0][&baud=9600]"
+    "[&faults=drop:0.01,corrupt:0.01,…]"
+)
 
 
 def parse_sim_url(url: str) -> dict[str, str]:
@@ -63,6 +69,7 @@ class SimSerial(SerialBase):  # type: ignore[misc]
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         self._wire: Wire | None = None
+        self._faults: tuple[FaultyLine, FaultyLine] | None = None
         self._rx = bytearray()
         self._origin = 0.0
         self.board: Board | None = None
@@ -87,6 +94,12 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             store = open_store(options.get("flash"))
         except AppmodeError as exc:
             raise SerialException(str(exc)) from None
+        try:
+            spec = FaultSpec.parse(options.get("faults", ""))
+        except ValueError as exc:
+            raise SerialException(f"sim:// option faults: {exc}") from None
+        rng = random.Random(spec.seed)
+        self._faults = (FaultyLine(spec, rng), FaultyLine(spec, rng)) if spec.active else None
         self.board = Board(store, drive=drive)
         self._wire = Wire(self.board, self._baudrate if pace else None)
         self._rx.clear()
@@ -108,8 +121,21 @@ class SimSerial(SerialBase):  # type: ignore[misc]
     def _pump(self) -> Wire:
         if not self.is_open or self._wire is None:
             raise serial.PortNotOpenError()
-        self._rx += self._wire.pump(self._now())
+        now = self._now()
+        if self._faults is None:
+            self._rx += self._wire.pump(now)
+            return self._wire
+        to_board, to_host = self._faults
+        self._wire.write(to_board.take(now), now)
+        to_host.push(self._wire.pump(now), now)
+        self._rx += to_host.take(now)
         return self._wire
+
+    def _next_wakeup(self, wire: Wire) -> float:
+        times = [wire.next_wakeup()]
+        if self._faults is not None:
+            times += [t for line in self._faults if (t := line.next_due()) is not None]
+        return min(times)
 
     @property
     def in_waiting(self) -> int:
@@ -127,7 +153,7 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             now = self._now()
             if deadline is not None and now >= deadline:
                 break
-            wake = wire.next_wakeup()
+            wake = self._next_wakeup(wire)
             if deadline is not None:
                 wake = min(wake, deadline)
             time.sleep(max(0.0, wake - now))
@@ -142,13 +168,18 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         while len(wire.to_board) > WRITE_BUFFER:  # the line is slower than the writer
             time.sleep(max(0.0, wire.next_wakeup() - self._now()))
             wire = self._pump()
-        wire.write(payload, self._now())
+        if self._faults is None:
+            wire.write(payload, self._now())
+        else:
+            self._faults[0].push(payload, self._now())
         return len(payload)
 
     def flush(self) -> None:
         wire = self._pump()
-        while wire.to_board.next_due() is not None:
-            time.sleep(max(0.0, wire.next_wakeup() - self._now()))
+        while wire.to_board.next_due() is not None or (
+            self._faults is not None and self._faults[0].next_due() is not None
+        ):
+            time.sleep(max(0.0, self._next_wakeup(wire) - self._now()))
             wire = self._pump()
 
     def reset_input_buffer(self) -> None:
