@@ -59,6 +59,7 @@ def _cmd_board(args: argparse.Namespace) -> int:
 
     return run_board(
         use_pty=args.pty,
+        link=args.link,
         listen=args.listen,
         device=args.port,
         drive=args.drive,
@@ -244,6 +245,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--port",
         metavar="DEV",
         help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
+    )
+    board.add_argument(
+        "--link",
+        metavar="PATH",
+        help="with --pty: keep a symlink PATH to the pty, so clients find a restarted board "
+        "at the same path",
     )
     board.add_argument(
         "--drive", choices=DRIVE_NAMES, help="drive type (default: the saved one, else omni)"

@@ -70,12 +70,16 @@ class PtyEndpoint:
     closes, and the path stays the same for the next client.
     """
 
-    def __init__(self, sel: selectors.BaseSelector, log: Log) -> None:
+    def __init__(self, sel: selectors.BaseSelector, log: Log, link: str | None = None) -> None:
         self._master, self._slave = pty.openpty()
         tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
         os.set_blocking(self._master, False)
         self._out = Outbox()
         self.url = os.ttyname(self._slave)
+        self._link = link
+        if link is not None:
+            _symlink(self.url, link)
+            log(f"{link} -> {self.url}")
         sel.register(self._master, selectors.EVENT_READ, self._read)
 
     def _read(self) -> bytes:
@@ -92,8 +96,23 @@ class PtyEndpoint:
         return len(self._out)
 
     def close(self) -> None:
+        if self._link is not None and os.path.islink(self._link):
+            if os.readlink(self._link) == self.url:
+                os.unlink(self._link)
         os.close(self._master)
         os.close(self._slave)
+
+
+def _symlink(target: str, link: str) -> None:
+    """Point `link` at `target`, replacing an older link atomically (not a real file)."""
+    if os.path.exists(link) and not os.path.islink(link):
+        raise AppmodeError(f"--link {link}: a file is already there; choose another path")
+    tmp = f"{link}.{os.getpid()}.tmp"
+    try:
+        os.symlink(target, tmp)
+        os.replace(tmp, link)
+    except OSError as exc:
+        raise AppmodeError(f"--link {link}: cannot create the link: {exc.strerror}") from None
 
 
 class TcpEndpoint:
@@ -262,6 +281,7 @@ def serve(
 def run_board(
     *,
     use_pty: bool,
+    link: str | None,
     listen: str | None,
     device: str | None,
     drive: str | None,
@@ -286,7 +306,7 @@ def run_board(
     elif device is not None:
         make = partial(_serial, device=device)
     else:
-        make = PtyEndpoint
+        make = partial(_pty, link=link)
     board = Board(open_store(flash), drive=DriveType.from_cli_name(drive) if drive else None)
     banner = (
         f"simulated board, {board.drive_type.cli_name} drive, flash {flash or 'in memory'}, "
@@ -302,6 +322,10 @@ def run_board(
         if recorder is not None:
             recorder.close()
     return 0
+
+
+def _pty(sel: selectors.BaseSelector, log: Log, *, link: str | None) -> Endpoint:
+    return PtyEndpoint(sel, log, link)
 
 
 def _tcp(sel: selectors.BaseSelector, log: Log, *, host: str, port: int) -> Endpoint:
