@@ -78,6 +78,8 @@ class JsonFileStore:
         os.ftruncate(fd, 0)
         os.write(fd, str(os.getpid()).encode())
         self._lock = fd
+        for stale in self.path.parent.glob(f".{self.path.name}.*"):
+            stale.unlink(missing_ok=True)  # temporary files of a save that was killed
 
     def close(self) -> None:
         if self._lock is not None:
