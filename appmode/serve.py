@@ -28,7 +28,6 @@ from .transcript import Recorder
 from .wire import Tap, Wire
 
 Log = Callable[[str], None]
-READ_SIZE = 4096
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
@@ -82,9 +81,9 @@ class PtyEndpoint:
             log(f"{link} -> {self.url}")
         sel.register(self._master, selectors.EVENT_READ, self._read)
 
-    def _read(self) -> bytes:
+    def _read(self, size: int) -> bytes:
         try:
-            return os.read(self._master, READ_SIZE)
+            return os.read(self._master, size)
         except (BlockingIOError, InterruptedError):
             return b""
 
@@ -137,7 +136,7 @@ class TcpEndpoint:
         self._out = Outbox()
         sel.register(self._listener, selectors.EVENT_READ, self._accept)
 
-    def _accept(self) -> bytes:
+    def _accept(self, size: int) -> bytes:
         try:
             conn, peer = self._listener.accept()
         except (BlockingIOError, InterruptedError):
@@ -153,10 +152,10 @@ class TcpEndpoint:
         self._log(f"client connected from {peer[0]}:{peer[1]}")
         return b""
 
-    def _read(self) -> bytes:
+    def _read(self, size: int) -> bytes:
         assert self._client is not None
         try:
-            data = self._client.recv(READ_SIZE)
+            data = self._client.recv(size)
         except (BlockingIOError, InterruptedError):
             return b""
         except OSError as exc:
@@ -206,8 +205,8 @@ class SerialEndpoint:
         self.baud = baud
         sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
 
-    def _read(self) -> bytes:
-        data: bytes = self._port.read(max(1, self._port.in_waiting))
+    def _read(self, size: int) -> bytes:
+        data: bytes = self._port.read(max(1, min(size, self._port.in_waiting)))
         return data
 
     def write(self, data: bytes) -> None:
@@ -262,11 +261,12 @@ def serve(
             timeout = max(0.0, wire.next_wakeup() - (time.monotonic() - origin))
             if endpoint.backlog:
                 timeout = min(timeout, RETRY_WRITE)
-            if len(wire.to_board) > INPUT_BACKLOG:
+            room = INPUT_BACKLOG - len(wire.to_board)
+            if room <= 0:  # leave the rest in the pty or socket: the writer waits
                 time.sleep(timeout)
                 continue
             for key, _ in sel.select(timeout):
-                data = key.data()
+                data = key.data(room)
                 if data:
                     now = time.monotonic() - origin
                     out = wire.pump(now)  # what was due before these bytes came

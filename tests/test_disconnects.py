@@ -20,9 +20,13 @@ from .processes import ROOT, BoardProcess, board_process, wait_for
 def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> None:
     link = str(tmp_path / "board")
     first = BoardProcess("--pty", "--link", link, "--quiet")
-    monitor = subprocess.Popen([sys.executable, "-m", "appmode", "monitor", link],
-                               cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
+    monitor = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "monitor", link],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     second = None
     try:
         time.sleep(1.5)
@@ -44,9 +48,13 @@ def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> No
 def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path) -> None:
     link = str(tmp_path / "board")
     first = BoardProcess("--pty", "--link", link, "--quiet")
-    drive = subprocess.Popen([sys.executable, "-m", "appmode", "drive", link], cwd=ROOT,
-                             stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE)
+    drive = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "drive", link],
+        cwd=ROOT,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     assert drive.stdin is not None
     record = tmp_path / "second.transcript"
     second = None
@@ -100,9 +108,12 @@ def test_a_tcp_reset_is_reported_and_the_host_resumes() -> None:
 def test_board_keeps_serving_after_clients_are_killed() -> None:
     for where in (("--pty",), ("--listen", "0")):
         with board_process(*where, "--quiet") as board:
-            client = subprocess.Popen([sys.executable, "-m", "appmode", "monitor", board.url],
-                                      cwd=ROOT, stdout=subprocess.PIPE,
-                                      stderr=subprocess.DEVNULL)
+            client = subprocess.Popen(
+                [sys.executable, "-m", "appmode", "monitor", board.url],
+                cwd=ROOT,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL,
+            )
             assert client.stdout is not None
             client.stdout.readline()
             client.kill()  # no goodbye, no Z
