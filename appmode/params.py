@@ -147,10 +147,18 @@ def lookup(key: str | int) -> Param:
     raise ValueError(f"unknown parameter {key!r}: use 0–{PARAM_COUNT - 1} or one of {names}")
 
 
+_BOUNDS = tuple((p.minimum, p.maximum) for p in PARAMS)
+
+
 def values_error(values: Sequence[int]) -> str | None:
     """Why `values` is not a valid set of the nine parameters, or None."""
     if len(values) != PARAM_COUNT:
         return f"expected {PARAM_COUNT} parameters, got {len(values)}"
+    # the common case, quickly (every C record a host decodes comes through here)
+    if all(lo <= v <= hi for v, (lo, hi) in zip(values, _BOUNDS)) and (
+        values[SYSTEM_MODE] & DRIVE_MASK
+    ) <= max(DriveType):
+        return None
     for index, value in enumerate(values):
         error = value_error(index, value)
         if error is not None:

@@ -124,9 +124,11 @@ def _separator_warning(separator: int) -> str | None:
 
 
 # ---------------------------------------------------------------- board → host records
+# Records are not frozen: a frozen dataclass costs four times as much to build, and the
+# decoder builds hundreds of thousands a second. Treat them as immutable all the same.
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Velocity:
     """`{A x:y:z:0}$`: body velocity, lateral (right +), forward (+), rotation (cw +)."""
 
@@ -138,7 +140,7 @@ class Velocity:
     raw: bytes = _raw()
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Attitude:
     """`{B pitch:roll:yaw:battery}$`: degrees and battery percent."""
 
@@ -150,7 +152,7 @@ class Attitude:
     raw: bytes = _raw()
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class ParamsRecord:
     """`{C p0:…:p8}$`: the nine parameters in index order."""
 
@@ -162,7 +164,7 @@ class ParamsRecord:
         return {p.name: v for p, v in zip(params.PARAMS, self.values, strict=True)}
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class OtherRecord:
     """A well-formed record whose letter this protocol does not define."""
 
@@ -418,6 +420,15 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
     return ParamsRecord(values, terminated, raw)
 
 
+_FAST = re.compile(
+    rb"(.*?)(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)",
+    re.DOTALL,
+)
+"""What comes before the next complete A or B record, and that record: the common case,
+decoded without the general path."""
+_FAST_KIND = {0x41: Velocity, 0x42: Attitude}
+
+
 class BoardDecoder:
     """board→host bytes → records (§3). A missing `$` is tolerated."""
 
@@ -425,54 +436,73 @@ class BoardDecoder:
     """Most bytes ever held between calls."""
 
     def __init__(self) -> None:
-        self._buf = bytearray()
+        self._buf = b""
 
     @property
     def buffered(self) -> int:
         return len(self._buf)
 
     def feed(self, data: bytes) -> list[BoardEvent]:
-        buf = self._buf
-        buf += data
+        buf = self._buf + data if self._buf else bytes(data)
         out: list[BoardEvent] = []
-        pos, n = 0, len(buf)
+        append, general, kind = out.append, self._general, _FAST_KIND
+        pos = 0
+        # findall does the scanning in C: each gap before a fast record goes the general way
+        for gap, raw, x, y, z, w in _FAST.findall(buf):
+            if gap:
+                general(buf, pos, pos + len(gap), out, False)
+                pos += len(gap)
+            append(kind[raw[1]](int(x), int(y), int(z), int(w), True, raw))
+            pos += len(raw)
+        pos = general(buf, pos, len(buf), out, True)
+        self._buf = buf[pos:]
+        return out
+
+    @staticmethod
+    def _general(buf: bytes, pos: int, n: int, out: list[BoardEvent], hold: bool) -> int:
+        """Decode buf[pos:n]. With `hold`, stop where more bytes could change the outcome
+        (a partial record or garbage run at the end); without, n is the start of a record.
+        Returns where it stopped."""
         while pos < n:
             if buf[pos] != LBRACE:
-                start = buf.find(b"{", pos, pos + MAX_RUN)
+                start = buf.find(b"{", pos, min(n, pos + MAX_RUN))
                 if start < 0:
                     if n - pos < MAX_RUN:
-                        break  # the run may go on: hold it
-                    start = pos + MAX_RUN
-                out.append(Garbage(bytes(buf[pos:start])))
+                        if hold:
+                            break  # the run may go on: hold it
+                        start = n
+                    else:
+                        start = pos + MAX_RUN
+                out.append(Garbage(buf[pos:start]))
                 pos = start
                 continue
             limit = min(n, pos + MAX_RECORD)
             close = buf.find(b"}", pos + 1, limit)
             reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
             if reopen >= 0:
-                out.append(Malformed(bytes(buf[pos:reopen]), "record interrupted by '{'"))
+                out.append(Malformed(buf[pos:reopen], "record interrupted by '{'"))
                 pos = reopen
             elif close >= 0:
-                if close + 1 == n:
+                if close + 1 == n and hold:
                     break  # a '$' may follow
-                end = close + 2 if buf[close + 1] == DOLLAR else close + 1
-                raw = bytes(buf[pos:end])
+                end = close + 2 if close + 1 < n and buf[close + 1] == DOLLAR else close + 1
+                raw = buf[pos:end]
                 out.append(_parse_record(raw, raw[1 : close - pos], end == close + 2))
                 pos = end
             elif n - pos >= MAX_RECORD:
-                out.append(
-                    Malformed(bytes(buf[pos:limit]), f"over {MAX_RECORD} bytes without '}}'")
-                )
+                out.append(Malformed(buf[pos:limit], f"over {MAX_RECORD} bytes without '}}'"))
                 pos = limit
-            else:
+            elif hold:
                 break
-        del buf[:pos]
-        return out
+            else:
+                out.append(Malformed(buf[pos:n], "record interrupted by '{'"))
+                pos = n
+        return pos
 
     def flush(self) -> list[BoardEvent]:
         """Report what is held at the end of the stream."""
-        raw = bytes(self._buf)
-        self._buf.clear()
+        raw = self._buf
+        self._buf = b""
         if not raw:
             return []
         if raw[0] != LBRACE:

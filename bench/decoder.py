@@ -1,0 +1,140 @@
+"""Decoder throughput on a 10 MB board stream with 1 % noise.
+
+Side by side in one run: appmode's BoardDecoder, and a straightforward byte-at-a-time
+decoder written the way the firmware's interrupt handler reads bytes (a handler called
+per byte, a state machine, a buffer of digits). Both build every record, fully decoded
+to integers.
+Target: at least 8 MB/s, and at least 2x the byte-at-a-time decoder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import random
+import time
+
+from appmode.protocol import RECORDS, Attitude, BoardDecoder, ParamsRecord, Velocity, encode
+
+
+def make_stream(size: int, noise: float, seed: int = 1) -> tuple[bytes, int]:
+    """A board stream like the real one (A/B alternating, a C now and then), with noise."""
+    rng = random.Random(seed)
+    parts = []
+    total = records = 0
+    k = 0
+    while total < size:
+        if k % 50 == 49:
+            record = encode(ParamsRecord((500, 10000, 20, 0, 10, 10, 10, 0, 1)))
+        elif k % 2:
+            record = encode(
+                Attitude(
+                    rng.randint(-9, 9),
+                    rng.randint(-9, 9),
+                    rng.randint(-179, 180),
+                    rng.randint(0, 100),
+                )
+            )
+        else:
+            record = encode(
+                Velocity(rng.randint(-600, 600), rng.randint(-600, 600), rng.randint(-600, 600), 0)
+            )
+        k += 1
+        data = bytearray(record)
+        for i in range(len(data)):
+            if rng.random() < noise:
+                data[i] = rng.randrange(256)
+        parts.append(bytes(data))
+        total += len(data)
+        records += 1
+    return b"".join(parts), records
+
+
+class ByteAtATime:
+    """The firmware's way: a handler called once per received byte (as the UART interrupt
+    is), a small state machine, digits gathered into ints; records built like appmode's."""
+
+    def __init__(self) -> None:
+        self.in_record = False
+        self.letter = 0
+        self.fields: list[int] = []
+        self.digits = bytearray()
+        self.records: list[object] = []
+
+    def feed(self, data: bytes) -> None:
+        for byte in data:
+            self.on_byte(byte)
+
+    def on_byte(self, byte: int) -> None:
+        if byte == 0x7B:  # '{'
+            self.in_record, self.letter, self.fields = True, 0, []
+            self.digits.clear()
+        elif not self.in_record:
+            return
+        elif self.letter == 0:
+            self.letter = byte
+        elif byte == 0x3A or byte == 0x7D:  # ':' or '}'
+            try:
+                self.fields.append(int(self.digits))
+            except ValueError:
+                self.in_record = False
+                return
+            self.digits.clear()
+            if byte == 0x7D:
+                self.in_record = False
+                self._record()
+        elif byte == 0x2D or 0x30 <= byte <= 0x39:
+            self.digits.append(byte)
+        else:
+            self.in_record = False
+
+    def _record(self) -> None:
+        fields = self.fields
+        if self.letter == 0x41 and len(fields) == 4:
+            self.records.append(Velocity(*fields))
+        elif self.letter == 0x42 and len(fields) == 4:
+            self.records.append(Attitude(*fields))
+        elif self.letter == 0x43 and len(fields) == 9:
+            self.records.append(ParamsRecord(tuple(fields)))
+
+
+def measure(name: str, run: object, size: int) -> tuple[float, int]:
+    start = time.perf_counter()
+    count = run()  # type: ignore[operator]
+    elapsed = time.perf_counter() - start
+    print(
+        f"{name:<28} {size / elapsed / 1e6:8.2f} MB/s {count / elapsed:12,.0f} records/s "
+        f"({count:,} records)"
+    )
+    return size / elapsed, count
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--megabytes", type=float, default=10.0)
+    parser.add_argument("--noise", type=float, default=0.01)
+    parser.add_argument("--chunk", type=int, default=4096, help="bytes per feed call")
+    args = parser.parse_args()
+    stream, sent = make_stream(int(args.megabytes * 1e6), args.noise)
+    chunks = [stream[i : i + args.chunk] for i in range(0, len(stream), args.chunk)]
+    print(
+        f"{len(stream) / 1e6:.1f} MB, {sent:,} records sent, {args.noise:.0%} of bytes "
+        f"replaced, fed in {args.chunk}-byte chunks"
+    )
+
+    def ours() -> int:
+        decoder = BoardDecoder()
+        return sum(isinstance(e, RECORDS) for c in chunks for e in decoder.feed(c))
+
+    def naive() -> int:
+        decoder = ByteAtATime()
+        for chunk in chunks:
+            decoder.feed(chunk)
+        return len(decoder.records)
+
+    fast, _ = measure("appmode BoardDecoder", ours, len(stream))
+    slow, _ = measure("byte-at-a-time (firmware)", naive, len(stream))
+    print(f"speed-up {fast / slow:.1f}x (targets: >= 8 MB/s, >= 2x)")
+
+
+if __name__ == "__main__":
+    main()
