@@ -67,6 +67,7 @@ def _cmd_board(args: argparse.Namespace) -> int:
         pace=not args.no_pace,
         record=args.record,
         quiet=args.quiet,
+        count=args.count,
     )
 
 
@@ -245,6 +246,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--port",
         metavar="DEV",
         help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
+    )
+    board.add_argument(
+        "--count",
+        type=int,
+        default=1,
+        metavar="N",
+        help="serve N boards, each on its own pty, from this one process (default 1)",
     )
     board.add_argument(
         "--link",

@@ -155,7 +155,7 @@ def values_error(values: Sequence[int]) -> str | None:
     if len(values) != PARAM_COUNT:
         return f"expected {PARAM_COUNT} parameters, got {len(values)}"
     # the common case, quickly (every C record a host decodes comes through here)
-    if all(lo <= v <= hi for v, (lo, hi) in zip(values, _BOUNDS)) and (
+    if all(lo <= v <= hi for v, (lo, hi) in zip(values, _BOUNDS, strict=True)) and (
         values[SYSTEM_MODE] & DRIVE_MASK
     ) <= max(DriveType):
         return None

@@ -15,6 +15,7 @@ import sys
 import time
 import tty
 from collections.abc import Callable
+from dataclasses import dataclass
 from functools import partial
 
 import serial
@@ -31,6 +32,8 @@ Log = Callable[[str], None]
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
+GRANULARITY = 0.004
+"""Paced output is written in runs this long (bytes are never sent early)."""
 INPUT_BACKLOG = 256
 """Bytes received but not yet on the simulated line beyond which the server stops reading:
 the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
@@ -79,7 +82,15 @@ class PtyEndpoint:
         if link is not None:
             _symlink(self.url, link)
             log(f"{link} -> {self.url}")
+        self._sel = sel
         sel.register(self._master, selectors.EVENT_READ, self._read)
+
+    def pause(self, paused: bool) -> None:
+        """Stop (or go on) reading: what is not read waits in the pty."""
+        if paused:
+            self._sel.unregister(self._master)
+        else:
+            self._sel.register(self._master, selectors.EVENT_READ, self._read)
 
     def _read(self, size: int) -> bytes:
         try:
@@ -95,9 +106,9 @@ class PtyEndpoint:
         return len(self._out)
 
     def close(self) -> None:
-        if self._link is not None and os.path.islink(self._link):
-            if os.readlink(self._link) == self.url:
-                os.unlink(self._link)
+        link = self._link
+        if link is not None and os.path.islink(link) and os.readlink(link) == self.url:
+            os.unlink(link)
         os.close(self._master)
         os.close(self._slave)
 
@@ -134,7 +145,17 @@ class TcpEndpoint:
         self.url = f"socket://{bound_host}:{bound_port}"
         self._client: socket.socket | None = None
         self._out = Outbox()
+        self._paused = False
         sel.register(self._listener, selectors.EVENT_READ, self._accept)
+
+    def pause(self, paused: bool) -> None:
+        """Stop (or go on) reading the client: what is not read waits in the socket."""
+        self._paused = paused
+        if self._client is not None:
+            if paused:
+                self._sel.unregister(self._client)
+            else:
+                self._sel.register(self._client, selectors.EVENT_READ, self._read)
 
     def _accept(self, size: int) -> bytes:
         try:
@@ -148,7 +169,8 @@ class TcpEndpoint:
         conn.setblocking(False)
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._client = conn
-        self._sel.register(conn, selectors.EVENT_READ, self._read)
+        if not self._paused:
+            self._sel.register(conn, selectors.EVENT_READ, self._read)
         self._log(f"client connected from {peer[0]}:{peer[1]}")
         return b""
 
@@ -181,7 +203,8 @@ class TcpEndpoint:
     def _drop(self, why: str) -> None:
         self._out.clear()
         if self._client is not None:
-            self._sel.unregister(self._client)
+            if not self._paused:
+                self._sel.unregister(self._client)
             self._client.close()
             self._client = None
             self._log(f"{why}; waiting for the next client")
@@ -203,7 +226,15 @@ class SerialEndpoint:
             raise AppmodeError(explain_open_error(path, exc)) from None
         self.url = path
         self.baud = baud
+        self._sel = sel
         sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
+
+    def pause(self, paused: bool) -> None:
+        """Stop (or go on) reading: what is not read waits in the OS buffer."""
+        if paused:
+            self._sel.unregister(self._port.fileno())
+        else:
+            self._sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
 
     def _read(self, size: int) -> bytes:
         data: bytes = self._port.read(max(1, min(size, self._port.in_waiting)))
@@ -230,9 +261,50 @@ def parse_listen(text: str) -> tuple[str, int]:
     return host.strip("[]") or "127.0.0.1", int(port)
 
 
+@dataclass
+class Served:
+    """One board being served: its endpoint and its wire."""
+
+    endpoint: Endpoint
+    wire: Wire
+    paused: bool = False
+    last_write: float = float("-inf")
+
+    def wakeup(self) -> float:
+        """When this board next has something to do. Paced output is written in runs of
+        GRANULARITY seconds, never early: fewer wake-ups, the same bytes per second."""
+        wire = self.wire
+        times = [wire.board.next_slot()]
+        if (due := wire.to_board.next_due()) is not None:
+            times.append(due)
+        if (due := wire.to_host.next_due()) is not None:
+            paced = wire.to_host.byte_time > 0
+            times.append(max(due, self.last_write + GRANULARITY) if paced else due)
+        if self.endpoint.backlog:
+            times.append(self.last_write + RETRY_WRITE)
+        return min(times)
+
+    def pump(self, now: float) -> None:
+        out = self.wire.pump(now)
+        if out or self.endpoint.backlog:
+            self.endpoint.write(out)
+            self.last_write = now
+
+    def receive(self, data: bytes, now: float) -> None:
+        self.pump(now)  # what was due before these bytes came
+        self.wire.write(data, now)
+
+    def throttle(self) -> None:
+        """Read no more while INPUT_BACKLOG bytes wait for the simulated line."""
+        full = len(self.wire.to_board) >= INPUT_BACKLOG
+        if full != self.paused:
+            self.endpoint.pause(full)
+            self.paused = full
+
+
 def serve(
-    make_endpoint: Callable[[selectors.BaseSelector, Log], Endpoint],
-    board: Board,
+    make_endpoints: list[Callable[[selectors.BaseSelector, Log], Endpoint]],
+    boards: list[Board],
     *,
     pace: bool,
     log: Log,
@@ -240,41 +312,41 @@ def serve(
     tap: Tap | None = None,
     banner: str = "",
 ) -> None:
-    """Serve `board` until interrupted (KeyboardInterrupt); `announce` gets the port line."""
+    """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line."""
     sel = selectors.DefaultSelector()
-    endpoint = make_endpoint(sel, log)
-    baud = getattr(endpoint, "baud", BAUD)
-    wire = Wire(board, baud if pace else None, tap)
-    origin = time.monotonic()
-    announce(f"port: {endpoint.url}")
-    if banner:
-        log(banner)
-    for note in board.take_notes():
-        log(note.text)
+    served: list[Served] = []
+    by_endpoint: dict[int, Served] = {}
     try:
+        for make, board in zip(make_endpoints, boards, strict=True):
+            endpoint = make(sel, log)
+            baud = getattr(endpoint, "baud", BAUD)
+            one = Served(endpoint, Wire(board, baud if pace else None, tap))
+            served.append(one)
+            by_endpoint[id(endpoint)] = one
+            announce(f"port: {endpoint.url}")
+        if banner:
+            log(banner)
+        origin = time.monotonic()
         while True:
-            out = wire.pump(time.monotonic() - origin)
-            if out or endpoint.backlog:
-                endpoint.write(out)
-            for note in board.take_notes():
-                log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
-            timeout = max(0.0, wire.next_wakeup() - (time.monotonic() - origin))
-            if endpoint.backlog:
-                timeout = min(timeout, RETRY_WRITE)
-            room = INPUT_BACKLOG - len(wire.to_board)
-            if room <= 0:  # leave the rest in the pty or socket: the writer waits
-                time.sleep(timeout)
-                continue
+            now = time.monotonic() - origin
+            wake = float("inf")
+            for one in served:
+                if one.wakeup() <= now:
+                    one.pump(now)
+                for note in one.wire.board.take_notes():
+                    log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
+                one.throttle()
+                wake = min(wake, one.wakeup())
+            timeout = max(0.0, wake - (time.monotonic() - origin))
             for key, _ in sel.select(timeout):
-                data = key.data(room)
+                reader = key.data
+                one = by_endpoint[id(reader.__self__)]
+                data = reader(max(1, INPUT_BACKLOG - len(one.wire.to_board)))
                 if data:
-                    now = time.monotonic() - origin
-                    out = wire.pump(now)  # what was due before these bytes came
-                    if out:
-                        endpoint.write(out)
-                    wire.write(data, now)
+                    one.receive(data, time.monotonic() - origin)
     finally:
-        endpoint.close()
+        for one in served:
+            one.endpoint.close()
         sel.close()
 
 
@@ -289,8 +361,9 @@ def run_board(
     pace: bool,
     record: str | None,
     quiet: bool,
+    count: int = 1,
 ) -> int:
-    """The `appmode board` command: build the board and serve it until interrupted."""
+    """The `appmode board` command: build the board(s) and serve until interrupted."""
 
     def log(text: str) -> None:
         if not quiet:
@@ -299,6 +372,13 @@ def run_board(
     def announce(text: str) -> None:
         print(text, flush=True)
 
+    if count < 1:
+        raise AppmodeError("--count must be at least 1")
+    if count > 1 and (listen or device or link or flash or record):
+        raise AppmodeError(
+            "--count serves several boards on ptys: it cannot be combined "
+            "with --listen, --port, --link, --flash or --record"
+        )
     make: Callable[[selectors.BaseSelector, Log], Endpoint]
     if listen is not None:
         host, port = parse_listen(listen)
@@ -307,18 +387,28 @@ def run_board(
         make = partial(_serial, device=device)
     else:
         make = partial(_pty, link=link)
-    board = Board(open_store(flash), drive=DriveType.from_cli_name(drive) if drive else None)
+    kind = DriveType.from_cli_name(drive) if drive else None
+    boards = [Board(open_store(flash), drive=kind) for _ in range(count)]
     banner = (
-        f"simulated board, {board.drive_type.cli_name} drive, flash {flash or 'in memory'}, "
-        f"{'paced at the line rate' if pace else 'not paced'}"
+        f"simulated board{'s' if count > 1 else ''}, {boards[0].drive_type.cli_name} drive, "
+        f"flash {flash or 'in memory'}, {'paced at the line rate' if pace else 'not paced'}"
     )
     recorder = Recorder.create(record) if record else None
     try:
-        serve(make, board, pace=pace, log=log, announce=announce, tap=recorder, banner=banner)
+        serve(
+            [make] * count,
+            boards,
+            pace=pace,
+            log=log,
+            announce=announce,
+            tap=recorder,
+            banner=banner,
+        )
     except KeyboardInterrupt:
         log("stopped")
     finally:
-        board.store.close()
+        for board in boards:
+            board.store.close()
         if recorder is not None:
             recorder.close()
     return 0
