@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from . import protocol
 from .query import Outcome, ParamQuery, QueryFailed
 
-RATE_WINDOW = 1.0
+RATE_WINDOW = 2.0
 DEGRADED_WINDOW = 5.0
 
 

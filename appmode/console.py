@@ -26,12 +26,15 @@ from prompt_toolkit.output import Output
 
 from . import params
 from .directions import grid_for
-from .panel import ARROWS, KEY_GRID, status_fragments
+from .panel import ARROWS, KEY_GRID, status_fragments, status_text
 from .session import COMMAND_NAMES, MESSAGES, PAGE_WORDS, Quit, Session
 from .tokens import Wait
 
 REFRESH = 0.02
-"""Seconds between reads of the link and redraws."""
+"""Seconds between reads of the link (and checks of the hold-to-drive timers)."""
+REDRAW = 0.1
+"""How often the panel is checked, and redrawn if what it shows changed (a key redraws at
+once)."""
 
 
 def _completer() -> NestedCompleter:
@@ -142,10 +145,18 @@ async def run_app(app: Application[None], session: Session) -> None:
     async def ticker() -> None:
         # A failure here must end the console (and so stop the car), not leave it
         # running without release emulation behind prompt_toolkit's "Press ENTER".
+        checked = 0.0
+        shown = ""
         try:
             while True:
                 session.tick()
-                app.invalidate()
+                now = time.monotonic()
+                if now - checked >= REDRAW:  # redraw only when what is shown changed
+                    checked = now
+                    text = status_text(session) + "\n".join(session.messages)
+                    if text != shown:
+                        shown = text
+                        app.invalidate()
                 await asyncio.sleep(REFRESH)
         except Exception as exc:
             app.exit(exception=exc)

@@ -26,6 +26,14 @@ KEYS_HELP = (
 )
 
 
+STALE = 0.5
+"""Seconds without a record after which the panel shows how long it has been."""
+
+
+def _size(count: int) -> str:
+    return f"{count} B" if count < 1000 else f"{count // 1000} kB"
+
+
 def _bar(percent: int) -> str:
     filled = round(percent / 100 * BAR)
     return "[" + "#" * filled + "." * (BAR - filled) + "]"
@@ -45,7 +53,10 @@ def status_fragments(session: Session) -> Fragments:
 
     if host.connected:
         age = stats.since_last(now)
-        last = "no record yet" if age is None else f"last record {age:.2f} s ago"
+        if age is None:
+            last = "no record yet"
+        else:
+            last = "records live" if age < STALE else f"last record {age:.1f} s ago"
         stale = age is None or age > 1.0
         recent = stats.recent_errors(now)
         if recent:
@@ -55,8 +66,8 @@ def status_fragments(session: Session) -> Fragments:
         out.append(
             (
                 "",
-                f"   {stats.rate(now):4.1f} records/s · in {stats.bytes_in} B · "
-                f"out {stats.bytes_out} B · errors {stats.errors} · {last}\n",
+                f"   {stats.rate(now):3.0f} records/s · in {_size(stats.bytes_in)} · "
+                f"out {_size(stats.bytes_out)} · errors {stats.errors} · {last}\n",
             )
         )
     else:

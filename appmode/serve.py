@@ -32,8 +32,6 @@ Log = Callable[[str], None]
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
-GRANULARITY = 0.004
-"""Paced output is written in runs this long (bytes are never sent early)."""
 INPUT_BACKLOG = 256
 """Bytes received but not yet on the simulated line beyond which the server stops reading:
 the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
@@ -271,15 +269,15 @@ class Served:
     last_write: float = float("-inf")
 
     def wakeup(self) -> float:
-        """When this board next has something to do. Paced output is written in runs of
-        GRANULARITY seconds, never early: fewer wake-ups, the same bytes per second."""
+        """When this board next has something to do. Paced output is written a record at a
+        time, when its last byte would have arrived on a real line: never early, and one
+        wake-up per record rather than one per byte."""
         wire = self.wire
         times = [wire.board.next_slot()]
         if (due := wire.to_board.next_due()) is not None:
             times.append(due)
-        if (due := wire.to_host.next_due()) is not None:
-            paced = wire.to_host.byte_time > 0
-            times.append(max(due, self.last_write + GRANULARITY) if paced else due)
+        if (due := wire.to_host.burst_due()) is not None:
+            times.append(due)
         if self.endpoint.backlog:
             times.append(self.last_write + RETRY_WRITE)
         return min(times)

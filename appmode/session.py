@@ -112,9 +112,12 @@ class Session:
 
     # ------------------------------------------------------------ time
 
-    def tick(self) -> None:
-        """Read what arrived, finish queries, and stop a held direction that timed out."""
-        for event in self.host.poll_nowait():
+    def tick(self) -> bool:
+        """Read what arrived, finish queries, and stop a held direction that timed out.
+
+        Returns whether anything happened (a view needs redrawing)."""
+        events = self.host.poll_nowait()
+        for event in events:
             if isinstance(event, LinkStatus):
                 self.say(event.text)
                 if not event.up:
@@ -126,6 +129,8 @@ class Session:
                 self.say(f"error: {event.text}")
         if self.driving.release_due(self.host.now()):
             self._send_letter(STOP_LETTER)
+            return True
+        return bool(events)
 
     # ------------------------------------------------------------ driving
 

@@ -1,0 +1,390 @@
+"""Every benchmark in one run, printed as one table (python bench/run_all.py).
+
+Decoder throughput, CPU cost of `appmode board` and `appmode drive`, boards one process
+serves, board-model steps, console key-to-byte latency, 60 s floods, paced throughput,
+{Q:P} round trip and replay timing. `--quick` shortens the long ones.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import platform
+import random
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import tty
+from collections.abc import Callable
+from pathlib import Path
+
+import decoder
+import link_pacing
+import link_roundtrip
+import replay_timing
+import serial
+from common import board, percentile
+
+from appmode.board import TICK, Board
+from appmode.protocol import RECORDS, BoardDecoder
+
+Row = tuple[str, str, str]
+TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def cpu_seconds(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / TICKS
+
+
+def rss_mib(pid: int) -> float:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    return 0.0
+
+
+def board_pid(url_owner: subprocess.Popen[str]) -> int:
+    return url_owner.pid
+
+
+def start_board(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "board", "--quiet", *args],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None
+    count = int(args[args.index("--count") + 1]) if "--count" in args else 1
+    urls = [proc.stdout.readline().split("port: ")[1].strip() for _ in range(count)]
+    return proc, urls
+
+
+def stop(proc: subprocess.Popen[str]) -> None:
+    proc.terminate()
+    proc.wait(10)
+
+
+def open_raw(path: str) -> int:
+    fd = os.open(path, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+    tty.setraw(fd)
+    return fd
+
+
+# ---------------------------------------------------------------- measurements
+
+
+def bench_decoder(quick: bool) -> list[Row]:
+    r = decoder.compare(2.0 if quick else 10.0, 0.01, 4096)
+    return [
+        (
+            "decoder, 1 % noise, 4 KiB chunks",
+            f"{r['ours_mbs']:.2f} MB/s, {r['ours_rps']:,.0f} records/s",
+            ">= 8 MB/s",
+        ),
+        (
+            "byte-at-a-time decoder (firmware way)",
+            f"{r['naive_mbs']:.2f} MB/s, "
+            f"{r['naive_rps']:,.0f} records/s; appmode {r['speedup']:.1f}x",
+            ">= 2x",
+        ),
+    ]
+
+
+def bench_board_cpu(seconds: float) -> list[Row]:
+    proc, [url] = start_board("--pty")
+    fd = open_raw(url)
+    try:
+        time.sleep(1.0)
+        start_cpu, start = cpu_seconds(proc.pid), time.monotonic()
+        received = 0
+        while time.monotonic() - start < seconds:
+            time.sleep(0.05)
+            with contextlib.suppress(BlockingIOError):
+                received += len(os.read(fd, 4096))
+        share = (cpu_seconds(proc.pid) - start_cpu) / (time.monotonic() - start) * 100
+    finally:
+        os.close(fd)
+        stop(proc)
+    return [
+        (
+            "appmode board streaming telemetry (paced)",
+            f"{share:.2f} % of a core ({received / seconds:.0f} bytes/s out)",
+            "< 1 %",
+        )
+    ]
+
+
+def bench_drive_cpu(seconds: float) -> list[Row]:
+    if shutil.which("tmux") is None:
+        return [("appmode drive showing telemetry", "not measured: tmux missing", "< 3 %")]
+    proc, [url] = start_board("--pty")
+    session = "appmode-bench"
+    try:
+        subprocess.run(
+            [
+                "tmux",
+                "new-session",
+                "-d",
+                "-s",
+                session,
+                "-x",
+                "120",
+                "-y",
+                "40",
+                f"exec {sys.executable} -m appmode drive {url}",
+            ],
+            check=True,
+        )
+        time.sleep(2.0)
+        pid = int(
+            subprocess.run(
+                ["tmux", "display-message", "-p", "-t", session, "#{pane_pid}"],
+                capture_output=True,
+                text=True,
+                check=True,
+            ).stdout
+        )
+        start_cpu, start = cpu_seconds(pid), time.monotonic()
+        time.sleep(seconds)
+        share = (cpu_seconds(pid) - start_cpu) / (time.monotonic() - start) * 100
+    finally:
+        subprocess.run(["tmux", "kill-session", "-t", session], capture_output=True, check=False)
+        stop(proc)
+    return [("appmode drive showing telemetry (tmux)", f"{share:.2f} % of a core", "< 3 %")]
+
+
+def bench_many_boards(count: int, seconds: float) -> Row:
+    proc, urls = start_board("--pty", "--count", str(count))
+    fds = [open_raw(url) for url in urls]
+    decoders = [BoardDecoder() for _ in fds]
+    records = [0] * count
+    try:
+        time.sleep(1.0)
+        for fd in fds:
+            with contextlib.suppress(BlockingIOError):
+                os.read(fd, 65536)
+        start_cpu, start = cpu_seconds(proc.pid), time.monotonic()
+        while time.monotonic() - start < seconds:
+            time.sleep(0.1)
+            for k, fd in enumerate(fds):
+                try:
+                    data = os.read(fd, 65536)
+                except BlockingIOError:
+                    continue
+                records[k] += sum(isinstance(e, RECORDS) for e in decoders[k].feed(data))
+        elapsed = time.monotonic() - start
+        share = (cpu_seconds(proc.pid) - start_cpu) / elapsed * 100
+    finally:
+        for fd in fds:
+            os.close(fd)
+        stop(proc)
+    rates = [r / elapsed for r in records]
+    return (
+        f"{count} boards in one process, on ptys",
+        f"{share:.1f} % of a core; records/s "
+        f"per board min {min(rates):.1f}, median {statistics.median(rates):.1f}",
+        ">= 200 boards within one core at 20/s",
+    )
+
+
+def bench_model_steps() -> list[Row]:
+    board = Board()
+    board.receive(b"KC", 0.0)
+    seconds = 2000.0
+    start = time.perf_counter()
+    for k in range(1, int(seconds / 0.5) + 1):
+        board.poll(k * 0.5)
+    elapsed = time.perf_counter() - start
+    steps = seconds / TICK / elapsed
+    return [("board model", f"{steps:,.0f} steps/s ({steps * TICK:,.0f}x real time)", "")]
+
+
+def bench_key_latency(keys: int) -> list[Row]:
+    from prompt_toolkit.input import create_pipe_input
+    from prompt_toolkit.output import DummyOutput
+
+    from appmode.console import run_drive
+    from appmode.driving import HoldToDrive
+    from appmode.session import Session
+
+    sent: list[float] = []
+    typed: list[float] = []
+    session = Session("sim://?pace=0", HoldToDrive(latched=True))
+    real_send = session.host.send
+
+    def send(data: bytes) -> None:
+        if data in (b"A", b"Z"):
+            sent.append(time.perf_counter())
+        real_send(data)
+
+    session.host.send = send  # type: ignore[method-assign]
+    with create_pipe_input() as pipe:
+
+        def typist() -> None:
+            time.sleep(1.0)
+            sent.clear()
+            for k in range(keys):
+                typed.append(time.perf_counter())
+                pipe.send_text("w" if k % 2 == 0 else " ")
+                time.sleep(0.02)
+            time.sleep(0.3)
+            pipe.send_text("\x03")
+
+        thread = threading.Thread(target=typist, daemon=True)
+        thread.start()
+        run_drive(session, True, [], io.StringIO(), pipe, DummyOutput())
+        thread.join()
+    latency = [(s - t) * 1000 for t, s in zip(typed, sent, strict=False)]
+    return [
+        (
+            "console key-to-byte latency",
+            f"median {statistics.median(latency):.2f} ms, "
+            f"p99 {percentile(latency, 99):.2f} ms (n={len(latency)})",
+            "p99 < 5 ms",
+        )
+    ]
+
+
+def bench_flood(seconds: float, paced: bool, garbage: bool) -> Row:
+    with tempfile.TemporaryDirectory() as tmp:
+        record = Path(tmp) / "b.transcript"
+        args = ["--pty"] + ([] if paced else ["--no-pace"])
+        if not garbage:
+            args += ["--record", str(record)]
+        proc, [url] = start_board(*args)
+        rng = random.Random(1)
+        written = [0]
+        stop_at = time.monotonic() + seconds
+
+        def writer() -> None:
+            port = serial.Serial(url, 9600, write_timeout=None)
+            try:
+                while time.monotonic() < stop_at:
+                    if garbage:
+                        port.write(rng.randbytes(512))
+                    else:
+                        port.write(b"{7:%d}" % (written[0] % 100000))
+                    written[0] += 1
+            except (serial.SerialException, OSError):
+                pass
+
+        time.sleep(0.5)
+        before = rss_mib(proc.pid)
+        thread = threading.Thread(target=writer, daemon=True)
+        thread.start()
+        time.sleep(seconds)
+        after = rss_mib(proc.pid)
+        stop(proc)
+        thread.join(5)
+        what = "garbage" if garbage else "valid commands"
+        label = f"flood of {what}, {seconds:.0f} s, {'paced' if paced else 'no pacing'}"
+        memory = f"RSS {before:.1f} -> {after:.1f} MiB"
+        if garbage:
+            return (
+                label,
+                f"{written[0] * 512 / seconds / 1e3:,.0f} KB/s in; {memory}",
+                "memory flat",
+            )
+        lines = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+        if lines and not lines[-1].endswith("}"):
+            lines.pop()
+        in_order = lines == [f"{{7:{k % 100000}}}" for k in range(len(lines))]
+        return (
+            label,
+            f"{len(lines) / seconds:,.0f} commands/s applied, "
+            f"{'all in order' if in_order else 'OUT OF ORDER'}; {memory}",
+            "all applied in order, memory flat",
+        )
+
+
+def bench_links(quick: bool) -> list[Row]:
+    rate = link_pacing.measure(5.0 if quick else 10.0)
+    rows = [
+        (
+            "paced throughput over a pty",
+            f"{rate:.1f} bytes/s = {rate / 9.6:.2f} % of 960",
+            ">= 99.5 %, <= 100 %",
+        )
+    ]
+    for label, option in (("pty", ("--pty",)), ("TCP", ("--listen", "0"))):
+        with board(*option, "--no-pace") as url:
+            extra = [x * 1000 for x in link_roundtrip.measure(url, 50 if quick else 200)]
+        rows.append(
+            (
+                f"{{Q:P}} -> C over {label}, beyond the next slot",
+                f"median {statistics.median(extra):.2f} ms, p99 {percentile(extra, 99):.2f} ms",
+                "< 2 ms",
+            )
+        )
+    return rows
+
+
+def bench_replay(events: int) -> list[Row]:
+    times = [k * 0.01 for k in range(events)]
+    rows = []
+    for name, late in (
+        ("appmode replay", replay_timing.appmode_lateness(times)),
+        ("python-can MessageSync", replay_timing.python_can_lateness(times)),
+    ):
+        if late is None:
+            rows.append((f"{name}, {events} events at 10 ms", "python-can not installed", ""))
+            continue
+        ms = [x * 1000 for x in late]
+        rows.append(
+            (
+                f"{name}, {events} events at 10 ms",
+                f"median {statistics.median(ms):.3f}"
+                f" ms, p99 {percentile(ms, 99):.3f} ms, drift {ms[-1]:.3f} ms",
+                "p99 < 1 ms, no drift",
+            )
+        )
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="shorter runs (about 2 min)")
+    args = parser.parse_args()
+    quick = args.quick
+    plan: list[tuple[str, Callable[[], list[Row]]]] = [
+        ("decoder", lambda: bench_decoder(quick)),
+        ("board model", bench_model_steps),
+        ("key latency", lambda: bench_key_latency(100 if quick else 300)),
+        ("board CPU", lambda: bench_board_cpu(10 if quick else 30)),
+        ("drive CPU", lambda: bench_drive_cpu(10 if quick else 30)),
+        ("200 boards", lambda: [bench_many_boards(200, 5 if quick else 15)]),
+        ("links", lambda: bench_links(quick)),
+        (
+            "floods",
+            lambda: [
+                bench_flood(10 if quick else 60, paced, garbage)
+                for paced, garbage in ((False, False), (True, False), (False, True))
+            ],
+        ),
+        ("replay", lambda: bench_replay(1000 if quick else 10_000)),
+    ]
+    rows: list[Row] = []
+    for name, run in plan:
+        print(f"running: {name} …", file=sys.stderr, flush=True)
+        rows += run()
+    machine = (
+        f"{platform.machine()}, {os.cpu_count()} cores, Python "
+        f"{platform.python_version()}, {platform.system()} {platform.release()}"
+    )
+    print(f"appmode benchmarks — {time.strftime('%Y-%m-%d')} — {machine}")
+    width = max(len(r[0]) for r in rows)
+    print(f"| {'benchmark'.ljust(width)} | result | target |")
+    print(f"|{'-' * (width + 2)}|---|---|")
+    for label, result, target in rows:
+        print(f"| {label.ljust(width)} | {result} | {target} |")
+
+
+if __name__ == "__main__":
+    main()
