@@ -72,11 +72,6 @@ class Board:
 
     # ------------------------------------------------------------ clock
 
-    @property
-    def now(self) -> float:
-        """Time of the last tick run."""
-        return self._boot + (self._tick - 1) * TICK
-
     def next_slot(self) -> float:
         """When the next telemetry record is due."""
         ticks = -self._tick % SLOT_TICKS

@@ -137,7 +137,7 @@ def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
                 title = stripped.lstrip("# ").strip()
             continue
         if stripped.startswith("@"):
-            name, *args = stripped[1:].split()
+            name, *args = stripped[1:].split() or [""]
             if name not in DIRECTIVES:
                 known = ", ".join(f"@{d}" for d in DIRECTIVES)
                 raise TranscriptError(f"{where}: unknown directive @{name} (known: {known})")

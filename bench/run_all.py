@@ -50,10 +50,6 @@ def rss_mib(pid: int) -> float:
     return 0.0
 
 
-def board_pid(url_owner: subprocess.Popen[str]) -> int:
-    return url_owner.pid
-
-
 def start_board(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
     proc = subprocess.Popen(
         [sys.executable, "-m", "appmode", "board", "--quiet", *args],

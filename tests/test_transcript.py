@@ -79,6 +79,7 @@ def test_reader_keeps_title_directives_and_entries(tmp_path: Path) -> None:
         ("0.1 > A B", "column 2: ' ' cannot stand for itself"),
         ("0.1 > \\q", "column 1: '\\\\' cannot stand for itself"),
         ("@timeout 3", "unknown directive @timeout (known: @board, @tolerance"),
+        ("@", "unknown directive @ (known:"),  # found by fuzz/fuzz_decoders.py
     ],
 )
 def test_malformed_lines_name_file_and_line(tmp_path: Path, line: str, message: str) -> None:
