@@ -31,3 +31,20 @@ def assert_split_invariant(make: Callable[[], Decoder], data: bytes) -> list[Any
     assert decode_chunks(make, [data[i : i + 1] for i in range(len(data))]) == whole
     assert b"".join(e.raw for e in whole) == data, "every byte belongs to one event"
     return whole
+
+
+def assert_any_bytes_ok(
+    make: type[protocol.HostDecoder] | type[protocol.BoardDecoder], data: bytes, cuts: list[int]
+) -> None:
+    """Fed in pieces of `cuts` sizes: no exception, buffer within LIMIT, every byte in one
+    event, and the same events as fed whole."""
+    decoder = make()
+    events: list[Any] = []
+    pos = 0
+    for size in [*cuts, len(data)]:
+        events += decoder.feed(data[pos : pos + size])
+        assert decoder.buffered <= make.LIMIT
+        pos += size
+    events += decoder.flush()
+    assert b"".join(e.raw for e in events) == data
+    assert events == decode_whole(make, data)

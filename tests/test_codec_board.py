@@ -18,7 +18,7 @@ from appmode.protocol import (
     encode,
 )
 
-from .conftest import assert_split_invariant, decode_whole
+from .conftest import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
 C_DEFAULT = b"{C500:10000:20:0:10:10:10:0:0}$"
 
@@ -129,16 +129,7 @@ def test_property_encode_decode_round_trip(items: list[object]) -> None:
 def test_property_arbitrary_bytes_never_raise_and_stay_bounded(
     data: bytes, cuts: list[int]
 ) -> None:
-    decoder = BoardDecoder()
-    events = []
-    pos = 0
-    for size in [*cuts, len(data)]:
-        events += decoder.feed(data[pos : pos + size])
-        assert decoder.buffered <= BoardDecoder.LIMIT
-        pos += size
-    events += decoder.flush()
-    assert b"".join(e.raw for e in events) == data
-    assert events == decode_whole(BoardDecoder, data)
+    assert_any_bytes_ok(BoardDecoder, data, cuts)
 
 
 @given(

@@ -21,7 +21,7 @@ from appmode.protocol import (
     encode,
 )
 
-from .conftest import assert_split_invariant, decode_chunks, decode_whole
+from .conftest import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
 
 def test_s2_1_letters_a_to_h_drive_directions_1_to_8() -> None:
@@ -169,14 +169,4 @@ def test_property_encode_decode_round_trip(cmds: list[object]) -> None:
 def test_property_arbitrary_bytes_never_raise_and_stay_bounded(
     data: bytes, cuts: list[int]
 ) -> None:
-    decoder = HostDecoder()
-    events = []
-    pos = 0
-    for size in [*cuts, len(data)]:
-        events += decoder.feed(data[pos : pos + size])
-        assert decoder.buffered <= HostDecoder.LIMIT
-        pos += size
-    events += decoder.flush()
-    assert b"".join(e.raw for e in events) == data
-    assert events == decode_whole(HostDecoder, data)
-    assert decode_chunks(HostDecoder, [data]) == events
+    assert_any_bytes_ok(HostDecoder, data, cuts)
