@@ -13,7 +13,7 @@ import argparse
 import random
 import time
 
-from appmode.protocol import RECORDS, Attitude, BoardDecoder, ParamsRecord, Velocity, encode
+from appmode.protocol.app import RECORDS, Attitude, BoardDecoder, ParamsRecord, Velocity, encode
 
 
 def make_stream(size: int, noise: float, seed: int = 1) -> tuple[bytes, int]:

@@ -16,8 +16,8 @@ import time
 from common import board, summary_ms
 
 import appmode  # noqa: F401 - registers sim://
-from appmode.link import open_link
-from appmode.protocol import BoardDecoder, ParamsRecord
+from appmode.ports.link import open_link
+from appmode.protocol.app import BoardDecoder, ParamsRecord
 
 SLOT = 0.05
 

@@ -14,7 +14,7 @@ import time
 
 from common import percentile
 
-from appmode.replay import play
+from appmode.transcript.replay import play
 
 
 def appmode_lateness(times: list[float]) -> list[float]:

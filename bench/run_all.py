@@ -31,8 +31,8 @@ import replay_timing
 import serial
 from common import board, percentile
 
-from appmode.board import TICK, Board
-from appmode.protocol import RECORDS, BoardDecoder
+from appmode.board.firmware import TICK, Board
+from appmode.protocol.app import RECORDS, BoardDecoder
 
 Row = tuple[str, str, str]
 TICKS = os.sysconf("SC_CLK_TCK")
@@ -206,9 +206,9 @@ def bench_key_latency(keys: int) -> list[Row]:
     from prompt_toolkit.input import create_pipe_input
     from prompt_toolkit.output import DummyOutput
 
-    from appmode.console import run_drive
-    from appmode.driving import HoldToDrive
-    from appmode.session import Session
+    from appmode.console.app import run_drive
+    from appmode.console.hold import HoldToDrive
+    from appmode.console.session import Session
 
     sent: list[float] = []
     typed: list[float] = []

@@ -15,8 +15,8 @@ import sys
 import atheris
 
 with atheris.instrument_imports():
-    from appmode.protocol import BoardDecoder, HostDecoder
-    from appmode.transcript import TranscriptError, parse_transcript
+    from appmode.protocol.app import BoardDecoder, HostDecoder
+    from appmode.protocol.transcript import TranscriptError, parse_transcript
 
 
 def check(make: type[HostDecoder] | type[BoardDecoder], data: bytes, cut: int) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from appmode import params
+from appmode.protocol import params
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 

@@ -1,0 +1,81 @@
+"""`appmode board`: serve the simulated board on a pseudo-terminal, TCP or a serial port."""
+
+from __future__ import annotations
+
+import argparse
+
+from appmode.cli.options import Subparsers, add_record
+from appmode.protocol.params import DRIVE_NAMES
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    board = sub.add_parser(
+        "board",
+        help="serve the simulated board on a pseudo-terminal, TCP or a serial port",
+        description="Serve the simulated board so that any serial program (the phone app "
+        "through a Bluetooth module, miniterm, appmode itself) can talk to it. Prints "
+        "'port: URL' for clients to open, then logs what it receives until Ctrl-C.",
+    )
+    where = board.add_mutually_exclusive_group()
+    where.add_argument(
+        "--pty", action="store_true", help="serve on a new pseudo-terminal (the default)"
+    )
+    where.add_argument(
+        "--listen",
+        metavar="HOST:PORT",
+        help="serve on TCP, one client at a time (host 127.0.0.1 by default; "
+        "port 0 picks a free one)",
+    )
+    where.add_argument(
+        "--port",
+        metavar="DEV",
+        help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
+    )
+    board.add_argument(
+        "--count",
+        type=int,
+        default=1,
+        metavar="N",
+        help="serve N boards, each on its own pty, from this one process (default 1)",
+    )
+    board.add_argument(
+        "--link",
+        metavar="PATH",
+        help="with --pty: keep a symlink PATH to the pty, so clients find a restarted board "
+        "at the same path",
+    )
+    board.add_argument(
+        "--drive", choices=DRIVE_NAMES, help="drive type (default: the saved one, else omni)"
+    )
+    board.add_argument(
+        "--flash",
+        metavar="FILE",
+        help="keep saved parameters in this JSON file (default: in memory)",
+    )
+    board.add_argument(
+        "--no-pace",
+        action="store_true",
+        help="send as fast as the link takes, not at the 9600-bps line rate",
+    )
+    add_record(board)
+    board.add_argument(
+        "--quiet", "-q", action="store_true", help="do not log what the board receives"
+    )
+    return board
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.ports.serve import run_board
+
+    return run_board(
+        use_pty=args.pty,
+        link=args.link,
+        listen=args.listen,
+        device=args.port,
+        drive=args.drive,
+        flash=args.flash,
+        pace=not args.no_pace,
+        record=args.record,
+        quiet=args.quiet,
+        count=args.count,
+    )

@@ -1,0 +1,27 @@
+"""`appmode dump`: decode a transcript."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from appmode.cli.options import Subparsers
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    dump = sub.add_parser(
+        "dump",
+        help="decode a transcript",
+        description="Decode every command and record of a transcript: text, JSON Lines or CSV.",
+    )
+    dump.add_argument("file", metavar="FILE", help="the transcript")
+    fmt = dump.add_mutually_exclusive_group()
+    fmt.add_argument("--json", action="store_true", help="JSON Lines")
+    fmt.add_argument("--csv", action="store_true", help="CSV with a header row")
+    return dump
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.transcript.dump import run_dump
+
+    return run_dump(args.file, "json" if args.json else "csv" if args.csv else "text", sys.stdout)

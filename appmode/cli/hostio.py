@@ -1,0 +1,38 @@
+"""What `send`, `params` and `monitor` share: a host opened with its recording, and its
+events printed as text or JSON Lines."""
+
+from __future__ import annotations
+
+import json
+import sys
+from contextlib import ExitStack, closing
+from typing import TextIO
+
+from appmode.host.client import Event, Host
+from appmode.host.query import QueryDone, QueryFailed
+from appmode.host.state import LinkStatus
+from appmode.ports.sim import sim_directives
+from appmode.protocol.render import describe, line, to_json
+from appmode.protocol.transcript import Recorder
+
+
+def open_host(stack: ExitStack, url: str, record: str | None) -> Host:
+    recorder = (
+        stack.enter_context(closing(Recorder.create(record, 0.0, sim_directives(url))))
+        if record
+        else None
+    )
+    return stack.enter_context(Host(url, tap=recorder))
+
+
+def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:
+    if isinstance(event, LinkStatus):
+        print(f"appmode: {event.text}", file=sys.stderr, flush=True)
+        return
+    if isinstance(event, (QueryDone, QueryFailed)):
+        return
+    if as_json:
+        out.write(json.dumps({"t": round(host.now(), 3), **to_json(event)}) + "\n")
+    else:
+        out.write(line(host.now(), "<", event.raw, describe(event)) + "\n")
+    out.flush()

@@ -1,0 +1,88 @@
+"""The `appmode` command line: one module per command, collected into one parser."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+from collections.abc import Callable, Sequence
+from types import ModuleType
+
+from appmode import __version__
+from appmode.cli import (
+    board,
+    conform,
+    decode,
+    demo,
+    drive,
+    dump,
+    monitor,
+    params,
+    plot,
+    replay,
+    send,
+    tap,
+)
+from appmode.errors import AppmodeError
+
+COMMANDS: tuple[ModuleType, ...] = (
+    drive,
+    demo,
+    decode,
+    board,
+    send,
+    params,
+    monitor,
+    conform,
+    replay,
+    tap,
+    dump,
+    plot,
+)
+"""Each command's module: `register(sub)` adds its arguments, `run(args)` does the job."""
+
+Handler = Callable[[argparse.Namespace], int]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="appmode",
+        description="Drive, emulate and test robot-car boards that speak the APP protocol "
+        "(9600 bps: letters drive, {…} frames read and set parameters).",
+    )
+    parser.add_argument("--version", action="version", version=f"appmode {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for command in COMMANDS:
+        command.register(sub).set_defaults(handler=command.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler: Handler = args.handler
+    signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        return handler(args)
+    except AppmodeError as exc:
+        print(f"appmode: error: {exc}", file=sys.stderr)
+        return 2
+    except ValueError as exc:
+        print(f"appmode: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    """SIGTERM ends a command the way Ctrl-C does: cleanly, the car stopped."""
+    raise KeyboardInterrupt
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,28 @@
+"""`appmode plot`: draw a transcript's telemetry (needs matplotlib)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from appmode.cli.options import Subparsers
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    plot = sub.add_parser(
+        "plot",
+        help="draw a transcript's telemetry (needs matplotlib)",
+        description="Draw velocities, attitude and battery over time, with the commands "
+        "marked, to a PNG. Needs the plot extra: pip install 'appmode[plot]'.",
+    )
+    plot.add_argument("file", metavar="FILE", help="the transcript")
+    plot.add_argument("-o", "--output", required=True, metavar="PNG", help="the image to write")
+    return plot
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.transcript.dump import run_plot
+
+    run_plot(args.file, args.output)
+    print(f"wrote {args.output}", file=sys.stderr)
+    return 0

@@ -1,0 +1,42 @@
+"""`appmode replay`: play one side of a transcript to a port."""
+
+from __future__ import annotations
+
+import argparse
+
+from appmode.cli.options import Subparsers
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    replay = sub.add_parser(
+        "replay",
+        help="play one side of a transcript to a port",
+        description="Play the host's lines ('>', driving a board) or the board's lines ('<', "
+        "feeding an app) to a port, each at its time from the start. As the host the replay "
+        "ends with Z.",
+    )
+    replay.add_argument("file", metavar="FILE", help="the transcript")
+    replay.add_argument("--to", required=True, metavar="URL", help="where to play it")
+    replay.add_argument(
+        "--side",
+        choices=("host", "board"),
+        default="host",
+        help="which side to play (default: host)",
+    )
+    replay.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        metavar="X",
+        help="time factor: 2 plays twice as fast (default 1)",
+    )
+    replay.add_argument(
+        "--loop", type=int, default=1, metavar="N", help="play it N times (default 1)"
+    )
+    return replay
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.transcript.replay import run_replay
+
+    return run_replay(args.file, args.to, args.side, args.speed, args.loop)

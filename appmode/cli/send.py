@@ -1,0 +1,82 @@
+"""`appmode send`: send letters and frames to a board and print what comes back."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from contextlib import ExitStack
+from typing import TextIO
+
+from appmode.cli.hostio import open_host, show
+from appmode.cli.options import Subparsers, add_record, add_url
+from appmode.host.tokens import Wait, parse_token
+from appmode.protocol.app import HostDecoder
+from appmode.protocol.render import describe, line
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    send = sub.add_parser(
+        "send",
+        help="send letters and frames to a board and print what comes back",
+        description="Send tokens in order and print the records that come back. Tokens: "
+        "letters (A-H drive, I J K pages, Z stop; 'JAZ' sends three), frames ({Q:P}, "
+        "{Q:W}, {0:800}), escaped bytes (\\x01) and waits (wait:0.5). Z is always sent "
+        "last, so the car is never left moving.",
+    )
+    add_url(send)
+    send.add_argument("tokens", nargs="+", metavar="TOKEN", help="what to send")
+    send.add_argument(
+        "--listen",
+        type=float,
+        default=0.3,
+        metavar="SECONDS",
+        help="how long to print replies after the last token (default 0.3)",
+    )
+    send.add_argument(
+        "--raw", action="store_true", help="send frames even if the board would reject them"
+    )
+    send.add_argument("--json", action="store_true", help="print JSON Lines")
+    add_record(send)
+    return send
+
+
+def run(args: argparse.Namespace) -> int:
+    return run_send(
+        args.url,
+        args.tokens,
+        listen=args.listen,
+        raw=args.raw,
+        as_json=args.json,
+        record=args.record,
+        out=sys.stdout,
+    )
+
+
+def run_send(
+    url: str,
+    tokens: list[str],
+    *,
+    listen: float,
+    raw: bool,
+    as_json: bool,
+    record: str | None,
+    out: TextIO,
+) -> int:
+    """Send the tokens in order, printing what comes back; `Z` is always sent last."""
+    steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
+    with ExitStack() as stack:
+        host = open_host(stack, url, record)
+        for step in steps:
+            if isinstance(step, Wait):
+                for event in host.events(step.seconds):
+                    show(host, event, out, as_json)
+                continue
+            host.send(step)
+            if not as_json:
+                text = ", ".join(describe(e) for e in HostDecoder().feed(step))
+                out.write(line(host.now(), ">", step, text) + "\n")
+            for event in host.poll(0):
+                show(host, event, out, as_json)
+        for event in host.events(listen):
+            show(host, event, out, as_json)
+    return 0

@@ -1,0 +1,49 @@
+"""Hold-to-drive with no key-release events, as a state machine with no I/O.
+
+Terminals report key presses (and the OS repeats them while a key is held) but never a
+release. A press of a new direction sends its letter; presses of the same one keep it
+alive; when they stop coming the car is stopped with `Z`. The first timeout is longer
+than the OS delay before auto-repeat starts, the second short, for once repeats arrive.
+In latched mode a direction stays until stop or another direction.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from appmode.protocol.directions import STOP_LETTER
+
+FIRST_TIMEOUT = 0.6
+REPEAT_TIMEOUT = 0.15
+
+
+@dataclass(slots=True)
+class HoldToDrive:
+    first_timeout: float = FIRST_TIMEOUT
+    repeat_timeout: float = REPEAT_TIMEOUT
+    latched: bool = False
+    current: str | None = None
+    deadline: float = field(default=0.0)
+
+    def press(self, letter: str, now: float) -> str | None:
+        """A key for `letter` was pressed (or repeated): the letter to send, if any."""
+        if letter == STOP_LETTER:
+            self.current = None
+            return STOP_LETTER
+        if letter == self.current:
+            self.deadline = now + self.repeat_timeout
+            return None
+        self.current = letter
+        self.deadline = now + self.first_timeout
+        return letter
+
+    def release_due(self, now: float) -> bool:
+        """True once, when a held direction has timed out and `Z` must be sent."""
+        if self.latched or self.current is None or now < self.deadline:
+            return False
+        self.current = None
+        return True
+
+    def stop(self) -> None:
+        """Forget the direction in force (a stop was sent another way)."""
+        self.current = None

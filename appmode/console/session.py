@@ -1,0 +1,321 @@
+"""One driving session: the host, what is in force, and the console's commands.
+
+Both faces of `appmode drive` use it: the full-screen console (keys and a command line)
+and the script mode that reads the same commands line by line from stdin. It never
+blocks: parameter reads and sets run as queries whose outcome arrives with `tick()`.
+"""
+
+from __future__ import annotations
+
+import shlex
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from appmode.console.hold import HoldToDrive
+from appmode.errors import AppmodeError
+from appmode.host.client import Host, LinkLost
+from appmode.host.query import ParamQuery, QueryDone, QueryFailed
+from appmode.host.state import LinkStatus
+from appmode.host.tokens import Wait, parse_token
+from appmode.ports.link import is_simulated
+from appmode.ports.sim import sim_directives
+from appmode.protocol import params
+from appmode.protocol.app import HostDecoder, Move, Noise, Stop, SwitchPage
+from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES, STOP_LETTER, Page, letter_name
+from appmode.protocol.transcript import Recorder
+
+SPEED_STEP = 100
+MESSAGES = 8
+
+
+@dataclass(frozen=True, slots=True)
+class CommandSpec:
+    name: str
+    args: str
+    help: str
+
+
+COMMANDS: tuple[CommandSpec, ...] = (
+    CommandSpec("params", "", "read the nine parameters"),
+    CommandSpec("set", "NAME VALUE", "set a parameter, verified by reading back"),
+    CommandSpec("save", "", "save the parameters to the board's flash"),
+    CommandSpec("speed", "+N|-N|N", f"change max_speed (keys + and - step {SPEED_STEP})"),
+    CommandSpec("drive", "A-H", "drive in a direction (latched: until stop)"),
+    CommandSpec("stop", "", "stop the car (Z)"),
+    CommandSpec("page", "direction|button|gravity|joystick", "switch page (I, J, K)"),
+    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop"),
+    CommandSpec("send", "TOKEN...", "send raw tokens: letters, {frames}, \\xNN"),
+    CommandSpec("record", "FILE|stop", "start or stop recording a transcript"),
+    CommandSpec("wait", "SECONDS", "script mode: let time pass"),
+    CommandSpec("status", "", "print the status panel (script mode)"),
+    CommandSpec("help", "", "list the commands"),
+    CommandSpec("quit", "", "stop the car and leave"),
+)
+COMMAND_NAMES = tuple(c.name for c in COMMANDS)
+PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}
+
+
+class Quit(Exception):
+    """The user asked to leave."""
+
+
+class ShowStatus:
+    """`status` was asked for: the view prints the panel (script mode)."""
+
+
+SHOW_STATUS = ShowStatus()
+
+
+class Session:
+    """A host session with driving state, messages, recording and commands."""
+
+    def __init__(
+        self,
+        url: str,
+        driving: HoldToDrive | None = None,
+        record: str | None = None,
+        on_message: Callable[[str], None] | None = None,
+    ) -> None:
+        self.url = url
+        self.simulated = is_simulated(url)
+        self.driving = driving or HoldToDrive()
+        self.messages: deque[str] = deque(maxlen=MESSAGES)
+        self.on_message = on_message
+        self.recorder: Recorder | None = None
+        self.host = Host(url, tap=self._tap)
+        self.page = Page.DIRECTION
+        self.page_letter = "J"
+        self.in_force = STOP_LETTER
+        self._sent = HostDecoder()
+        if record:
+            self.start_recording(record)
+
+    # ------------------------------------------------------------ life cycle
+
+    def start(self) -> None:
+        """Put the board on the direction page (stopped) and read its parameters."""
+        self.switch_page("J")
+        self.host.start_query(ParamQuery(where=self.url))
+
+    def close(self) -> None:
+        """Stop the car — `Z` is the last byte sent — and close everything."""
+        try:
+            self.host.close()
+        finally:
+            if self.recorder is not None:
+                self.recorder.close()
+                self.recorder = None
+
+    def say(self, text: str) -> None:
+        self.messages.append(text)
+        if self.on_message is not None:
+            self.on_message(text)
+
+    def _tap(self, direction: str, time: float, data: bytes) -> None:
+        if self.recorder is not None:
+            self.recorder(direction, time, data)
+
+    # ------------------------------------------------------------ time
+
+    def tick(self) -> bool:
+        """Read what arrived, finish queries, and stop a held direction that timed out.
+
+        Returns whether anything happened (a view needs redrawing)."""
+        events = self.host.poll_nowait()
+        for event in events:
+            if isinstance(event, LinkStatus):
+                self.say(event.text)
+                if not event.up:
+                    self.driving.stop()
+                    self.in_force = STOP_LETTER
+            elif isinstance(event, QueryDone):
+                self.say(event.text)
+            elif isinstance(event, QueryFailed):
+                self.say(f"error: {event.text}")
+        if self.driving.release_due(self.host.now()):
+            self._send_letter(STOP_LETTER)
+            return True
+        return bool(events)
+
+    # ------------------------------------------------------------ driving
+
+    def press(self, letter: str) -> None:
+        """A driving key: a letter of the current page, or Z."""
+        if not self.host.connected:
+            self.say("link is down: not driving")
+            return
+        to_send = self.driving.press(letter, self.host.now())
+        if to_send is not None:
+            self._send_letter(to_send)
+
+    def stop(self) -> None:
+        self.driving.stop()
+        self._send_letter(STOP_LETTER)
+
+    def switch_page(self, letter: str) -> None:
+        self.driving.stop()
+        self._send(letter.encode())
+
+    def _send_letter(self, letter: str) -> None:
+        self._send(letter.encode())
+
+    def _send(self, data: bytes) -> bool:
+        """Send, then follow what was sent: the page and the direction in force."""
+        try:
+            self.host.send(data)
+        except LinkLost as exc:
+            self.say(str(exc))
+            self.driving.stop()
+            return False
+        for event in self._sent.feed(data):
+            if isinstance(event, Move):
+                self.in_force = event.letter
+            elif isinstance(event, SwitchPage):
+                self.page = PAGE_LETTERS[event.letter]
+                self.page_letter = event.letter
+                self.in_force = STOP_LETTER
+            elif isinstance(event, (Stop, Noise)):
+                self.in_force = STOP_LETTER
+        return True
+
+    @property
+    def in_force_text(self) -> str:
+        return f"{self.in_force} {letter_name(self.page, self.in_force)}"
+
+    @property
+    def page_text(self) -> str:
+        return f"{self.page.value} ({self.page_letter} {PAGE_NAMES[self.page_letter]})"
+
+    # ------------------------------------------------------------ parameters
+
+    def _query(self, query: ParamQuery) -> None:
+        if self.host.state.query is not None:
+            self.say("busy: a parameter read or set is in progress")
+            return
+        self.host.start_query(query)
+
+    def read_params(self) -> None:
+        self._query(ParamQuery(where=self.url))
+
+    def set_param(self, index: int, value: int) -> None:
+        params.check_value(index, value)
+        self._query(ParamQuery((index, value), where=self.url))
+
+    def change_speed(self, delta: int) -> None:
+        current = self.host.state.params
+        if current is None:
+            self.say("parameters not read yet: reading them, try again")
+            self.read_params()
+            return
+        top = params.PARAMS[params.MAX_SPEED].maximum
+        self.set_param(params.MAX_SPEED, min(top, max(0, current.values[0] + delta)))
+
+    def save(self) -> None:
+        if self._send(b"{Q:W}"):
+            self.say("saved to the board's flash ({Q:W})")
+
+    # ------------------------------------------------------------ recording
+
+    def start_recording(self, path: str) -> None:
+        if self.recorder is not None:
+            self.recorder.close()
+        self.recorder = Recorder.create(path, self.host.now(), sim_directives(self.url))
+        self.say(f"recording to {path}")
+
+    def stop_recording(self) -> None:
+        if self.recorder is None:
+            self.say("not recording")
+            return
+        self.recorder.close()
+        self.recorder = None
+        self.say("recording stopped")
+
+    # ------------------------------------------------------------ commands
+
+    def run(self, line: str) -> Wait | ShowStatus | None:
+        """Run one command line; returns a Wait for `wait`, SHOW_STATUS for `status`.
+        Raises Quit to leave.
+
+        Mistakes are reported as messages, never raised.
+        """
+        try:
+            words = shlex.split(line, comments=True)
+        except ValueError as exc:
+            self.say(f"error: {exc}")
+            return None
+        if not words:
+            return None
+        try:
+            return self._dispatch(words[0].lower(), words[1:])
+        except (AppmodeError, ValueError) as exc:
+            self.say(f"error: {exc}")
+            return None
+
+    def _dispatch(self, name: str, args: list[str]) -> Wait | ShowStatus | None:
+        if name in ("quit", "exit", "q"):
+            raise Quit
+        if name in ("help", "?"):
+            for spec in COMMANDS:
+                self.say(f"{spec.name} {spec.args}".strip().ljust(42) + spec.help)
+        elif name in ("params", "read"):
+            self.read_params()
+        elif name == "set":
+            if len(args) != 2 or not args[1].isdigit():
+                raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
+            self.set_param(params.lookup(args[0]).index, int(args[1]))
+        elif name == "save":
+            self.save()
+        elif name == "speed":
+            self._speed(args)
+        elif name == "drive":
+            if len(args) != 1 or args[0].upper() not in "ABCDEFGH" or len(args[0]) != 1:
+                raise AppmodeError("usage: drive LETTER, one of A-H")
+            self.press(args[0].upper())
+        elif name == "stop":
+            self.stop()
+        elif name == "page":
+            if len(args) != 1 or args[0].lower() not in PAGE_WORDS:
+                raise AppmodeError("usage: page direction|button|gravity|joystick")
+            self.switch_page(PAGE_WORDS[args[0].lower()])
+        elif name == "latch":
+            if args not in (["on"], ["off"]):
+                raise AppmodeError("usage: latch on|off")
+            self.driving.latched = args[0] == "on"
+            self.say(f"latched driving {args[0]}")
+        elif name == "send":
+            self._send_tokens(args)
+        elif name == "record":
+            if len(args) != 1:
+                raise AppmodeError("usage: record FILE, or record stop")
+            self.stop_recording() if args[0] == "stop" else self.start_recording(args[0])
+        elif name == "wait":
+            step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
+            assert isinstance(step, Wait)
+            return step
+        elif name == "status":
+            return SHOW_STATUS
+        else:
+            raise AppmodeError(f"unknown command {name!r}: type help for the list")
+        return None
+
+    def _speed(self, args: list[str]) -> None:
+        if len(args) != 1 or not args[0].lstrip("+-").isdigit():
+            raise AppmodeError("usage: speed +N, speed -N or speed N")
+        text = args[0]
+        if text[0] in "+-":
+            self.change_speed(int(text))
+        else:
+            self.set_param(params.MAX_SPEED, int(text))
+
+    def _send_tokens(self, tokens: list[str]) -> None:
+        if not tokens:
+            raise AppmodeError("usage: send TOKEN..., e.g. send J A or send {Q:P}")
+        steps = [parse_token(token) for token in tokens]
+        if any(isinstance(step, Wait) for step in steps):
+            raise AppmodeError("send takes no waits here: use the wait command")
+        self.driving.stop()
+        for step in steps:
+            assert isinstance(step, bytes)
+            self._send(step)
+        self.say(f"sent {' '.join(tokens)}")

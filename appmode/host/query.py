@@ -1,0 +1,118 @@
+"""Parameter reads and verified sets as a state machine, with no I/O.
+
+A ParamQuery sends `{Q:P}` (after `{n:v}` for a set) and waits for C records. The
+protocol has no checksum, so a corrupted digit can still make a well-formed C record: a
+read is reported only when AGREE C records, each asked for separately, agree. A set is
+done when the agreed values show it. On a timeout the request is sent again; after
+`tries × agree` requests the query ends in QueryFailed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from appmode.protocol import app, params
+
+TIMEOUT = 0.5
+TRIES = 5
+AGREE = 2
+
+
+@dataclass(frozen=True, slots=True)
+class QueryDone:
+    values: tuple[int, ...]
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class QueryFailed:
+    text: str
+
+
+Outcome = QueryDone | QueryFailed
+
+
+class ParamQuery:
+    """Read the parameters, or set one and verify it by reading back."""
+
+    def __init__(
+        self,
+        change: tuple[int, int] | None = None,
+        timeout: float = TIMEOUT,
+        tries: int = TRIES,
+        where: str = "the board",
+        agree: int = AGREE,
+    ) -> None:
+        if change is not None:
+            params.check_value(*change)
+        self.change = change
+        self.timeout = timeout
+        self.tries = tries
+        self.where = where
+        self.agree = agree
+        self.sent = 0
+        self.deadline = 0.0
+        self._candidate: tuple[int, ...] | None = None
+        self._seen = 0
+        self._mismatch: int | None = None
+
+    @property
+    def limit(self) -> int:
+        return self.tries * self.agree
+
+    def _request(self, now: float, with_change: bool) -> bytes:
+        self.sent += 1
+        self.deadline = now + self.timeout
+        read = app.encode(app.ReadParams())
+        if self.change is None or not with_change:
+            return read
+        return app.encode(app.SetParam(*self.change)) + read
+
+    def start(self, now: float) -> bytes:
+        """The bytes to send first."""
+        return self._request(now, with_change=True)
+
+    def on_params(self, values: tuple[int, ...], now: float) -> tuple[bytes, Outcome | None]:
+        """A C record arrived: (bytes to send, outcome or None)."""
+        if values == self._candidate:
+            self._seen += 1
+        else:
+            self._candidate, self._seen = values, 1
+        if self._seen < self.agree:
+            if self.sent >= self.limit:
+                return self._retry(now)
+            return self._request(now, with_change=False), None  # ask again to confirm
+        if self.change is None:
+            return b"", QueryDone(values, "parameters read")
+        index, value = self.change
+        if values[index] == value:
+            return b"", QueryDone(values, f"{params.PARAMS[index].name} = {value} (verified)")
+        self._mismatch = values[index]
+        self._candidate, self._seen = None, 0
+        return self._retry(now)
+
+    def on_garbled(self, now: float) -> tuple[bytes, Outcome | None]:
+        """A C record arrived garbled: ask again at once rather than wait for the timeout."""
+        return self._retry(now)
+
+    def on_time(self, now: float) -> tuple[bytes, Outcome | None]:
+        """Call as time passes: a resend, a failure, or nothing yet."""
+        if now < self.deadline:
+            return b"", None
+        return self._retry(now)
+
+    def _retry(self, now: float) -> tuple[bytes, Outcome | None]:
+        if self.sent < self.limit:
+            return self._request(now, with_change=True), None
+        if self.change is not None and self._mismatch is not None:
+            index, value = self.change
+            return b"", QueryFailed(
+                f"{params.PARAMS[index].name} reads {self._mismatch} after setting it to "
+                f"{value}: the board did not take the value"
+            )
+        return b"", QueryFailed(
+            f"no parameters from {self.where}: sent {{Q:P}} {self.sent} times and no "
+            f"{self.agree} C records that agree came back ({self.timeout:g} s each); "
+            f"check the board is on, the port and baud rate (9600), and that no other "
+            f"program is using the port"
+        )

@@ -1,0 +1,148 @@
+"""The host side as a state machine, with no I/O: what the host knows of the board.
+
+`HostState.feed(data, now)` decodes board bytes and keeps the last A, B and C records and
+the link statistics; a view (console, monitor) reads them.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+from appmode.host.query import Outcome, ParamQuery, QueryFailed
+from appmode.protocol import app
+
+RATE_WINDOW = 2.0
+DEGRADED_WINDOW = 5.0
+
+
+@dataclass(frozen=True, slots=True)
+class LinkStatus:
+    """The link went down (`up` False) or came back."""
+
+    up: bool
+    text: str
+
+
+@dataclass(slots=True)
+class LinkStats:
+    """Counters of one host session."""
+
+    bytes_in: int = 0
+    bytes_out: int = 0
+    records: int = 0
+    errors: int = 0
+    discarded: int = 0
+    last_record: float | None = None
+    _recent: deque[float] = field(default_factory=deque)
+    _error_times: deque[float] = field(default_factory=deque)
+
+    def rate(self, now: float) -> float:
+        """Records a second over the last RATE_WINDOW seconds."""
+        self._expire(now)
+        return len(self._recent) / RATE_WINDOW
+
+    def recent_errors(self, now: float) -> int:
+        """Errors in the last DEGRADED_WINDOW seconds: the link is degraded while > 0."""
+        while self._error_times and self._error_times[0] <= now - DEGRADED_WINDOW:
+            self._error_times.popleft()
+        return len(self._error_times)
+
+    def count_error(self, now: float, size: int) -> None:
+        self.errors += 1
+        self.discarded += size
+        self._error_times.append(now)
+        self.recent_errors(now)
+
+    def since_last(self, now: float) -> float | None:
+        return None if self.last_record is None else now - self.last_record
+
+    def count_record(self, now: float) -> None:
+        self.records += 1
+        self.last_record = now
+        self._recent.append(now)
+        self._expire(now)
+
+    def _expire(self, now: float) -> None:
+        while self._recent and self._recent[0] <= now - RATE_WINDOW:
+            self._recent.popleft()
+
+
+class HostState:
+    """Last records seen and link counters, fed with the board's bytes."""
+
+    def __init__(self) -> None:
+        self.decoder = app.BoardDecoder()
+        self.stats = LinkStats()
+        self.velocity: app.Velocity | None = None
+        self.attitude: app.Attitude | None = None
+        self.params: app.ParamsRecord | None = None
+        self.query: ParamQuery | None = None
+        self._errors_at_start = 0
+        self._outbox = bytearray()
+
+    def feed(self, data: bytes, now: float) -> list[app.BoardEvent | Outcome]:
+        """Decode board bytes; returns the events, and the outcome of a query they end."""
+        self.stats.bytes_in += len(data)
+        events: list[app.BoardEvent | Outcome] = []
+        for event in self.decoder.feed(data):
+            events.append(event)
+            outcome = self._apply(event, now)
+            if outcome is not None:
+                events.append(outcome)
+        return events
+
+    def sent(self, data: bytes) -> None:
+        self.stats.bytes_out += len(data)
+
+    def start_query(self, query: ParamQuery, now: float) -> None:
+        """Begin a parameter read or set; its bytes wait in the outbox."""
+        self.query = query
+        self._errors_at_start = self.stats.errors
+        self._outbox += query.start(now)
+
+    def tick(self, now: float) -> Outcome | None:
+        """Let time pass: a query may resend (into the outbox) or fail."""
+        if self.query is None:
+            return None
+        data, outcome = self.query.on_time(now)
+        return self._step(data, outcome)
+
+    def take_outbox(self) -> bytes:
+        """Bytes the state wants sent."""
+        data = bytes(self._outbox)
+        self._outbox.clear()
+        return data
+
+    def _step(self, data: bytes, outcome: Outcome | None) -> Outcome | None:
+        self._outbox += data
+        if outcome is not None:
+            self.query = None
+            garbled = self.stats.errors - self._errors_at_start
+            if isinstance(outcome, QueryFailed) and garbled:
+                outcome = QueryFailed(
+                    f"{outcome.text} ({garbled} garbled records or bytes "
+                    f"came meanwhile: the link is noisy)"
+                )
+        return outcome
+
+    def reset_decoder(self) -> None:
+        """Forget a partial record (after the link was lost)."""
+        self.decoder = app.BoardDecoder()
+
+    def _apply(self, event: app.BoardEvent, now: float) -> Outcome | None:
+        if isinstance(event, app.ERRORS):
+            self.stats.count_error(now, len(event.raw))
+            if self.query is not None and event.raw.startswith(b"{C"):
+                return self._step(*self.query.on_garbled(now))
+            return None
+        self.stats.count_record(now)
+        if isinstance(event, app.Velocity):
+            self.velocity = event
+        elif isinstance(event, app.Attitude):
+            self.attitude = event
+        elif isinstance(event, app.ParamsRecord):
+            self.params = event
+            if self.query is not None:
+                return self._step(*self.query.on_params(event.values, now))
+        return None

@@ -1,0 +1,53 @@
+"""Command-line tokens for `appmode send`: letters, frames, escaped bytes and waits."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from appmode.errors import AppmodeError
+from appmode.protocol import app
+from appmode.protocol.directions import LETTERS, PAGE_LETTERS, STOP_LETTER
+from appmode.protocol.escaping import unescape
+
+SINGLE = LETTERS + "".join(PAGE_LETTERS) + STOP_LETTER
+HELP = (
+    "tokens are letters (A–H drive, I J K pages, Z stop; 'JAZ' sends three), frames "
+    "({Q:P}, {Q:W}, {0:800}), escaped bytes (\\x01) and waits (wait:0.5)"
+)
+
+
+@dataclass(frozen=True, slots=True)
+class Wait:
+    seconds: float
+
+
+def parse_token(token: str, raw: bool = False) -> bytes | Wait:
+    """The bytes a token sends, or a Wait; AppmodeError names the token and the fix.
+
+    Frames are checked as the board would decode them, unless `raw` is set.
+    """
+    if token.startswith("wait:"):
+        try:
+            seconds = float(token[5:])
+        except ValueError:
+            seconds = -1.0
+        if not 0 <= seconds <= 3600:
+            raise AppmodeError(f"token {token!r}: wait takes seconds, e.g. wait:0.5")
+        return Wait(seconds)
+    try:
+        data = unescape(token)
+    except ValueError as exc:
+        raise AppmodeError(f"token {token!r}: {exc}") from None
+    if raw:
+        return data
+    if token.startswith("{"):
+        events = app.HostDecoder().feed(data)
+        if len(events) != 1 or len(events[0].raw) != len(data):
+            raise AppmodeError(f"token {token!r} is not one frame; {HELP}")
+        event = events[0]
+        if isinstance(event, app.BadFrame):
+            raise AppmodeError(f"token {token!r}: {event.reason} (--raw sends it anyway)")
+        return data
+    if "\\" in token or (token and all(c in SINGLE for c in token)):
+        return data
+    raise AppmodeError(f"token {token!r} is not understood: {HELP}")

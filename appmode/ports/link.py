@@ -1,0 +1,90 @@
+"""Open any board by URL (design.md): a device path, pyserial's URLs, or `sim://`.
+
+| URL | what |
+|---|---|
+| `/dev/ttyUSB0`, `COM3`, `/dev/rfcomm0`, `/dev/pts/4` | a serial port, 9600 8N1 unless `?baud=N` |
+| `socket://HOST:PORT`, `rfc2217://HOST:PORT`, `loop://` | pyserial's own handlers |
+| `sim://?drive=…&flash=…&pace=…` | the simulated board in-process |
+
+Every failure to open becomes one AppmodeError that says what to do.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+from urllib.parse import parse_qs
+
+import serial
+
+from appmode.errors import AppmodeError
+
+if "appmode.ports" not in serial.protocol_handler_packages:
+    serial.protocol_handler_packages.append("appmode.ports")  # sim:// (protocol_sim.py)
+
+BAUD = 9600
+SCHEMES = ("sim", "socket", "rfc2217", "loop")
+URL_HELP = (
+    "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
+    "rfc2217://HOST:PORT, loop:// or sim://"
+)
+
+
+def is_simulated(url: str) -> bool:
+    return url.lower().startswith("sim://")
+
+
+def open_link(url: str, timeout: float | None = 0.05) -> serial.SerialBase:
+    """An open pyserial port for `url`, at 9600 8N1 unless the URL says otherwise."""
+    if "://" in url:
+        scheme = url.split("://", 1)[0].lower()
+        if scheme not in SCHEMES:
+            raise AppmodeError(f"unknown URL scheme {scheme + '://'!r} in {url!r}: {URL_HELP}")
+        try:
+            return serial.serial_for_url(url, baudrate=BAUD, timeout=timeout)
+        except (serial.SerialException, ValueError, OSError) as exc:
+            raise AppmodeError(explain_open_error(url, exc)) from None
+    path, baud = parse_device(url)
+    try:
+        return serial.Serial(path, baudrate=baud, timeout=timeout, exclusive=os.name == "posix")
+    except (serial.SerialException, ValueError, OSError) as exc:
+        raise AppmodeError(explain_open_error(path, exc)) from None
+
+
+def parse_device(url: str) -> tuple[str, int]:
+    path, _, query = url.partition("?")
+    if not path:
+        raise AppmodeError(f"empty port name in {url!r}: {URL_HELP}")
+    baud = BAUD
+    for name, values in parse_qs(query, keep_blank_values=True).items():
+        if name != "baud":
+            raise AppmodeError(f"unknown option {name!r} in {url!r}: only ?baud=N is known")
+        if not values[-1].isdigit() or int(values[-1]) == 0:
+            raise AppmodeError(f"bad baud rate {values[-1]!r} in {url!r}: use e.g. ?baud=9600")
+        baud = int(values[-1])
+    return path, baud
+
+
+def explain_open_error(where: str, exc: Exception) -> str:
+    code = getattr(exc, "errno", None)
+    text = str(exc)
+    if code == errno.ENOENT or "No such file" in text:
+        return (
+            f"no such port {where}: check the adapter is plugged in (and paired, for "
+            f"Bluetooth); list ports with: python -m serial.tools.list_ports"
+        )
+    if code == errno.EACCES or "Permission denied" in text:
+        return (
+            f"permission denied opening {where}: add yourself to the dialout group "
+            f"(sudo usermod -aG dialout $USER) and log in again"
+        )
+    if code == errno.EBUSY or "exclusively lock" in text or "busy" in text.lower():
+        return f"{where} is busy: another program has it open; close that program and retry"
+    if "Connection refused" in text:
+        return (
+            f"nothing is listening at {where}: start the board (appmode board --listen "
+            f"HOST:PORT) or check the address"
+        )
+    if "Name or service not known" in text or "nodename nor servname" in text:
+        return f"unknown host in {where}: check the address"
+    return f"cannot open {where}: {text}"

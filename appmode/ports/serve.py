@@ -1,0 +1,424 @@
+"""`appmode board`: serve the simulated board on a pseudo-terminal, TCP, or a real port.
+
+One thread, one selector. The board keeps running (and keeps its state) whatever the
+client does: a pty's other end closing, a TCP client leaving, nobody listening.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import pty
+import selectors
+import socket
+import sys
+import time
+import tty
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+
+import serial
+
+from appmode.board.firmware import Board
+from appmode.board.store import open_store
+from appmode.errors import AppmodeError
+from appmode.line.wire import Tap, Wire
+from appmode.ports.link import BAUD, explain_open_error, parse_device
+from appmode.protocol.params import DriveType
+from appmode.protocol.transcript import Recorder
+
+Log = Callable[[str], None]
+OUTBOX = 4096
+RETRY_WRITE = 0.002
+"""Seconds before writing again what the OS would not take."""
+INPUT_BACKLOG = 256
+"""Bytes received but not yet on the simulated line beyond which the server stops reading:
+the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
+by a real line."""
+
+
+class Outbox:
+    """Bytes the OS would not take yet (a full pty or socket buffer): kept, in order, and
+    retried; beyond OUTBOX bytes the oldest are dropped, as when nobody reads a UART."""
+
+    def __init__(self) -> None:
+        self._data = bytearray()
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def clear(self) -> None:
+        self._data.clear()
+
+    def send(self, data: bytes, write: Callable[[bytes], int]) -> None:
+        self._data += data
+        if len(self._data) > OUTBOX:
+            del self._data[: len(self._data) - OUTBOX]
+        while self._data:
+            try:
+                written = write(bytes(self._data))
+            except (BlockingIOError, InterruptedError):
+                return
+            del self._data[:written]
+
+
+class PtyEndpoint:
+    """A new pseudo-terminal; clients open its slave path like a serial port.
+
+    The server holds the slave open itself, so the master never sees EIO when a client
+    closes, and the path stays the same for the next client.
+    """
+
+    def __init__(self, sel: selectors.BaseSelector, log: Log, link: str | None = None) -> None:
+        self._master, self._slave = pty.openpty()
+        tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
+        os.set_blocking(self._master, False)
+        self._out = Outbox()
+        self.url = os.ttyname(self._slave)
+        self._link = link
+        if link is not None:
+            _symlink(self.url, link)
+            log(f"{link} -> {self.url}")
+        self._sel = sel
+        sel.register(self._master, selectors.EVENT_READ, self._read)
+
+    def pause(self, paused: bool) -> None:
+        """Stop (or go on) reading: what is not read waits in the pty."""
+        if paused:
+            self._sel.unregister(self._master)
+        else:
+            self._sel.register(self._master, selectors.EVENT_READ, self._read)
+
+    def _read(self, size: int) -> bytes:
+        try:
+            return os.read(self._master, size)
+        except (BlockingIOError, InterruptedError):
+            return b""
+
+    def write(self, data: bytes) -> None:
+        self._out.send(data, lambda chunk: os.write(self._master, chunk))
+
+    @property
+    def backlog(self) -> int:
+        return len(self._out)
+
+    def close(self) -> None:
+        link = self._link
+        if link is not None and os.path.islink(link) and os.readlink(link) == self.url:
+            os.unlink(link)
+        os.close(self._master)
+        os.close(self._slave)
+
+
+def _symlink(target: str, link: str) -> None:
+    """Point `link` at `target`, replacing an older link atomically (not a real file)."""
+    if os.path.exists(link) and not os.path.islink(link):
+        raise AppmodeError(f"--link {link}: a file is already there; choose another path")
+    tmp = f"{link}.{os.getpid()}.tmp"
+    try:
+        os.symlink(target, tmp)
+        os.replace(tmp, link)
+    except OSError as exc:
+        raise AppmodeError(f"--link {link}: cannot create the link: {exc.strerror}") from None
+
+
+class TcpEndpoint:
+    """A TCP listener serving one client at a time; others are refused while it stays."""
+
+    def __init__(self, sel: selectors.BaseSelector, log: Log, host: str, port: int) -> None:
+        self._sel = sel
+        self._log = log
+        try:
+            self._listener = socket.create_server((host, port))
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                raise AppmodeError(
+                    f"TCP port {host}:{port} is already in use: pick another with --listen "
+                    f"HOST:PORT (port 0 picks a free one), or stop the program using it"
+                ) from None
+            raise AppmodeError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
+        self._listener.setblocking(False)
+        bound_host, bound_port = self._listener.getsockname()[:2]
+        self.url = f"socket://{bound_host}:{bound_port}"
+        self._client: socket.socket | None = None
+        self._out = Outbox()
+        self._paused = False
+        sel.register(self._listener, selectors.EVENT_READ, self._accept)
+
+    def pause(self, paused: bool) -> None:
+        """Stop (or go on) reading the client: what is not read waits in the socket."""
+        self._paused = paused
+        if self._client is not None:
+            if paused:
+                self._sel.unregister(self._client)
+            else:
+                self._sel.register(self._client, selectors.EVENT_READ, self._read)
+
+    def _accept(self, size: int) -> bytes:
+        try:
+            conn, peer = self._listener.accept()
+        except (BlockingIOError, InterruptedError):
+            return b""
+        if self._client is not None:
+            self._log(f"refused a client from {peer[0]}:{peer[1]}: one client at a time")
+            conn.close()
+            return b""
+        conn.setblocking(False)
+        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._client = conn
+        if not self._paused:
+            self._sel.register(conn, selectors.EVENT_READ, self._read)
+        self._log(f"client connected from {peer[0]}:{peer[1]}")
+        return b""
+
+    def _read(self, size: int) -> bytes:
+        assert self._client is not None
+        try:
+            data = self._client.recv(size)
+        except (BlockingIOError, InterruptedError):
+            return b""
+        except OSError as exc:
+            self._drop(f"client connection lost ({exc.strerror})")
+            return b""
+        if not data:
+            self._drop("client disconnected")
+        return data
+
+    def write(self, data: bytes) -> None:
+        if self._client is None:
+            return
+        client = self._client
+        try:
+            self._out.send(data, client.send)
+        except OSError as exc:
+            self._drop(f"client connection lost ({exc.strerror})")
+
+    @property
+    def backlog(self) -> int:
+        return len(self._out)
+
+    def _drop(self, why: str) -> None:
+        self._out.clear()
+        if self._client is not None:
+            if not self._paused:
+                self._sel.unregister(self._client)
+            self._client.close()
+            self._client = None
+            self._log(f"{why}; waiting for the next client")
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+        self._listener.close()
+
+
+class SerialEndpoint:
+    """A real serial port (a USB-UART, with a Bluetooth module for the phone app)."""
+
+    def __init__(self, sel: selectors.BaseSelector, log: Log, device: str) -> None:
+        path, baud = parse_device(device)
+        try:
+            self._port = serial.Serial(path, baudrate=baud, timeout=0, exclusive=True)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise AppmodeError(explain_open_error(path, exc)) from None
+        self.url = path
+        self.baud = baud
+        self._sel = sel
+        sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
+
+    def pause(self, paused: bool) -> None:
+        """Stop (or go on) reading: what is not read waits in the OS buffer."""
+        if paused:
+            self._sel.unregister(self._port.fileno())
+        else:
+            self._sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
+
+    def _read(self, size: int) -> bytes:
+        data: bytes = self._port.read(max(1, min(size, self._port.in_waiting)))
+        return data
+
+    def write(self, data: bytes) -> None:
+        if data:
+            self._port.write(data)
+
+    backlog = 0  # pyserial's write blocks until the OS has the bytes
+
+    def close(self) -> None:
+        self._port.close()
+
+
+Endpoint = PtyEndpoint | TcpEndpoint | SerialEndpoint
+
+
+def parse_listen(text: str) -> tuple[str, int]:
+    """`PORT` or `HOST:PORT` (host 127.0.0.1 by default)."""
+    host, _, port = text.rpartition(":")
+    if not port.isdigit() or int(port) > 65535:
+        raise AppmodeError(f"--listen {text!r}: expected HOST:PORT or PORT, e.g. 127.0.0.1:5000")
+    return host.strip("[]") or "127.0.0.1", int(port)
+
+
+@dataclass
+class Served:
+    """One board being served: its endpoint and its wire."""
+
+    endpoint: Endpoint
+    wire: Wire
+    paused: bool = False
+    last_write: float = float("-inf")
+
+    def wakeup(self) -> float:
+        """When this board next has something to do. Paced output is written a record at a
+        time, when its last byte would have arrived on a real line: never early, and one
+        wake-up per record rather than one per byte."""
+        wire = self.wire
+        times = [wire.board.next_slot()]
+        if (due := wire.to_board.next_due()) is not None:
+            times.append(due)
+        if (due := wire.to_host.burst_due()) is not None:
+            times.append(due)
+        if self.endpoint.backlog:
+            times.append(self.last_write + RETRY_WRITE)
+        return min(times)
+
+    def pump(self, now: float) -> None:
+        out = self.wire.pump(now)
+        if out or self.endpoint.backlog:
+            self.endpoint.write(out)
+            self.last_write = now
+
+    def receive(self, data: bytes, now: float) -> None:
+        self.pump(now)  # what was due before these bytes came
+        self.wire.write(data, now)
+
+    def throttle(self) -> None:
+        """Read no more while INPUT_BACKLOG bytes wait for the simulated line."""
+        full = len(self.wire.to_board) >= INPUT_BACKLOG
+        if full != self.paused:
+            self.endpoint.pause(full)
+            self.paused = full
+
+
+def serve(
+    make_endpoints: list[Callable[[selectors.BaseSelector, Log], Endpoint]],
+    boards: list[Board],
+    *,
+    pace: bool,
+    log: Log,
+    announce: Callable[[str], None],
+    tap: Tap | None = None,
+    banner: str = "",
+) -> None:
+    """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line."""
+    sel = selectors.DefaultSelector()
+    served: list[Served] = []
+    by_endpoint: dict[int, Served] = {}
+    try:
+        for make, board in zip(make_endpoints, boards, strict=True):
+            endpoint = make(sel, log)
+            baud = getattr(endpoint, "baud", BAUD)
+            one = Served(endpoint, Wire(board, baud if pace else None, tap))
+            served.append(one)
+            by_endpoint[id(endpoint)] = one
+            announce(f"port: {endpoint.url}")
+        if banner:
+            log(banner)
+        origin = time.monotonic()
+        while True:
+            now = time.monotonic() - origin
+            wake = float("inf")
+            for one in served:
+                if one.wakeup() <= now:
+                    one.pump(now)
+                for note in one.wire.board.take_notes():
+                    log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
+                one.throttle()
+                wake = min(wake, one.wakeup())
+            timeout = max(0.0, wake - (time.monotonic() - origin))
+            for key, _ in sel.select(timeout):
+                reader = key.data
+                one = by_endpoint[id(reader.__self__)]
+                data = reader(max(1, INPUT_BACKLOG - len(one.wire.to_board)))
+                if data:
+                    one.receive(data, time.monotonic() - origin)
+    finally:
+        for one in served:
+            one.endpoint.close()
+        sel.close()
+
+
+def run_board(
+    *,
+    use_pty: bool,
+    link: str | None,
+    listen: str | None,
+    device: str | None,
+    drive: str | None,
+    flash: str | None,
+    pace: bool,
+    record: str | None,
+    quiet: bool,
+    count: int = 1,
+) -> int:
+    """The `appmode board` command: build the board(s) and serve until interrupted."""
+
+    def log(text: str) -> None:
+        if not quiet:
+            print(f"board: {text}", file=sys.stderr, flush=True)
+
+    def announce(text: str) -> None:
+        print(text, flush=True)
+
+    if count < 1:
+        raise AppmodeError("--count must be at least 1")
+    if count > 1 and (listen or device or link or flash or record):
+        raise AppmodeError(
+            "--count serves several boards on ptys: it cannot be combined "
+            "with --listen, --port, --link, --flash or --record"
+        )
+    make: Callable[[selectors.BaseSelector, Log], Endpoint]
+    if listen is not None:
+        host, port = parse_listen(listen)
+        make = partial(_tcp, host=host, port=port)
+    elif device is not None:
+        make = partial(_serial, device=device)
+    else:
+        make = partial(_pty, link=link)
+    kind = DriveType.from_cli_name(drive) if drive else None
+    boards = [Board(open_store(flash), drive=kind) for _ in range(count)]
+    banner = (
+        f"simulated board{'s' if count > 1 else ''}, {boards[0].drive_type.cli_name} drive, "
+        f"flash {flash or 'in memory'}, {'paced at the line rate' if pace else 'not paced'}"
+    )
+    recorder = Recorder.create(record) if record else None
+    try:
+        serve(
+            [make] * count,
+            boards,
+            pace=pace,
+            log=log,
+            announce=announce,
+            tap=recorder,
+            banner=banner,
+        )
+    except KeyboardInterrupt:
+        log("stopped")
+    finally:
+        for board in boards:
+            board.store.close()
+        if recorder is not None:
+            recorder.close()
+    return 0
+
+
+def _pty(sel: selectors.BaseSelector, log: Log, *, link: str | None) -> Endpoint:
+    return PtyEndpoint(sel, log, link)
+
+
+def _tcp(sel: selectors.BaseSelector, log: Log, *, host: str, port: int) -> Endpoint:
+    return TcpEndpoint(sel, log, host, port)
+
+
+def _serial(sel: selectors.BaseSelector, log: Log, *, device: str) -> Endpoint:
+    return SerialEndpoint(sel, log, device)

@@ -1,0 +1,215 @@
+"""`sim://`: the simulated board in-process, as a pyserial port.
+
+`sim://?drive=mecanum&flash=board.json&pace=0` — options: `drive` (omni, mecanum, diff,
+diff-gyro; default: what the flash holds, else omni), `flash` (a JSON parameter file;
+default: in memory), `pace` (1: bytes move at the real 9600-bps rate, the default; 0:
+instantly), `baud`, `faults` (a faulty link both ways, see appmode.faults). There is no
+thread: the board runs whenever the port is used.
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+import serial
+from serial import SerialBase, SerialException
+
+from appmode.board.firmware import Board
+from appmode.board.store import open_store
+from appmode.errors import AppmodeError
+from appmode.line.faults import FaultSpec, FaultyLine
+from appmode.line.wire import Wire
+from appmode.protocol.params import DriveType
+
+OPTIONS = ("drive", "flash", "pace", "baud", "faults")
+WRITE_BUFFER = 4096
+"""Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
+USAGE = (
+    "sim://[?drive=omni|mecanum|diff|diff-gyro][&flash=FILE][&pace=1|0][&baud=9600]"
+    "[&faults=drop:0.01,corrupt:0.01,…]"
+)
+
+
+def parse_sim_url(url: str) -> dict[str, str]:
+    """The options of a sim:// URL; SerialException says what is wrong."""
+    parts = urlsplit(url)
+    if parts.scheme != "sim" or parts.netloc or parts.path not in ("", "/"):
+        raise SerialException(f"expected {USAGE}, not {url!r}")
+    options: dict[str, str] = {}
+    for name, values in parse_qs(parts.query, keep_blank_values=True).items():
+        if name not in OPTIONS:
+            raise SerialException(f"unknown sim:// option {name!r}: use {', '.join(OPTIONS)}")
+        options[name] = values[-1]
+    return options
+
+
+def sim_directives(url: str) -> tuple[str, ...]:
+    """Transcript directives that describe a sim:// board, for replaying its sessions."""
+    if not url.lower().startswith("sim://"):
+        return ()
+    drive = parse_sim_url(url).get("drive")
+    return (f"board drive={drive}",) if drive else ()
+
+
+def _flag(name: str, text: str) -> bool:
+    if text.lower() in ("1", "true", "yes", "on"):
+        return True
+    if text.lower() in ("0", "false", "no", "off"):
+        return False
+    raise SerialException(f"sim:// option {name}={text!r}: use 1 or 0")
+
+
+class SimSerial(SerialBase):  # type: ignore[misc]
+    """A pyserial port with the simulated board at the other end."""
+
+    is_open: bool
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self._wire: Wire | None = None
+        self._faults: tuple[FaultyLine, FaultyLine] | None = None
+        self._rx = bytearray()
+        self._origin = 0.0
+        self.board: Board | None = None
+        super().__init__(*args, **kwargs)
+
+    def open(self) -> None:
+        if self.is_open:
+            raise SerialException("port is already open")
+        if self._port is None:
+            raise SerialException("port must be configured before it can be used")
+        options = parse_sim_url(self._port)
+        try:
+            drive = DriveType.from_cli_name(options["drive"]) if "drive" in options else None
+        except ValueError as exc:
+            raise SerialException(f"sim:// option drive: {exc}") from None
+        if "baud" in options:
+            if not options["baud"].isdigit() or int(options["baud"]) <= 0:
+                raise SerialException(f"sim:// option baud={options['baud']!r}: use a number")
+            self._baudrate = int(options["baud"])
+        pace = _flag("pace", options.get("pace", "1"))
+        try:
+            store = open_store(options.get("flash"))
+        except AppmodeError as exc:
+            raise SerialException(str(exc)) from None
+        try:
+            spec = FaultSpec.parse(options.get("faults", ""))
+        except ValueError as exc:
+            raise SerialException(f"sim:// option faults: {exc}") from None
+        rng = random.Random(spec.seed)
+        self._faults = (FaultyLine(spec, rng), FaultyLine(spec, rng)) if spec.active else None
+        self.board = Board(store, drive=drive)
+        self._wire = Wire(self.board, self._baudrate if pace else None)
+        self._rx.clear()
+        self._origin = time.monotonic()
+        self.is_open = True
+
+    def close(self) -> None:
+        self.is_open = False
+        self._wire = None
+        if self.board is not None:
+            self.board.store.close()
+
+    def _reconfigure_port(self, force_update: bool = False) -> None:
+        """Settings change nothing in the simulation (the line rate is fixed at open)."""
+
+    def _now(self) -> float:
+        return time.monotonic() - self._origin
+
+    def _pump(self) -> Wire:
+        if not self.is_open or self._wire is None:
+            raise serial.PortNotOpenError()
+        now = self._now()
+        if self._faults is None:
+            self._rx += self._wire.pump(now)
+            return self._wire
+        to_board, to_host = self._faults
+        self._wire.write(to_board.take(now), now)
+        to_host.push(self._wire.pump(now), now)
+        self._rx += to_host.take(now)
+        return self._wire
+
+    def _next_wakeup(self, wire: Wire) -> float:
+        times = [wire.next_wakeup()]
+        if self._faults is not None:
+            times += [t for line in self._faults if (t := line.next_due()) is not None]
+        return min(times)
+
+    @property
+    def in_waiting(self) -> int:
+        self._pump()
+        return len(self._rx)
+
+    @property
+    def out_waiting(self) -> int:
+        return len(self._pump().to_board)
+
+    def read(self, size: int = 1) -> bytes:
+        wire = self._pump()
+        deadline = None if self._timeout is None else self._now() + self._timeout
+        while len(self._rx) < size:
+            now = self._now()
+            if deadline is not None and now >= deadline:
+                break
+            wake = self._next_wakeup(wire)
+            if deadline is not None:
+                wake = min(wake, deadline)
+            time.sleep(max(0.0, wake - now))
+            wire = self._pump()
+        data = bytes(self._rx[:size])
+        del self._rx[:size]
+        return data
+
+    def write(self, data: bytes) -> int:
+        wire = self._pump()
+        payload = serial.to_bytes(data)
+        while len(wire.to_board) > WRITE_BUFFER:  # the line is slower than the writer
+            time.sleep(max(0.0, wire.next_wakeup() - self._now()))
+            wire = self._pump()
+        if self._faults is None:
+            wire.write(payload, self._now())
+        else:
+            self._faults[0].push(payload, self._now())
+        return len(payload)
+
+    def flush(self) -> None:
+        wire = self._pump()
+        while wire.to_board.next_due() is not None or (
+            self._faults is not None and self._faults[0].next_due() is not None
+        ):
+            time.sleep(max(0.0, self._next_wakeup(wire) - self._now()))
+            wire = self._pump()
+
+    def reset_input_buffer(self) -> None:
+        self._pump()
+        self._rx.clear()
+
+    def reset_output_buffer(self) -> None:
+        """Bytes already on the simulated line cannot be called back."""
+
+    def _update_dtr_state(self) -> None:
+        """No modem lines."""
+
+    def _update_rts_state(self) -> None:
+        """No modem lines."""
+
+    def _update_break_state(self) -> None:
+        """No break."""
+
+    @property
+    def cts(self) -> bool:
+        return True
+
+    @property
+    def dsr(self) -> bool:
+        return True
+
+    @property
+    def ri(self) -> bool:
+        return False
+
+    @property
+    def cd(self) -> bool:
+        return True

@@ -1,0 +1,173 @@
+"""The nine board parameters and the system-mode bits (docs/protocol.md §5, §6): one table.
+
+The codec, the board model, the host, the console and the docs all read these tables;
+nothing else in appmode spells out a parameter's name, range or default.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from enum import IntEnum
+
+U16 = 0xFFFF
+U32 = 0xFFFF_FFFF
+
+
+@dataclass(frozen=True, slots=True)
+class Param:
+    """One parameter of the `{n:v}` / `{C…}$` set."""
+
+    index: int
+    name: str
+    label: str
+    maximum: int
+    default: int
+    minimum: int = 0
+
+    @property
+    def range_text(self) -> str:
+        return f"{self.minimum}–{self.maximum}"
+
+
+PARAMS: tuple[Param, ...] = (
+    Param(0, "max_speed", "max speed (velocity unit)", U16, 500),
+    Param(1, "max_position", "position-mode position limit", U16, 10000),
+    Param(2, "position_kp", "position Kp", U32, 20),
+    Param(3, "position_ki", "position Ki", U32, 0),
+    Param(4, "position_kd", "position Kd", U32, 10),
+    Param(5, "velocity_kp", "velocity Kp", U32, 10),
+    Param(6, "velocity_ki", "velocity Ki", U32, 10),
+    Param(7, "gyro_compensation", "gyro compensation (0.00001)", U32, 0),
+    Param(8, "system_mode", "system mode bits", U16, 0),
+)
+PARAM_COUNT = len(PARAMS)
+BY_NAME: dict[str, Param] = {p.name: p for p in PARAMS}
+DEFAULTS: tuple[int, ...] = tuple(p.default for p in PARAMS)
+MAX_SPEED = BY_NAME["max_speed"].index
+SYSTEM_MODE = BY_NAME["system_mode"].index
+
+
+class DriveType(IntEnum):
+    """System-mode bits 0–2."""
+
+    OMNI = 0
+    MECANUM = 1
+    DIFF = 2
+    DIFF_GYRO = 3
+
+    @property
+    def cli_name(self) -> str:
+        return _DRIVE_CLI_NAMES[self]
+
+    @property
+    def differential(self) -> bool:
+        return self in (DriveType.DIFF, DriveType.DIFF_GYRO)
+
+    @classmethod
+    def from_cli_name(cls, name: str) -> DriveType:
+        for drive, text in _DRIVE_CLI_NAMES.items():
+            if text == name:
+                return drive
+        choices = ", ".join(_DRIVE_CLI_NAMES.values())
+        raise ValueError(f"unknown drive type {name!r}: choose one of {choices}")
+
+
+_DRIVE_CLI_NAMES = {
+    DriveType.OMNI: "omni",
+    DriveType.MECANUM: "mecanum",
+    DriveType.DIFF: "diff",
+    DriveType.DIFF_GYRO: "diff-gyro",
+}
+DRIVE_NAMES: tuple[str, ...] = tuple(_DRIVE_CLI_NAMES.values())
+DRIVE_MASK = 0b111
+
+
+@dataclass(frozen=True, slots=True)
+class ModeBit:
+    """One named bit (or field) of system_mode."""
+
+    bit: int
+    name: str
+    meaning: str
+    saved: bool = True
+
+
+MODE_BITS: tuple[ModeBit, ...] = (
+    ModeBit(3, "gyro_calibration", "gyro calibration at power-up"),
+    ModeBit(4, "heading_correction", "gyro heading correction while x and y are 0"),
+    ModeBit(6, "encoder_report", "encoder report on UART2", saved=False),
+    ModeBit(7, "app_mode", "command mode: 0 control, 1 APP", saved=False),
+    ModeBit(8, "motor_reverse", "motor reverse"),
+    ModeBit(9, "encoder_reverse", "encoder reverse"),
+    ModeBit(10, "steering_reverse", "steering reverse"),
+    ModeBit(11, "gyro_reverse", "gyro reverse"),
+)
+MODE_BIT: dict[str, int] = {b.name: 1 << b.bit for b in MODE_BITS}
+UNSAVED_MASK = sum(1 << b.bit for b in MODE_BITS if not b.saved)
+
+
+def drive_type(system_mode: int) -> DriveType | None:
+    """The drive type in bits 0–2, or None when the field holds an invalid value (4–7)."""
+    value = system_mode & DRIVE_MASK
+    return DriveType(value) if value in DriveType._value2member_map_ else None
+
+
+def value_error(index: int, value: int) -> str | None:
+    """Why `value` cannot be parameter `index`, or None when it can."""
+    if not 0 <= index < PARAM_COUNT:
+        return f"no parameter {index}: indices are 0–{PARAM_COUNT - 1}"
+    param = PARAMS[index]
+    if not param.minimum <= value <= param.maximum:
+        return f"{param.name} (parameter {index}) must be in {param.range_text}, not {value}"
+    if index == SYSTEM_MODE and drive_type(value) is None:
+        return (
+            f"system_mode {value} has drive type {value & DRIVE_MASK} in bits 0–2; "
+            f"valid drive types are 0–3"
+        )
+    return None
+
+
+def check_value(index: int, value: int) -> None:
+    """Raise ValueError naming the parameter and its range when `value` is not allowed."""
+    error = value_error(index, value)
+    if error is not None:
+        raise ValueError(error)
+
+
+def lookup(key: str | int) -> Param:
+    """A parameter by name or index (as text or int); ValueError lists the valid names."""
+    if isinstance(key, int) or key.isdigit():
+        index = int(key)
+        if 0 <= index < PARAM_COUNT:
+            return PARAMS[index]
+    elif key in BY_NAME:
+        return BY_NAME[key]
+    names = ", ".join(p.name for p in PARAMS)
+    raise ValueError(f"unknown parameter {key!r}: use 0–{PARAM_COUNT - 1} or one of {names}")
+
+
+_BOUNDS = tuple((p.minimum, p.maximum) for p in PARAMS)
+
+
+def values_error(values: Sequence[int]) -> str | None:
+    """Why `values` is not a valid set of the nine parameters, or None."""
+    if len(values) != PARAM_COUNT:
+        return f"expected {PARAM_COUNT} parameters, got {len(values)}"
+    # the common case, quickly (every C record a host decodes comes through here)
+    if all(lo <= v <= hi for v, (lo, hi) in zip(values, _BOUNDS, strict=True)) and (
+        values[SYSTEM_MODE] & DRIVE_MASK
+    ) <= max(DriveType):
+        return None
+    for index, value in enumerate(values):
+        error = value_error(index, value)
+        if error is not None:
+            return error
+    return None
+
+
+def saved_form(values: Sequence[int]) -> tuple[int, ...]:
+    """The parameters as the board saves them: system_mode's unsaved bits cleared."""
+    out = list(values)
+    out[SYSTEM_MODE] &= ~UNSAVED_MASK
+    return tuple(out)

@@ -1,0 +1,132 @@
+"""Views of decoded events: JSON objects for machines, one-line text for people."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from typing import Any
+
+from appmode.protocol import app as p
+from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
+from appmode.protocol.escaping import escape
+
+
+def to_json(event: p.Event) -> dict[str, Any]:
+    """One JSON-ready object: `kind`, the integer values, and `raw` (escaped bytes)."""
+    body: dict[str, Any]
+    if isinstance(event, p.Velocity):
+        body = {"kind": "velocity", "x": event.x, "y": event.y, "z": event.z, "extra": event.extra}
+    elif isinstance(event, p.Attitude):
+        body = {
+            "kind": "attitude",
+            "pitch": event.pitch,
+            "roll": event.roll,
+            "yaw": event.yaw,
+            "battery": event.battery,
+        }
+    elif isinstance(event, p.ParamsRecord):
+        body = {"kind": "params", **event.as_dict()}
+    elif isinstance(event, p.OtherRecord):
+        body = {"kind": "record", "letter": event.letter, "values": list(event.values)}
+    elif isinstance(event, p.Move):
+        body = {
+            "kind": "move",
+            "direction": event.direction,
+            "letter": event.letter,
+            "numeric": event.numeric,
+        }
+    elif isinstance(event, p.Stop):
+        body = {"kind": "stop"}
+    elif isinstance(event, p.SwitchPage):
+        body = {
+            "kind": "page",
+            "letter": event.letter,
+            "page": PAGE_LETTERS[event.letter].value,
+            "mode": PAGE_NAMES[event.letter],
+        }
+    elif isinstance(event, (p.ReadParams, p.SaveParams)):
+        kind = "read_params" if isinstance(event, p.ReadParams) else "save_params"
+        body = {"kind": kind}
+        if event.warning is not None:
+            body["warning"] = event.warning
+    elif isinstance(event, p.SetParam):
+        body = {"kind": "set_param", "index": event.index, "name": event.name, "value": event.value}
+    elif isinstance(event, p.Noise):
+        body = {"kind": "noise"}
+    elif isinstance(event, p.Garbage):
+        body = {"kind": "garbage"}
+    else:
+        body = {
+            "kind": "bad_frame" if isinstance(event, p.BadFrame) else "malformed",
+            "reason": event.reason,
+        }
+    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord, p.OtherRecord)) and (
+        not event.terminated
+    ):
+        body["terminated"] = False
+    body["raw"] = escape(event.raw)
+    return body
+
+
+def describe(event: p.Event) -> str:
+    """A short human description of an event."""
+    if isinstance(event, p.Velocity):
+        return f"velocity x={event.x} y={event.y} z={event.z}"
+    if isinstance(event, p.Attitude):
+        return (
+            f"attitude pitch={event.pitch} roll={event.roll} yaw={event.yaw} "
+            f"battery={event.battery}%"
+        )
+    if isinstance(event, p.ParamsRecord):
+        return "params " + " ".join(f"{k}={v}" for k, v in event.as_dict().items())
+    if isinstance(event, p.OtherRecord):
+        return f"record {event.letter} {list(event.values)}"
+    if isinstance(event, p.Move):
+        return f"move {event.letter} (direction {event.direction})"
+    if isinstance(event, p.Stop):
+        return "stop"
+    if isinstance(event, p.SwitchPage):
+        return f"{PAGE_NAMES[event.letter]} mode, {PAGE_LETTERS[event.letter].value} page"
+    if isinstance(event, (p.ReadParams, p.SaveParams)):
+        text = "read parameters" if isinstance(event, p.ReadParams) else "save parameters"
+        return text if event.warning is None else f"{text} ({event.warning})"
+    if isinstance(event, p.SetParam):
+        return f"set {event.name} = {event.value}"
+    if isinstance(event, (p.BadFrame, p.Malformed)):
+        return f"error: {event.reason}"
+    return f"{len(event.raw)} undecodable byte(s)"
+
+
+def coalesce(events: Iterable[p.Event]) -> Iterator[p.Event]:
+    """Merge adjacent Noise or Garbage events into one event per run of bytes."""
+    pending: p.Noise | p.Garbage | None = None
+    for event in events:
+        if pending is not None and type(event) is type(pending):
+            pending = type(pending)(pending.raw + event.raw)
+            continue
+        if pending is not None:
+            yield pending
+            pending = None
+        if isinstance(event, (p.Noise, p.Garbage)):
+            pending = event
+        else:
+            yield event
+    if pending is not None:
+        yield pending
+
+
+def line(time: float, direction: str, raw: bytes, text: str) -> str:
+    """`  1.234 < {A0:0:0:0}$   velocity …`: one event of a session, for people."""
+    return f"{time:7.3f} {direction} {escape(raw):<34} {text}"
+
+
+def params_table(values: tuple[int, ...]) -> str:
+    """The nine parameters as an aligned table with their ranges and defaults."""
+    from appmode.protocol.params import PARAMS
+
+    rows = [f"{'n':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
+    for param, value in zip(PARAMS, values, strict=True):
+        rows.append(
+            f"{param.index:>2}  {param.name:<18} {value:>10}  "
+            f"{param.range_text:<14} {param.default:>7}"
+        )
+    return "\n".join(rows)

@@ -1,0 +1,185 @@
+"""Transcripts, format v1 (design.md): one protocol unit a line, `TIME DIR PAYLOAD`."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import TextIO
+
+from appmode.errors import AppmodeError
+from appmode.protocol import app
+from appmode.protocol.escaping import escape, unescape
+
+HEADER = "# appmode transcript v1"
+SUFFIX = ".transcript"
+
+
+class Recorder:
+    """Writes a session as it happens: each direction split into commands and records.
+
+    Call it as a tap: `recorder(direction, time, data)` with `>` for host→board bytes and
+    `<` for board→host bytes. Every line is flushed as it is written.
+    """
+
+    def __init__(self, out: TextIO, origin: float = 0.0, directives: tuple[str, ...] = ()) -> None:
+        self._out = out
+        self._owned = False  # a stream given by the caller stays open
+        self._origin = origin
+        self._decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
+            ">": app.HostDecoder(),
+            "<": app.BoardDecoder(),
+        }
+        self._last = {">": origin, "<": origin}
+        out.write(HEADER + "\n")
+        for directive in directives:
+            out.write(f"@{directive}\n")
+        out.flush()
+
+    @classmethod
+    def create(
+        cls, path: str | os.PathLike[str], origin: float = 0.0, directives: tuple[str, ...] = ()
+    ) -> Recorder:
+        try:
+            out = open(path, "w", encoding="utf-8")  # noqa: SIM115 - owned by the recorder
+        except OSError as exc:
+            raise AppmodeError(
+                f"cannot write transcript {os.fspath(path)}: {exc.strerror}"
+            ) from None
+        recorder = cls(out, origin, directives)
+        recorder._owned = True
+        return recorder
+
+    def __call__(self, direction: str, time: float, data: bytes) -> None:
+        self._last[direction] = time
+        for event in self._decoders[direction].feed(data):
+            self._line(time, direction, event.raw)
+
+    def _line(self, time: float, direction: str, raw: bytes) -> None:
+        self._out.write(f"{max(0.0, time - self._origin):.4f} {direction} {escape(raw)}\n")
+        self._out.flush()
+
+    def close(self) -> None:
+        """Write what the decoders still hold, and close the file (if it opened it)."""
+        if self._out.closed:
+            return
+        for direction, decoder in self._decoders.items():
+            for event in decoder.flush():
+                self._line(self._last[direction], direction, event.raw)
+        if self._owned:
+            self._out.close()
+
+
+# ---------------------------------------------------------------- reading
+
+DIRECTIVES = {
+    "board": "options for the board under test: @board drive=omni|mecanum|diff|diff-gyro",
+    "tolerance": "how early or late a '<' line may be matched, in seconds: @tolerance 0.3",
+    "strict": "@strict on: every record must match the next '<' line (none ignored)",
+    "align": "@align: time the '<' lines after the next one from when it is matched",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Entry:
+    """One `TIME DIR PAYLOAD` line."""
+
+    lineno: int
+    time: float
+    direction: str
+    data: bytes
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class Directive:
+    """One `@name args` line."""
+
+    lineno: int
+    name: str
+    args: tuple[str, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Transcript:
+    path: str
+    items: tuple[Entry | Directive, ...]
+    title: str = ""
+    """The first comment after the header: what the transcript checks."""
+
+    @property
+    def entries(self) -> list[Entry]:
+        return [item for item in self.items if isinstance(item, Entry)]
+
+    @property
+    def duration(self) -> float:
+        return max((e.time for e in self.entries), default=0.0)
+
+
+class TranscriptError(AppmodeError):
+    """A transcript line that cannot be read: the message gives file:line."""
+
+
+def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
+    """Read transcript text; TranscriptError names the file, the line and what is wrong."""
+    items: list[Entry | Directive] = []
+    title = ""
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        where = f"{path}:{lineno}"
+        stripped = line.strip()
+        if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
+            raise TranscriptError(
+                f"{where}: {stripped[2:]!r} is not a version this appmode reads (it reads v1)"
+            )
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            if not title and stripped != HEADER:
+                title = stripped.lstrip("# ").strip()
+            continue
+        if stripped.startswith("@"):
+            name, *args = stripped[1:].split() or [""]
+            if name not in DIRECTIVES:
+                known = ", ".join(f"@{d}" for d in DIRECTIVES)
+                raise TranscriptError(f"{where}: unknown directive @{name} (known: {known})")
+            items.append(Directive(lineno, name, tuple(args)))
+            continue
+        items.append(_entry(line.rstrip("\r\n"), lineno, where))
+    return Transcript(path, tuple(items), title)
+
+
+def _entry(line: str, lineno: int, where: str) -> Entry:
+    parts = line.split(" ", 2)
+    if len(parts) != 3 or not parts[2]:
+        raise TranscriptError(
+            f"{where}: expected 'TIME DIR PAYLOAD' (e.g. 0.050 > {{Q:P}}), got {line!r}"
+        )
+    time_text, direction, payload = parts
+    try:
+        time = float(time_text)
+    except ValueError:
+        time = -1.0
+    if not time >= 0 or not time < float("inf"):
+        raise TranscriptError(f"{where}: time {time_text!r} is not seconds >= 0")
+    if direction not in (">", "<"):
+        raise TranscriptError(
+            f"{where}: direction {direction!r} must be '>' (host to board) or '<' (board to host)"
+        )
+    try:
+        data = unescape(payload)
+    except ValueError as exc:
+        raise TranscriptError(f"{where}: {exc}") from None
+    return Entry(lineno, time, direction, data, payload)
+
+
+def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
+    """Read a transcript file; TranscriptError (file:line, with `name` in place of the
+    path if given) or AppmodeError if unreadable."""
+    name = name or os.fspath(path)
+    try:
+        with open(path, encoding="utf-8") as handle:
+            text = handle.read()
+    except UnicodeDecodeError as exc:
+        raise TranscriptError(f"{name}: not UTF-8 text (byte {exc.start})") from None
+    except OSError as exc:
+        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
+    return parse_transcript(text, name)

@@ -1,0 +1,151 @@
+"""`appmode dump` and `appmode plot`: decode a transcript, and draw its telemetry."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any, TextIO
+
+from appmode.errors import AppmodeError
+from appmode.protocol import app
+from appmode.protocol.render import describe, line, to_json
+from appmode.protocol.transcript import Transcript, read_transcript
+
+CSV_FIELDS = (
+    "t",
+    "dir",
+    "kind",
+    "x",
+    "y",
+    "z",
+    "pitch",
+    "roll",
+    "yaw",
+    "battery",
+    "max_speed",
+    "max_position",
+    "position_kp",
+    "position_ki",
+    "position_kd",
+    "velocity_kp",
+    "velocity_ki",
+    "gyro_compensation",
+    "system_mode",
+    "letter",
+    "direction",
+    "index",
+    "name",
+    "value",
+    "reason",
+    "raw",
+)
+
+
+def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event]]:
+    """(time, direction, event) for every command and record of the transcript."""
+    decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
+        ">": app.HostDecoder(),
+        "<": app.BoardDecoder(),
+    }
+    last = {">": 0.0, "<": 0.0}
+    for entry in transcript.entries:
+        last[entry.direction] = entry.time
+        for event in decoders[entry.direction].feed(entry.data):
+            yield entry.time, entry.direction, event
+    for direction, decoder in decoders.items():
+        for event in decoder.flush():
+            yield last[direction], direction, event
+
+
+def run_dump(path: str, fmt: str, out: TextIO) -> int:
+    transcript = read_transcript(path)
+    if fmt == "csv":
+        writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
+        writer.writeheader()
+    for t, direction, event in decoded(transcript):
+        if fmt == "json":
+            out.write(json.dumps({"t": t, "dir": direction, **to_json(event)}) + "\n")
+        elif fmt == "csv":
+            writer.writerow({"t": t, "dir": direction, **to_json(event)})
+        else:
+            out.write(line(t, direction, event.raw, describe(event)) + "\n")
+    return 0
+
+
+def run_plot(path: str, output: str) -> int:
+    """Velocities, attitude and battery over time, with the commands marked."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise AppmodeError("appmode plot needs matplotlib: pip install 'appmode[plot]'") from None
+    transcript = read_transcript(path)
+    series: dict[str, list[Any]] = {
+        k: [] for k in ("tA", "x", "y", "z", "tB", "pitch", "roll", "yaw", "battery")
+    }
+    commands: list[tuple[float, str]] = []
+    for t, direction, event in decoded(transcript):
+        if isinstance(event, app.Velocity):
+            series["tA"].append(t)
+            for k in ("x", "y", "z"):
+                series[k].append(getattr(event, k))
+        elif isinstance(event, app.Attitude):
+            series["tB"].append(t)
+            for k in ("pitch", "roll", "yaw", "battery"):
+                series[k].append(getattr(event, k))
+        elif direction == ">" and not isinstance(event, app.ERRORS):
+            commands.append((t, event.raw.decode("latin-1")))
+    if not series["tA"] and not series["tB"]:
+        raise AppmodeError(f"{path} has no A or B records to plot")
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(11, 8), constrained_layout=True)
+    vel, att, bat = axes
+    for k, label in (
+        ("x", "x (lateral, right +)"),
+        ("y", "y (forward +)"),
+        ("z", "z (rotation, cw +)"),
+    ):
+        vel.plot(series["tA"], series[k], label=label, drawstyle="steps-post")
+    vel.set_ylabel("velocity (board unit)")
+    for k in ("pitch", "roll", "yaw"):
+        att.plot(series["tB"], series[k], label=k, drawstyle="steps-post")
+    att.set_ylabel("degrees")
+    bat.plot(series["tB"], series["battery"], color="tab:green", drawstyle="steps-post")
+    bat.set_ylabel("battery %")
+    bat.set_ylim(0, 105)
+    bat.set_xlabel("time (s)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        for t, _ in commands:
+            ax.axvline(t, color="grey", linestyle=":", linewidth=0.8)
+    for t, text in commands:
+        vel.annotate(
+            text,
+            (t, 1.0),
+            xycoords=("data", "axes fraction"),
+            fontsize=8,
+            rotation=90,
+            va="top",
+            ha="right",
+            color="dimgrey",
+        )
+    vel.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    att.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    fig.suptitle(f"{Path(path).name} — {transcript.title or 'telemetry'}", fontsize=11)
+    directory = os.path.dirname(os.path.abspath(output))
+    fd, tmp = tempfile.mkstemp(suffix=".png", dir=directory)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=110)
+        os.replace(tmp, output)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise AppmodeError(f"cannot write {output}: {exc.strerror}") from None
+    finally:
+        plt.close(fig)
+    return 0

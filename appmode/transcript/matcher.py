@@ -1,0 +1,216 @@
+"""Transcripts as conformance tests (design.md): the matcher, with no I/O.
+
+`>` lines are sent at their times. Each `<` line that is a record is an expectation, to
+be matched in file order by a record the board sends; `*` in place of a field matches
+any integer. A record matches an expectation only once every `>` line before it in the
+file has been sent, and within `tolerance` seconds of its time (default TOLERANCE). Other
+records are ignored — unless `@strict on`, when each record must match the next
+expectation. `<` lines that are not records (bytes that decoded to nothing) expect
+nothing. `@board drive=…` names the drive type the transcript needs. `@align` makes the
+next expectation match whenever it comes (after its sends, by its time + tolerance), and
+shifts the times of the expectations after it by how early or late it came: timing is
+then checked against the board's own rhythm.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from appmode.errors import AppmodeError
+from appmode.protocol import app
+from appmode.protocol.escaping import escape
+from appmode.protocol.params import DriveType
+from appmode.protocol.transcript import Directive, Entry, Transcript
+
+TOLERANCE = 0.5
+_PATTERN = re.compile(r"\{([A-Za-z])((?:-?\d+|\*)(?::(?:-?\d+|\*))*)?\}\$?")
+
+
+@dataclass(frozen=True, slots=True)
+class Pattern:
+    """A record with `*` wildcards: `{A*:500:*:0}$`."""
+
+    letter: str
+    fields: tuple[int | None, ...]
+    text: str
+
+    def matches(self, record: app.Record) -> bool:
+        letter, values = app.record_fields(record)
+        return (
+            letter == self.letter
+            and len(values) == len(self.fields)
+            and all(f is None or f == v for f, v in zip(self.fields, values, strict=True))
+        )
+
+
+def parse_pattern(text: str) -> Pattern | None:
+    """The pattern of a `<` payload, or None when it is not a record."""
+    match = _PATTERN.fullmatch(text)
+    if match is None:
+        return None
+    body = match.group(2) or ""
+    fields = tuple(None if f == "*" else int(f) for f in body.split(":")) if body else ()
+    return Pattern(match.group(1), fields, text)
+
+
+@dataclass(frozen=True, slots=True)
+class Expectation:
+    entry: Entry
+    pattern: Pattern
+    tolerance: float
+    strict: bool
+    after: float
+    """Time of the last `>` line before it in the file: it cannot be matched earlier."""
+    align: bool = False
+    """`@align` before it: its match time becomes the time base of the lines after it."""
+
+
+@dataclass(frozen=True, slots=True)
+class BoardNeeds:
+    drive: DriveType | None = None
+
+
+@dataclass
+class Check:
+    """One transcript being run against a board."""
+
+    transcript: Transcript
+    sends: list[Entry] = field(default_factory=list)
+    expectations: list[Expectation] = field(default_factory=list)
+    needs: BoardNeeds = field(default_factory=BoardNeeds)
+    failure: str | None = None
+    offset: float = 0.0
+    """Shift of expectation times, set by an `@align` match."""
+    sent: int = 0
+    matched: int = 0
+    closest: dict[str, tuple[float, str]] = field(default_factory=dict)
+    """Per letter, the unmatched record nearest the expectation's time: what came instead."""
+
+    def __post_init__(self) -> None:
+        tolerance, strict, last_send, align = TOLERANCE, False, 0.0, False
+        for item in self.transcript.items:
+            if isinstance(item, Directive) and item.name == "align":
+                align = True
+            elif isinstance(item, Directive):
+                tolerance, strict = self._directive(item, tolerance, strict)
+            elif item.direction == ">":
+                self.sends.append(item)
+                last_send = max(last_send, item.time)
+            elif (pattern := parse_pattern(item.text)) is not None:
+                self.expectations.append(
+                    Expectation(item, pattern, tolerance, strict, last_send, align)
+                )
+                align = False
+        self.sends.sort(key=lambda e: e.time)
+
+    def _directive(self, item: Directive, tolerance: float, strict: bool) -> tuple[float, bool]:
+        where = f"{self.transcript.path}:{item.lineno}"
+        if item.name == "tolerance":
+            try:
+                tolerance = float(item.args[0]) if len(item.args) == 1 else -1.0
+            except ValueError:
+                tolerance = -1.0
+            if not tolerance >= 0:
+                raise AppmodeError(f"{where}: @tolerance takes seconds >= 0, e.g. @tolerance 0.3")
+        elif item.name == "strict":
+            if item.args not in (("on",), ("off",)):
+                raise AppmodeError(f"{where}: @strict takes on or off")
+            strict = item.args[0] == "on"
+        else:
+            drive = None
+            for arg in item.args:
+                key, _, value = arg.partition("=")
+                if key != "drive":
+                    raise AppmodeError(f"{where}: @board knows drive=…, not {arg!r}")
+                try:
+                    drive = DriveType.from_cli_name(value)
+                except ValueError as exc:
+                    raise AppmodeError(f"{where}: @board {exc}") from None
+            self.needs = BoardNeeds(drive)
+        return tolerance, strict
+
+    # ------------------------------------------------------------ driving it
+
+    @property
+    def done(self) -> bool:
+        return self.failure is not None or (
+            self.matched == len(self.expectations) and self.sent == len(self.sends)
+        )
+
+    @property
+    def end(self) -> float:
+        """When the run is over at the latest."""
+        last = max((e.entry.time + e.tolerance for e in self.expectations), default=0.0)
+        return max(last, self.transcript.duration)
+
+    def due(self, now: float) -> list[bytes]:
+        """The `>` payloads to send by `now`."""
+        out = []
+        while self.sent < len(self.sends) and self.sends[self.sent].time <= now:
+            out.append(self.sends[self.sent].data)
+            self.sent += 1
+        return out
+
+    def next_time(self) -> float | None:
+        """The next time something is due: a send, or an expectation's deadline."""
+        if self.done:
+            return None
+        times = []
+        if self.sent < len(self.sends):
+            times.append(self.sends[self.sent].time)
+        if self.matched < len(self.expectations):
+            exp = self.expectations[self.matched]
+            times.append(self._deadline(exp))
+        return min(times) if times else None
+
+    def on_record(self, record: app.Record, now: float) -> None:
+        if self.done or self.matched >= len(self.expectations):
+            return
+        exp = self.expectations[self.matched]
+        letter, _ = app.record_fields(record)
+        shown = escape(record.raw) if record.raw else escape(app.encode(record))
+        if not self._active(exp):
+            return  # what comes before the commands it answers is not an answer
+        if not exp.align and now < self._time(exp) - exp.tolerance:
+            if exp.strict:
+                self._fail(exp, f"got {shown} at {now:.3f} s, too early (strict)")
+            return
+        if exp.pattern.matches(record):
+            if exp.align:
+                self.offset = now - exp.entry.time
+            self.matched += 1
+            self.closest.clear()
+            return
+        if exp.strict:
+            self._fail(exp, f"got {shown} at {now:.3f} s instead (strict)")
+            return
+        distance = abs(now - self._time(exp))
+        if letter not in self.closest or distance < self.closest[letter][0]:
+            self.closest[letter] = (distance, f"{shown} at {now:.3f} s")
+
+    def _time(self, exp: Expectation) -> float:
+        """When the expectation is due: its time, shifted by the last @align match."""
+        return exp.entry.time + (0.0 if exp.align else self.offset)
+
+    def _active(self, exp: Expectation) -> bool:
+        """Every `>` line before the expectation has been sent."""
+        return self.sent == len(self.sends) or self.sends[self.sent].time > exp.after
+
+    def on_time(self, now: float) -> None:
+        if self.done or self.matched >= len(self.expectations):
+            return
+        exp = self.expectations[self.matched]
+        if now >= self._deadline(exp):
+            seen = self.closest.get(exp.pattern.letter)
+            what = f"got {seen[1]} instead" if seen else f"no {exp.pattern.letter} record came"
+            self._fail(exp, f"nothing matched by {self._deadline(exp):.3f} s; {what}")
+
+    def _deadline(self, exp: Expectation) -> float:
+        return self._time(exp) + exp.tolerance
+
+    def _fail(self, exp: Expectation, what: str) -> None:
+        self.failure = (
+            f"{self.transcript.path}:{exp.entry.lineno}: expected {exp.pattern.text} at "
+            f"{self._time(exp):.3f} s (±{exp.tolerance:g} s); {what}"
+        )

@@ -1,0 +1,126 @@
+"""`appmode replay`: play one side of a transcript to a port, against absolute deadlines.
+
+Each send's deadline is computed from the start (start + t / speed), never by adding up
+sleeps, so a late send does not make every later one late (python-can's MessageSync
+idea). As the host, the replay ends with `Z`, like every host session.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Sequence
+
+import serial
+
+from appmode.errors import AppmodeError
+from appmode.host.client import Host
+from appmode.ports.link import open_link
+from appmode.protocol.transcript import read_transcript
+
+Item = tuple[float, bytes]
+
+
+def plan(entries: Sequence[tuple[float, str, bytes]], side: str) -> list[Item]:
+    """The (time, bytes) a side sends: `>` lines for the host, `<` lines for the board."""
+    direction = ">" if side == "host" else "<"
+    return sorted(((t, data) for t, d, data in entries if d == direction), key=lambda i: i[0])
+
+
+def play(
+    items: Sequence[Item],
+    write: Callable[[bytes], None],
+    *,
+    speed: float = 1.0,
+    loops: int = 1,
+    clock: Callable[[], float] = time.monotonic,
+    sleep: Callable[[float], None] = time.sleep,
+    idle: Callable[[], None] | None = None,
+    progress: Callable[[float, float], None] | None = None,
+) -> list[float]:
+    """Send each item at start + (loop offset + t) / speed; returns how late each was (s)."""
+    period = max((t for t, _ in items), default=0.0)
+    total = period * loops / speed
+    lateness: list[float] = []
+    start = clock()
+    shown = start
+    for loop in range(loops):
+        for t, data in items:
+            deadline = start + (loop * period + t) / speed
+            while (left := deadline - clock()) > 0:
+                if idle is not None:
+                    idle()
+                if progress is not None and clock() - shown >= 0.2:
+                    shown = clock()
+                    progress(shown - start, total)
+                sleep(min(left, 0.05) if idle is not None or progress is not None else left)
+            write(data)
+            lateness.append(clock() - deadline)
+    if progress is not None:
+        progress(clock() - start, total)
+    return lateness
+
+
+def run_replay(path: str, url: str, side: str, speed: float, loops: int) -> int:
+    """The `appmode replay` command."""
+    if speed <= 0 or loops < 1:
+        raise AppmodeError("--speed must be > 0 and --loop at least 1")
+    transcript = read_transcript(path)
+    items = plan([(e.time, e.direction, e.data) for e in transcript.entries], side)
+    if not items:
+        mark = ">" if side == "host" else "<"
+        raise AppmodeError(f"{path} has no '{mark}' lines to play as the {side}")
+    show = _progress(path) if sys.stderr.isatty() else None
+    if side == "host":
+        with Host(url) as host:
+            late = play(
+                items,
+                host.send,
+                speed=speed,
+                loops=loops,
+                idle=lambda: _discard(host.poll_nowait),
+                progress=show,
+            )
+    else:
+        port = open_link(url)
+        try:
+            late = play(
+                items,
+                port.write,
+                speed=speed,
+                loops=loops,
+                idle=lambda: _discard(lambda: port.read(port.in_waiting)),
+                progress=show,
+            )
+        except (serial.SerialException, OSError) as exc:
+            raise AppmodeError(f"lost {url} during the replay: {exc}") from None
+        finally:
+            port.close()
+    if show is not None:
+        print(file=sys.stderr)
+    worst = max(late) * 1000
+    print(
+        f"replayed {len(late)} {'commands' if side == 'host' else 'records'} from {path} "
+        f"as the {side} to {url}; latest send {worst:.2f} ms after its time",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def _discard(read: Callable[[], object]) -> None:
+    read()
+
+
+def _progress(path: str) -> Callable[[float, float], None]:
+    def show(done: float, total: float) -> None:
+        share = 0.0 if total <= 0 else min(1.0, done / total)
+        bar = "#" * round(share * 30)
+        print(
+            f"\r\033[Kreplay {path} [{bar:<30}] {done:6.1f} / {total:.1f} s  "
+            f"ETA {max(0.0, total - done):5.1f} s",
+            end="",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    return show

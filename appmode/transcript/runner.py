@@ -1,0 +1,209 @@
+"""`appmode conform`: run transcripts against a board, on virtual or real time."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+import xml.etree.ElementTree as ET
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TextIO
+
+from appmode.board.firmware import Board
+from appmode.board.store import MemoryStore
+from appmode.errors import AppmodeError
+from appmode.host.client import Host, LinkLost
+from appmode.line.wire import Wire
+from appmode.protocol import app, params
+from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
+from appmode.transcript.matcher import Check
+
+Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True, slots=True)
+class Result:
+    path: str
+    title: str
+    passed: bool
+    seconds: float
+    """Transcript time covered (virtual or real)."""
+    wall: float
+    failure: str | None = None
+
+
+def run_virtual(transcript: Transcript) -> Result:
+    """Run against a fresh embedded board on virtual time: no sleeping."""
+    started = time.perf_counter()
+    check = Check(transcript)
+    wire = Wire(Board(MemoryStore(), drive=check.needs.drive), 9600)
+    decoder = app.BoardDecoder()
+    now = 0.0
+    while not check.done and now <= check.end:
+        for data in check.due(now):
+            wire.write(data, now)
+        _feed(check, decoder, wire.pump_timed(now))
+        check.on_time(now)
+        due = check.next_time()
+        if due is None:
+            break
+        now = min(due, wire.board.next_slot())  # both lie after `now`
+    return _result(transcript, check, now, time.perf_counter() - started)
+
+
+def _feed(check: Check, decoder: app.BoardDecoder, timed: list[tuple[float, bytes]]) -> None:
+    """Decode delivered bytes; each record counts at the time its last byte arrived."""
+    if not timed:
+        return
+    times = [t for t, chunk in timed for _ in chunk]
+    end = -decoder.buffered  # stream offset, relative to the new bytes, of the next event
+    for event in decoder.feed(b"".join(chunk for _, chunk in timed)):
+        end += len(event.raw)
+        if isinstance(event, app.RECORDS):
+            check.on_record(event, times[max(0, end - 1)])
+
+
+def _result(transcript: Transcript, check: Check, now: float, wall: float) -> Result:
+    if check.failure is None and not check.done:
+        check.on_time(float("inf"))
+    failure = check.failure
+    return Result(transcript.path, transcript.title, failure is None, now, wall, failure)
+
+
+def run_live(transcript: Transcript, url: str, progress: Progress | None = None) -> Result:
+    """Run in real time against any board URL."""
+    started = time.perf_counter()
+    check = Check(transcript)
+    with Host(url) as host:
+        if check.needs.drive is not None:
+            values = host.read_params()
+            have = params.drive_type(values[params.SYSTEM_MODE])
+            if have is not check.needs.drive:
+                name = have.cli_name if have is not None else "invalid"
+                message = (
+                    f"{transcript.path}: needs a {check.needs.drive.cli_name} drive; the board "
+                    f"at {url} reports {name} (system_mode {values[params.SYSTEM_MODE]}): set it "
+                    f"with appmode params {url} --set system_mode=…, or skip this transcript"
+                )
+                return Result(
+                    transcript.path,
+                    transcript.title,
+                    False,
+                    0.0,
+                    time.perf_counter() - started,
+                    message,
+                )
+        origin = host.now()
+        shown = -1
+        while not check.done:
+            now = host.now() - origin
+            try:
+                for data in check.due(now):
+                    host.send(data)
+            except LinkLost as exc:
+                check.failure = f"{transcript.path}: at {now:.3f} s: {exc}"
+                break
+            due = check.next_time()
+            wait = 0.05 if due is None else max(0.0, min(0.05, due - now))
+            for event in host.poll(wait):
+                if isinstance(event, app.RECORDS):
+                    check.on_record(event, host.now() - origin)
+            check.on_time(host.now() - origin)
+            if progress is not None and int(now * 2) != shown:
+                shown = int(now * 2)
+                progress(f"{transcript.path}: {now:5.1f} / {check.end:.1f} s")
+        now = host.now() - origin
+    return _result(transcript, check, now, time.perf_counter() - started)
+
+
+SUITE = Path(__file__).with_name("suite")
+"""The conformance suite shipped with appmode: `appmode conform` with no path runs it."""
+
+
+def collect(paths: list[str]) -> list[Path]:
+    """Transcript files from files and directories (searched recursively, sorted)."""
+    found: list[Path] = []
+    for name in paths:
+        path = Path(name)
+        if path.is_dir():
+            found += sorted(path.rglob(f"*{SUFFIX}"))
+        elif path.exists():
+            found.append(path)
+        else:
+            raise AppmodeError(f"no such transcript or directory: {name}")
+    if not found:
+        raise AppmodeError(f"no {SUFFIX} files in {', '.join(paths)}")
+    return found
+
+
+def write_junit(path: str, results: list[Result]) -> None:
+    """A JUnit XML report, written whole or not at all."""
+    suite = ET.Element(
+        "testsuite",
+        name="appmode conform",
+        tests=str(len(results)),
+        failures=str(sum(not r.passed for r in results)),
+        time=f"{sum(r.wall for r in results):.3f}",
+    )
+    for result in results:
+        case = ET.SubElement(
+            suite,
+            "testcase",
+            classname="appmode.conform",
+            name=result.path,
+            time=f"{result.wall:.3f}",
+        )
+        if result.failure is not None:
+            failure = ET.SubElement(case, "failure", message=result.failure.splitlines()[0])
+            failure.text = result.failure
+    tmp = f"{path}.tmp"
+    try:
+        ET.ElementTree(suite).write(tmp, encoding="utf-8", xml_declaration=True)
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise AppmodeError(f"cannot write {path}: {exc.strerror}") from None
+
+
+def run_conform(paths: list[str], board: str | None, junit: str | None, out: TextIO) -> int:
+    """Run every transcript; one line each; exit status 1 on any failure."""
+    if paths:
+        transcripts = [read_transcript(path) for path in collect(paths)]
+    else:
+        out.write(f"the shipped suite: {SUITE}\n")
+        transcripts = [
+            read_transcript(path, name=str(path.relative_to(SUITE.parent)))
+            for path in collect([str(SUITE)])
+        ]  # all readable before any runs
+    interactive = sys.stderr.isatty()
+
+    def progress(text: str) -> None:
+        if interactive:
+            print(f"\r\033[K{text}", end="", file=sys.stderr, flush=True)
+
+    results: list[Result] = []
+    for transcript in transcripts:
+        if board is None:
+            result = run_virtual(transcript)
+        else:
+            result = run_live(transcript, board, progress)
+            if interactive:
+                print("\r\033[K", end="", file=sys.stderr, flush=True)
+        results.append(result)
+        verdict = "PASS" if result.passed else "FAIL"
+        if board is None:
+            timing = f"{result.seconds:.2f} s of virtual time in {result.wall:.3f} s"
+        else:
+            timing = f"{result.wall:.2f} s"
+        out.write(f"{verdict}  {result.path}  ({timing})\n")
+        if result.failure is not None:
+            out.write(f"      {result.failure}\n")
+        out.flush()
+    failed = sum(not r.passed for r in results)
+    target = "the embedded simulated board" if board is None else board
+    out.write(f"{len(results) - failed} passed, {failed} failed against {target}\n")
+    if junit:
+        write_junit(junit, results)
+    return 1 if failed else 0

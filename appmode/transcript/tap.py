@@ -1,0 +1,133 @@
+"""`appmode tap`: sit between an app and a board, forwarding and recording both ways.
+
+Two threads each read one side and write to the other; the recorder hears both. The app
+side may be `pty` — a new pseudo-terminal for the app to open (its path is printed). On
+the way out the board gets `Z`: the app can no longer stop it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import pty
+import select
+import sys
+import threading
+import time
+import tty
+from typing import Protocol
+
+import serial
+
+from appmode.ports.link import open_link
+from appmode.protocol.transcript import Recorder
+
+READ_TIMEOUT = 0.05
+
+
+class Port(Protocol):
+    def read(self, size: int = 1) -> bytes: ...
+
+    def write(self, data: bytes) -> int | None: ...
+
+    def close(self) -> None: ...
+
+
+class PtyPort:
+    """The master side of a new pseudo-terminal; the app opens `path`."""
+
+    def __init__(self) -> None:
+        self._master, self._slave = pty.openpty()
+        tty.setraw(self._slave)
+        self.path = os.ttyname(self._slave)
+
+    def read(self, size: int = 1) -> bytes:
+        if not select.select([self._master], [], [], READ_TIMEOUT)[0]:
+            return b""
+        return os.read(self._master, max(size, 4096))
+
+    def write(self, data: bytes) -> int:
+        return os.write(self._master, data)
+
+    def close(self) -> None:
+        os.close(self._master)
+        os.close(self._slave)
+
+
+def _read(port: Port) -> bytes:
+    if isinstance(port, serial.SerialBase):
+        data: bytes = port.read(max(1, port.in_waiting))
+        return data
+    return port.read(4096)
+
+
+def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
+    """Forward until interrupted, recording both directions."""
+    app: Port
+    if app_url == "pty":
+        pty_port = PtyPort()
+        app = pty_port
+        print(f"port: {pty_port.path}", flush=True)
+    else:
+        app = open_link(app_url, timeout=READ_TIMEOUT)
+    try:
+        board = open_link(board_url, timeout=READ_TIMEOUT)
+    except BaseException:
+        app.close()
+        raise
+    recorder = Recorder.create(record)
+    lock = threading.Lock()
+    stop = threading.Event()
+    origin = time.monotonic()
+    counts = {">": 0, "<": 0}
+    errors: list[str] = []
+
+    def forward(src: Port, dst: Port, direction: str, name: str) -> None:
+        while not stop.is_set():
+            try:
+                data = _read(src)
+                if data:
+                    dst.write(data)
+            except (serial.SerialException, OSError) as exc:
+                errors.append(f"{name}: {exc}")
+                stop.set()
+                return
+            if data:
+                with lock:
+                    counts[direction] += len(data)
+                    recorder(direction, time.monotonic() - origin, data)
+
+    threads = [
+        threading.Thread(target=forward, args=(app, board, ">", "app side"), daemon=True),
+        threading.Thread(target=forward, args=(board, app, "<", "board side"), daemon=True),
+    ]
+    if not quiet:
+        print(
+            f"tap: {app_url} <-> {board_url}, recording to {record} (Ctrl-C to stop)",
+            file=sys.stderr,
+            flush=True,
+        )
+    for thread in threads:
+        thread.start()
+    try:
+        while not stop.is_set():
+            stop.wait(0.2)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        stop.set()
+        for thread in threads:  # stop the readers before closing their ports
+            thread.join(2)
+        with contextlib.suppress(serial.SerialException, OSError):
+            board.write(b"Z")  # the app can no longer stop the car
+            recorder(">", time.monotonic() - origin, b"Z")
+        board.close()
+        app.close()
+        recorder.close()
+    if not quiet:
+        print(
+            f"tap: {counts['>']} bytes app->board, {counts['<']} bytes board->app", file=sys.stderr
+        )
+    for error in errors:
+        print(f"tap: stopped: {error}", file=sys.stderr)
+    return 1 if errors else 0

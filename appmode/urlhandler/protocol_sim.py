@@ -1,5 +1,0 @@
-"""pyserial looks up `sim://` here (serial.protocol_handler_packages)."""
-
-from appmode.simport import SimSerial as Serial
-
-__all__ = ["Serial"]

@@ -1,0 +1,176 @@
+"""`appmode board`, `params`, `send`, `monitor` as a user runs them (design.md contract)."""
+
+from __future__ import annotations
+
+import json
+import os
+import pty
+import re
+import select
+import signal
+import subprocess
+import sys
+import time
+import tty
+from pathlib import Path
+
+import pytest
+
+from tests.support.processes import board_process, run
+
+
+def test_done_when_params_set_save_survives_a_board_restart(tmp_path: Path) -> None:
+    flash = str(tmp_path / "b.json")
+    with board_process("--pty", "--flash", flash) as board:
+        done = run("params", board.url, "--set", "max_speed=800", "--save")
+        assert done.returncode == 0, done.stderr
+        assert re.search(r"^ 0  max_speed\s+800 ", done.stdout, re.M), done.stdout
+        assert "set max_speed = 800 (verified)" in done.stderr
+        log = board.stop(signal.SIGINT)
+    assert "{Q:W}: saved [800," in log and "board: stopped" in log
+    assert board.proc.returncode == 0
+    with board_process("--pty", "--flash", flash) as board:
+        done = run("params", board.url, "--json")
+        assert json.loads(done.stdout)["max_speed"] == 800
+
+
+def test_miniterm_shows_the_telemetry_and_drives_the_board() -> None:
+    with board_process("--pty") as board:
+        master, slave = pty.openpty()
+        term = subprocess.Popen(
+            [sys.executable, "-m", "serial.tools.miniterm", board.url, "9600"],
+            stdin=slave,
+            stdout=slave,
+            stderr=slave,
+        )
+        screen = b""
+        end = time.monotonic() + 3
+        sent = False
+        while time.monotonic() < end:
+            if select.select([master], [], [], 0.1)[0]:
+                screen += os.read(master, 4096)
+            if not sent and b"{A0:0:0:0}$" in screen and b"{B0:0:0:100}$" in screen:
+                os.write(master, b"JA")  # typed into miniterm: goes to the board
+                sent = True
+        os.write(master, b"\x1d")  # Ctrl-] quits miniterm
+        term.wait(5)
+        os.close(master)
+        os.close(slave)
+        log = board.stop()
+    assert b"{A0:0:0:0}$" in screen and b"{B0:0:0:100}$" in screen
+    assert re.search(rb"\{A0:[1-9]\d*:0:0\}\$", screen), "the car moved forward"
+    assert "A: forward" in log
+
+
+def test_board_rejects_and_logs_bad_input_and_stops_on_sigterm() -> None:
+    with board_process("--listen", "0") as board:
+        done = run("send", board.url, "--raw", "{0:99999}", "x", "{Q\\x03P}", "--listen", "0")
+        assert done.returncode == 0, done.stderr
+        log = board.stop()
+    assert "rejected {0:99999}: max_speed (parameter 0) must be in 0–65535" in log
+    assert "rejected x: unrecognised byte, stop" in log
+    assert "warning  {Q\\x03P}: Q frame separator is 0x03" in log
+    assert board.proc.returncode == 0 and "Traceback" not in log
+
+
+def test_board_record_writes_a_v1_transcript(tmp_path: Path) -> None:
+    record = tmp_path / "s.transcript"
+    with board_process("--pty", "--no-pace", "--quiet", "--record", str(record)) as board:
+        assert run("send", board.url, "J", "A", "wait:0.2").returncode == 0
+    lines = record.read_text().splitlines()
+    assert lines[0] == "# appmode transcript v1"
+    pattern = re.compile(r"^\d+\.\d{4} [<>] \S+$")
+    assert all(pattern.match(text) for text in lines[1:]), lines
+    directions = [text.split()[1:] for text in lines[1:]]
+    assert [">", "J"] in directions and [">", "A"] in directions
+    assert directions[-1] == [">", "Z"] or [">", "Z"] in directions
+    assert any(d[0] == "<" and d[1].startswith("{A") for d in directions)
+
+
+def test_send_prints_what_comes_back_over_sim() -> None:
+    done = run("send", "sim://?pace=0", "{Q:P}", "wait:0.2", "J", "A", "wait:0.5", "--listen", "0")
+    assert done.returncode == 0, done.stderr
+    assert "> {Q:P}" in done.stdout and "read parameters" in done.stdout
+    assert "< {C500:10000:20:0:10:10:10:0:0}$" in done.stdout
+    assert re.search(r"velocity x=0 y=4\d\d z=0", done.stdout)
+
+
+def test_send_json_lines() -> None:
+    done = run("send", "sim://?pace=0", "{Q:P}", "--listen", "0.2", "--json")
+    objects = [json.loads(text) for text in done.stdout.splitlines()]
+    assert any(o["kind"] == "params" and o["max_speed"] == 500 for o in objects)
+    assert all("t" in o for o in objects)
+
+
+def test_monitor_counts_and_json() -> None:
+    done = run("monitor", "sim://", "--count", "6", "--json")
+    assert done.returncode == 0, done.stderr
+    kinds = [json.loads(text)["kind"] for text in done.stdout.splitlines()]
+    assert len(kinds) == 6 and set(kinds) == {"velocity", "attitude"}
+    assert "monitor: 6 records, 0 errors" in done.stderr
+
+
+def test_monitor_over_tcp_for_a_duration() -> None:
+    with board_process("--listen", "0", "--quiet") as board:
+        done = run("monitor", board.url, "--duration", "0.6")
+    records = [text for text in done.stdout.splitlines() if "undecodable" not in text]
+    assert 8 <= len(records) <= 14 and all(" < {" in text for text in records)
+    # joining a stream mid-record costs at most the first partial record
+    assert len(done.stdout.splitlines()) - len(records) <= 1
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            ["params", "sim://", "--set", "max_speed=70000"],
+            "max_speed (parameter 0) must be in 0–65535, not 70000",
+        ),
+        (["params", "sim://", "--set", "speed=5"], "unknown parameter 'speed'"),
+        (["params", "sim://", "--set", "max_speed"], "expected NAME=VALUE"),
+        (["params", "sim://", "--set", "max_speed=-1"], "takes a whole number in 0–65535"),
+        (["send", "sim://", "hello"], "token 'hello' is not understood"),
+        (["send", "sim://", "{0:99999}"], "(--raw sends it anyway)"),
+        (["monitor", "nope://x"], "unknown URL scheme 'nope://'"),
+        (["params", "/dev/ttyUSB97"], "no such port /dev/ttyUSB97"),
+        (["board", "--listen", "nonsense"], "expected HOST:PORT or PORT"),
+        (["board", "--port", "/dev/ttyUSB97"], "no such port /dev/ttyUSB97"),
+        (["params", "loop://"], "no parameters from loop://"),
+    ],
+)
+def test_bad_input_is_one_line_on_stderr(args: list[str], message: str) -> None:
+    done = run(*args)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr, done.stderr
+    assert done.stderr.startswith("appmode: error: ") and message in done.stderr
+
+
+def test_tcp_port_in_use_is_one_line() -> None:
+    with board_process("--listen", "0", "--quiet") as board:
+        port = board.url.rsplit(":", 1)[1]
+        done = run("board", "--listen", port)
+    assert done.returncode == 2
+    assert f"TCP port 127.0.0.1:{port} is already in use" in done.stderr
+    assert done.stderr.count("\n") == 1
+
+
+def test_board_serves_on_a_real_port_like_a_bluetooth_module() -> None:
+    """--port DEV: the test holds the far end of a pty, as the phone app would."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    path = os.ttyname(slave)
+    try:
+        with board_process("--port", path, "--quiet") as board:
+            assert board.url == path
+            os.write(master, b"{Q:P}")
+            received = b""
+            end = time.monotonic() + 3
+            while b"{C" not in received or not received.endswith(b"$"):
+                if time.monotonic() > end:
+                    break
+                if select.select([master], [], [], 0.1)[0]:
+                    received += os.read(master, 4096)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert b"{C500:10000:20:0:10:10:10:0:0}$" in received

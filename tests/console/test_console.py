@@ -1,0 +1,147 @@
+"""The driving console, headless (create_pipe_input + DummyOutput) on the simulated board."""
+
+from __future__ import annotations
+
+import io
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from prompt_toolkit.input import create_pipe_input
+from prompt_toolkit.output import DummyOutput
+
+from appmode.console import app
+from appmode.console.hold import HoldToDrive
+from appmode.console.session import Session
+
+UP = "\x1b[A"
+CTRL_C = "\x03"
+
+
+def sent(record: Path) -> list[tuple[float, str]]:
+    """The host→board lines of a transcript: (time, payload)."""
+    out = []
+    for line in record.read_text().splitlines():
+        if " > " in line:
+            time_text, _, payload = line.split(" ", 2)
+            out.append((float(time_text), payload))
+    return out
+
+
+def run_console(
+    tmp_path: Path, keys: list[tuple[str, float]], url: str = "sim://", **driving: Any
+) -> tuple[Session, Path, list[float]]:
+    """Run the console with `keys` typed (text, pause after); returns when it has quit."""
+    record = tmp_path / "app.transcript"
+    session = Session(url, HoldToDrive(**driving), str(record))
+    typed_at: list[float] = []
+    with create_pipe_input() as pipe:
+
+        def typist() -> None:
+            time.sleep(0.5)
+            for text, pause in keys:
+                typed_at.append(session.host.now())
+                pipe.send_text(text)
+                time.sleep(pause)
+
+        thread = threading.Thread(target=typist, daemon=True)
+        thread.start()
+        app.run_drive(session, True, [], io.StringIO(), pipe, DummyOutput())
+        thread.join(5)
+    return session, record, typed_at
+
+
+@pytest.fixture
+def quit_key() -> Iterator[tuple[str, float]]:
+    yield (CTRL_C, 0.0)
+
+
+def test_holding_up_drives_and_letting_go_stops(
+    tmp_path: Path, quit_key: tuple[str, float]
+) -> None:
+    hold = [(UP, 0.03)] * 25  # the terminal's auto-repeat: ~33 presses a second
+    _, record, typed = run_console(tmp_path, [*hold, ("", 0.6), quit_key])
+    lines = sent(record)
+    payloads = [p for _, p in lines]
+    assert payloads[:2] == ["J", "{Q:P}"], "the console starts on the direction page"
+    assert payloads.count("A") == 1, "repeats do not resend"
+    z_after = [t for t, p in lines if p == "Z" and t > typed[0]]
+    release = z_after[0] - typed[24]
+    assert 0.14 <= release <= 0.35, f"stopped {release:.3f} s after the last repeat"
+    assert payloads[-1] == "Z"
+
+
+def test_a_single_tap_stops_after_the_first_timeout(
+    tmp_path: Path, quit_key: tuple[str, float]
+) -> None:
+    _, record, typed = run_console(tmp_path, [(UP, 1.0), quit_key], first_timeout=0.4)
+    lines = sent(record)
+    z_time = next(t for t, p in lines if p == "Z" and t > typed[0])
+    assert 0.38 <= z_time - typed[0] <= 0.6
+
+
+def test_grid_keys_follow_the_page(tmp_path: Path, quit_key: tuple[str, float]) -> None:
+    keys = [
+        ("q", 0.1),
+        (" ", 0.1),
+        ("k", 0.1),
+        ("q", 0.1),
+        ("d", 0.1),
+        (" ", 0.1),
+        ("j", 0.1),
+        ("c", 0.1),
+        quit_key,
+    ]
+    _, record, _ = run_console(tmp_path, keys)
+    letters = [p for _, p in sent(record) if not p.startswith("{")]
+    # direction page: q = H front-left; button page: q = B front-left, d = C rotate-cw
+    assert letters[1:] == ["H", "Z", "K", "B", "C", "Z", "J", "D", "Z"]
+
+
+def test_command_line_set_is_verified_and_typing_does_not_drive(
+    tmp_path: Path, quit_key: tuple[str, float]
+) -> None:
+    keys = [(":", 0.1), ("set max_speed 800\r", 0.8), quit_key]
+    session, record, _ = run_console(tmp_path, keys)
+    payloads = [p for _, p in sent(record)]
+    assert "{0:800}" in payloads
+    assert not set(payloads) & {"A", "B", "C", "D", "E", "F", "G", "H"}
+    assert session.host.state.params is not None
+    assert session.host.state.params.values[0] == 800
+    assert "max_speed = 800 (verified)" in session.messages
+
+
+def test_command_line_errors_are_messages(tmp_path: Path, quit_key: tuple[str, float]) -> None:
+    keys = [(":", 0.1), ("set max_speed 99999\r", 0.2), (":", 0.1), ("fly\r", 0.2), quit_key]
+    session, _, _ = run_console(tmp_path, keys)
+    assert any("max_speed (parameter 0) must be in 0–65535" in m for m in session.messages)
+    assert any("unknown command 'fly'" in m for m in session.messages)
+
+
+def test_quit_command_sends_z_last_even_while_latched(tmp_path: Path) -> None:
+    keys = [("l", 0.1), ("w", 0.5), (":", 0.1), ("quit\r", 0.0)]
+    _, record, _ = run_console(tmp_path, keys)
+    payloads = [p for _, p in sent(record)]
+    assert "A" in payloads and payloads[-1] == "Z"
+
+
+def test_a_crash_in_the_console_still_sends_z_last(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = {"n": 0}
+    real = app.Session.tick
+
+    def failing_tick(self: Session) -> None:
+        calls["n"] += 1
+        if calls["n"] == 40:
+            raise RuntimeError("boom")
+        real(self)
+
+    monkeypatch.setattr(app.Session, "tick", failing_tick)
+    with pytest.raises(RuntimeError, match="boom"):
+        run_console(tmp_path, [("w", 0.0), ("w", 5.0)], latched=True)
+    payloads = [p for _, p in sent(tmp_path / "app.transcript")]
+    assert "A" in payloads and payloads[-1] == "Z"

@@ -1,0 +1,122 @@
+"""The console as a person uses it: in tmux, against `appmode board --pty --record`."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from tests.support.processes import ROOT, board_process
+
+SESSION = "appmode-test"
+
+
+def tmux(*args: str) -> str:
+    return subprocess.run(["tmux", *args], capture_output=True, text=True, check=True).stdout
+
+
+def screen() -> str:
+    return tmux("capture-pane", "-t", SESSION, "-p")
+
+
+def wait_screen(pattern: str, timeout: float = 10.0) -> re.Match[str]:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        match = re.search(pattern, screen())
+        if match:
+            return match
+        time.sleep(0.02)
+    raise AssertionError(f"{pattern!r} never showed; screen:\n{screen()}")
+
+
+def _alive() -> bool:
+    done = subprocess.run(["tmux", "has-session", "-t", SESSION], capture_output=True, check=False)
+    return done.returncode == 0
+
+
+def forward_speed() -> int:
+    return int(wait_screen(r"velocity\s+x\s+-?\d+\s+y\s+(-?\d+)").group(1))
+
+
+def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
+    assert shutil.which("tmux"), "tmux is required (.ci/run installs it)"
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        command = f"cd {ROOT} && {sys.executable} -m appmode drive {board.url}"
+        tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+        try:
+            wait_screen(r"REAL BOARD")
+            wait_screen(r"params\s+max_speed 500")
+            pressed = time.monotonic()
+            moving_after = None
+            while time.monotonic() - pressed < 1.2:  # hold: keys repeat every 30 ms
+                tmux("send-keys", "-t", SESSION, "Up")
+                if moving_after is None and forward_speed() > 0:
+                    moving_after = time.monotonic() - pressed
+                time.sleep(0.03)
+            released = time.monotonic()
+            assert moving_after is not None and moving_after < 0.3, moving_after
+            wait_screen(r"in force\s+Z stop", timeout=2)
+            stopped_after = time.monotonic() - released
+            assert stopped_after < 0.5, stopped_after
+            tmux("send-keys", "-t", SESSION, ":")
+            tmux("send-keys", "-t", SESSION, "set max_speed 800", "Enter")
+            wait_screen(r"max_speed = 800 \(verified\)")
+            wait_screen(r"params\s+max_speed 800")
+            tmux("send-keys", "-t", SESSION, "C-c")
+            end = time.monotonic() + 5
+            while time.monotonic() < end and _alive():
+                time.sleep(0.05)
+            assert not _alive(), "Ctrl-C ends the console"
+        finally:
+            subprocess.run(
+                ["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False
+            )
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert "A" in sent and "{0:800}" in sent
+    assert sent[-1] == "Z", sent[-5:]
+
+
+def test_sigterm_ends_the_console_with_z_last(tmp_path: Path) -> None:
+    record = tmp_path / "drive.transcript"
+    command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched --record {record}"
+    tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+    try:
+        wait_screen(r"params\s+max_speed 500")
+        tmux("send-keys", "-t", SESSION, "w")
+        wait_screen(r"in force\s+A forward")
+        pid = int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+        os.kill(pid, signal.SIGTERM)
+        end = time.monotonic() + 5
+        while time.monotonic() < end and _alive():
+            time.sleep(0.05)
+        assert not _alive()
+    finally:
+        subprocess.run(["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False)
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert "A" in sent and sent[-1] == "Z"
+
+
+def test_sigterm_ends_script_mode_with_z_last(tmp_path: Path) -> None:
+    record = tmp_path / "script.transcript"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "drive", "--record", str(record)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None and proc.stdout is not None
+    proc.stdin.write(b"drive A\n")
+    proc.stdin.flush()
+    end = time.monotonic() + 10
+    while time.monotonic() < end and (not record.exists() or " > A" not in record.read_text()):
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(10)
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert "A" in sent and sent[-1] == "Z"

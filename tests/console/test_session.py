@@ -1,0 +1,63 @@
+"""`appmode drive` script mode and the session under a lost link."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from appmode.console.hold import HoldToDrive
+from appmode.console.session import Session
+from tests.support.processes import BoardProcess, run
+
+
+def test_script_mode_reads_commands_from_stdin(tmp_path: Path) -> None:
+    record = tmp_path / "s.transcript"
+    script = b"set max_speed 800\ndrive A\nwait 0.6\nstatus\nspeed -300\nfly\nquit\n"
+    done = run("drive", "--record", str(record), stdin=script)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    assert "max_speed = 800 (verified)" in out
+    assert "SIMULATED BOARD" in out and "in force  A forward" in out
+    assert "max_speed = 500 (verified)" in out
+    assert "error: unknown command 'fly': type help for the list" in out
+    sent = [line for line in record.read_text().splitlines() if " > " in line]
+    assert sent[-1].endswith(" > Z"), sent[-3:]
+
+
+def test_script_mode_against_a_board_process_over_tcp(tmp_path: Path) -> None:
+    log_file = tmp_path / "board.transcript"
+    board = BoardProcess("--listen", "0", "--quiet", "--record", str(log_file))
+    try:
+        done = run("drive", board.url, stdin=b"page button\ndrive C\nwait 0.3\n")
+        assert done.returncode == 0, done.stderr
+        assert "REAL BOARD" not in done.stdout  # no status asked for
+    finally:
+        board.stop()
+    sent = [line.split(" ", 2)[2] for line in log_file.read_text().splitlines() if " > " in line]
+    assert sent[:2] == ["J", "{Q:P}"] and "K" in sent and "C" in sent
+    assert sent[-1] == "Z"
+
+
+def test_keys_do_not_pretend_while_the_link_is_lost(tmp_path: Path) -> None:
+    board = BoardProcess("--listen", "0", "--quiet")
+    session = Session(board.url, HoldToDrive())
+    try:
+        session.start()
+        board.kill()
+        end = time.monotonic() + 5
+        while session.host.connected and time.monotonic() < end:
+            session.tick()
+            time.sleep(0.02)
+        assert not session.host.connected
+        session.press("A")
+        assert session.in_force == "Z"
+        assert any("lost" in m for m in session.messages)
+        assert session.messages[-1] == "link is down: not driving"
+    finally:
+        session.close()
+
+
+def test_help_lists_every_command() -> None:
+    done = run("drive", stdin=b"help\n")
+    for name in ("params", "set NAME VALUE", "save", "speed", "record FILE|stop", "quit"):
+        assert name in done.stdout

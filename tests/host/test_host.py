@@ -1,0 +1,109 @@
+"""The host client API over links: parameters, send, records, lost links, Z on close."""
+
+from __future__ import annotations
+
+import socket
+import time
+from pathlib import Path
+
+import pytest
+
+from appmode.errors import AppmodeError
+from appmode.host.client import Host
+from appmode.host.state import LinkStatus
+from appmode.protocol.app import Attitude, ParamsRecord, Velocity
+from tests.support.processes import BoardProcess, board_process
+
+
+def test_read_set_verify_save_over_sim() -> None:
+    with Host("sim://?pace=0") as host:
+        assert host.read_params()[0] == 500
+        assert host.set_param(5, 42)[5] == 42
+        with pytest.raises(ValueError, match="system_mode"):
+            host.set_param(8, 7)
+
+
+def test_read_params_times_out_with_a_clear_error() -> None:
+    with Host("loop://") as host:  # a loop echoes {Q:P}: no C record ever comes
+        start = time.monotonic()
+        with pytest.raises(AppmodeError, match=r"sent \{Q:P\} 4 times and no 2 C records"):
+            host.read_params(timeout=0.2, tries=2)
+        assert time.monotonic() - start < 2
+
+
+def test_events_and_statistics_at_the_line_rate() -> None:
+    with Host("sim://") as host:
+        events = list(host.events(2.2))
+        kinds = {type(e) for e in events}
+        assert kinds == {Velocity, Attitude}
+        assert 40 <= len(events) <= 46, "about 20 records a second"
+        stats = host.state.stats
+        assert stats.records == len(events) and stats.errors == 0
+        assert 15 <= stats.rate(host.now()) <= 21
+
+
+def test_close_sends_z_last(tmp_path: Path) -> None:
+    record = tmp_path / "board.transcript"
+    with board_process("--listen", "0", "--quiet", "--record", str(record)) as board:
+        host = Host(board.url)
+        host.send(b"JA")
+        host.poll(0.2)
+        host.close()
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert sent == ["J", "A", "Z"]
+
+
+def test_board_keeps_state_between_clients() -> None:
+    with board_process("--pty", "--no-pace", "--quiet") as board:
+        with Host(board.url) as first:
+            first.set_param(0, 900)
+        with Host(board.url) as second:
+            assert second.read_params()[0] == 900
+
+
+def test_lost_link_is_reported_and_recovered_after_board_restart() -> None:
+    first = BoardProcess("--listen", "127.0.0.1:0", "--quiet")
+    port = first.url.rsplit(":", 1)[1]
+    host = Host(first.url)
+    try:
+        host.read_params()
+        first.kill()
+        statuses: list[LinkStatus] = []
+        restarted = None
+        for event in host.events(8.0):
+            if isinstance(event, LinkStatus):
+                statuses.append(event)
+                if not event.up and restarted is None:
+                    restarted = BoardProcess("--listen", f"127.0.0.1:{port}", "--quiet")
+                if event.up:
+                    break
+        assert [s.up for s in statuses] == [False, True], statuses
+        assert "lost" in statuses[0].text and "back" in statuses[1].text
+        assert host.read_params()[0] == 500
+    finally:
+        host.close()
+        if restarted is not None:
+            restarted.stop()
+
+
+def test_second_tcp_client_is_refused_while_first_stays() -> None:
+    with board_process("--listen", "0") as board:
+        host, port = board.url[len("socket://") :].rsplit(":", 1)
+        with Host(board.url) as first:
+            first.read_params()
+            with socket.create_connection((host, int(port)), timeout=3) as second:
+                assert second.recv(100) == b"", "refused: closed at once"
+            assert isinstance(first.read_params(), tuple)
+        log = board.stop()
+    assert "refused a client" in log and "one client at a time" in log
+
+
+def test_params_record_is_not_reported_unless_intact() -> None:
+    with Host("loop://") as host:
+        host.send(b"{C500:10000:20:0:10:10:10:0:0}$")  # echoed back: a C record
+        events = host.poll(0.5) + host.poll(0.1)
+        assert any(isinstance(e, ParamsRecord) for e in events)
+        host.send(b"{C500:10000:20:0:10:10:10:0:7}$")  # drive type 7: not a valid C
+        events = host.poll(0.5) + host.poll(0.1)
+        assert not any(isinstance(e, ParamsRecord) for e in events)
+        assert host.state.stats.errors >= 1

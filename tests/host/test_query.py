@@ -1,0 +1,92 @@
+"""Parameter reads and verified sets as a state machine (client.HostState + query)."""
+
+from __future__ import annotations
+
+import pytest
+
+from appmode.host.query import ParamQuery, QueryDone, QueryFailed
+from appmode.host.state import HostState
+from appmode.protocol import params
+from appmode.protocol.app import ParamsRecord, encode
+
+
+def c_record(**changes: int) -> bytes:
+    values = list(params.DEFAULTS)
+    for name, value in changes.items():
+        values[params.BY_NAME[name].index] = value
+    return encode(ParamsRecord(tuple(values)))
+
+
+def outcomes(events: list[object]) -> list[object]:
+    return [e for e in events if isinstance(e, (QueryDone, QueryFailed))]
+
+
+def test_read_ends_when_two_c_records_asked_for_separately_agree() -> None:
+    state = HostState()
+    state.start_query(ParamQuery(), 0.0)
+    assert state.take_outbox() == b"{Q:P}"
+    assert outcomes(state.feed(c_record(), 0.1)) == []
+    assert state.take_outbox() == b"{Q:P}", "asks again to confirm"
+    [done] = outcomes(state.feed(c_record(), 0.2))
+    assert isinstance(done, QueryDone) and done.values == params.DEFAULTS
+    assert state.query is None
+
+
+def test_a_corrupted_digit_is_not_reported() -> None:
+    state = HostState()
+    state.start_query(ParamQuery(), 0.0)
+    state.feed(c_record(max_speed=900), 0.1)  # a digit hit by noise: well-formed, wrong
+    assert outcomes(state.feed(c_record(), 0.2)) == []
+    [done] = outcomes(state.feed(c_record(), 0.3))
+    assert isinstance(done, QueryDone) and done.values[0] == 500
+
+
+def test_a_garbled_c_record_is_asked_for_again_at_once() -> None:
+    state = HostState()
+    state.start_query(ParamQuery(), 0.0)
+    state.take_outbox()
+    state.feed(b"{C500:10000:20:0:1\x000:10:10:0:0}$", 0.1)
+    assert state.take_outbox() == b"{Q:P}"
+    assert state.stats.errors == 1 and state.params is None
+
+
+def test_read_resends_on_timeout_then_fails_with_a_clear_error() -> None:
+    state = HostState()
+    state.start_query(ParamQuery(timeout=0.5, tries=2, where="/dev/ttyUSB0"), 0.0)
+    state.take_outbox()
+    assert state.tick(0.4) is None and state.take_outbox() == b""
+    for k in range(1, 4):
+        assert state.tick(0.5 * k) is None and state.take_outbox() == b"{Q:P}"
+    outcome = state.tick(2.0)
+    assert isinstance(outcome, QueryFailed)
+    assert "no parameters from /dev/ttyUSB0: sent {Q:P} 4 times and no 2 C records" in (
+        outcome.text
+    )
+
+
+def test_set_is_verified_by_agreeing_c_records_read_after_it() -> None:
+    state = HostState()
+    state.start_query(ParamQuery((0, 800)), 0.0)
+    assert state.take_outbox() == b"{0:800}{Q:P}"
+    assert outcomes(state.feed(c_record(), 0.02)) == []  # already on its way: old value
+    assert outcomes(state.feed(c_record(max_speed=800), 0.1)) == []
+    [done] = outcomes(state.feed(c_record(max_speed=800), 0.2))
+    assert isinstance(done, QueryDone) and done.text == "max_speed = 800 (verified)"
+
+
+def test_set_that_never_takes_is_retried_then_fails_naming_the_value_read() -> None:
+    state = HostState()
+    state.start_query(ParamQuery((5, 42), timeout=0.5, tries=2), 0.0)
+    assert state.take_outbox() == b"{5:42}{Q:P}"
+    state.feed(c_record(), 0.1)
+    state.feed(c_record(), 0.2)  # agreed: the set did not take
+    assert state.take_outbox() == b"{Q:P}{5:42}{Q:P}", "confirm, then set again"
+    state.feed(c_record(), 0.3)
+    [failed] = outcomes(state.feed(c_record(), 0.4))
+    assert isinstance(failed, QueryFailed)
+    assert failed.text.startswith("velocity_kp reads 10 after setting it to 42")
+
+
+def test_query_rejects_out_of_range_before_sending() -> None:
+    with pytest.raises(ValueError, match="max_speed"):
+        ParamQuery((0, 70000))

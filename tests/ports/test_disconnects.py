@@ -1,0 +1,123 @@
+"""Disconnects: boards killed and restarted, ptys that vanish, TCP resets, clients killed."""
+
+from __future__ import annotations
+
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from appmode.host.client import Host
+from appmode.host.state import LinkStatus
+from appmode.protocol.app import Velocity
+from tests.support.processes import ROOT, BoardProcess, board_process, wait_for
+
+
+def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> None:
+    link = str(tmp_path / "board")
+    first = BoardProcess("--pty", "--link", link, "--quiet")
+    monitor = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "monitor", link],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    second = None
+    try:
+        time.sleep(1.5)
+        first.kill()  # the device vanishes: the pty is gone, the link dangles
+        time.sleep(1.5)
+        second = BoardProcess("--pty", "--link", link, "--quiet")
+        time.sleep(2.5)
+    finally:
+        monitor.send_signal(signal.SIGINT)
+        out, err = monitor.communicate(timeout=10)
+        if second is not None:
+            second.stop()
+    assert "lost" in err and "is back" in err, err
+    after_back = out.splitlines()[-5:]
+    assert all(" < {" in line for line in after_back), "records again after the return"
+    assert "Traceback" not in err
+
+
+def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path) -> None:
+    link = str(tmp_path / "board")
+    first = BoardProcess("--pty", "--link", link, "--quiet")
+    drive = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "drive", link],
+        cwd=ROOT,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    assert drive.stdin is not None
+    record = tmp_path / "second.transcript"
+    second = None
+    try:
+        drive.stdin.write(b"wait 1.5\ndrive A\nwait 3\ndrive C\nwait 0.5\nstatus\n")
+        drive.stdin.flush()
+        time.sleep(1.0)
+        first.kill()  # the board dies before `drive A`
+        time.sleep(1.5)
+        second = BoardProcess("--pty", "--link", link, "--quiet", "--record", str(record))
+        out, _ = drive.communicate(timeout=20)
+    finally:
+        if second is not None:
+            second.stop()
+    text = out.decode()
+    assert "lost" in text and "link is down: not driving" in text and "is back" in text
+    assert "in force  C right" in text
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    assert "C" in sent and sent[-1] == "Z" and "A" not in sent
+
+
+def test_a_tcp_reset_is_reported_and_the_host_resumes() -> None:
+    listener = socket.create_server(("127.0.0.1", 0))
+    port = listener.getsockname()[1]
+    host = Host(f"socket://127.0.0.1:{port}")
+    conn, _ = listener.accept()
+    conn.sendall(b"{A1:2:3:0}$")
+    events = host.poll(1.0)
+    assert events == [Velocity(1, 2, 3, 0)]
+    conn.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+    conn.close()  # RST
+    listener.close()
+    statuses: list[LinkStatus] = []
+    board = None
+    try:
+        end = time.monotonic() + 10
+        while time.monotonic() < end and not (statuses and statuses[-1].up):
+            for event in host.poll(0.2):
+                if isinstance(event, LinkStatus):
+                    statuses.append(event)
+                    if not event.up and board is None:
+                        board = BoardProcess("--listen", f"127.0.0.1:{port}", "--quiet")
+        assert [s.up for s in statuses] == [False, True]
+        assert host.read_params()[0] == 500
+    finally:
+        host.close()
+        if board is not None:
+            board.stop()
+
+
+def test_board_keeps_serving_after_clients_are_killed() -> None:
+    for where in (("--pty",), ("--listen", "0")):
+        with board_process(*where, "--quiet") as board:
+            client = subprocess.Popen(
+                [sys.executable, "-m", "appmode", "monitor", board.url],
+                cwd=ROOT,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL,
+            )
+            assert client.stdout is not None
+            client.stdout.readline()
+            client.kill()  # no goodbye, no Z
+            client.wait()
+            wait_for(lambda: board.proc.poll() is None)
+            with Host(board.url) as host:
+                assert host.read_params()[0] == 500
+            assert board.proc.poll() is None

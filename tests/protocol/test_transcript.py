@@ -1,0 +1,128 @@
+"""Transcript format v1 (design.md): writer and reader, and bad input with file:line."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from appmode.errors import AppmodeError
+from appmode.protocol.transcript import (
+    HEADER,
+    Directive,
+    Recorder,
+    TranscriptError,
+    parse_transcript,
+    read_transcript,
+)
+
+
+def test_recorder_writes_one_unit_a_line_and_escapes_bytes() -> None:
+    out = io.StringIO()
+    recorder = Recorder(out, directives=("board drive=diff",))
+    recorder(">", 0.0, b"JA{Q:")
+    recorder(">", 0.01, b"P}\r\n")
+    recorder("<", 0.05, b"{A0:0:0:0}${B0:0")
+    recorder("<", 0.06, b":0:100}$xx\\")
+    recorder.close()
+    assert out.getvalue().splitlines() == [
+        HEADER,
+        "@board drive=diff",
+        "0.0000 > J",
+        "0.0000 > A",
+        "0.0100 > {Q:P}",
+        "0.0100 > \\x0d",
+        "0.0100 > \\x0a",
+        "0.0500 < {A0:0:0:0}$",
+        "0.0600 < {B0:0:0:100}$",
+        "0.0600 < xx\\\\",
+    ]
+
+
+def test_concatenated_payloads_give_back_the_exact_bytes() -> None:
+    stream = bytes(range(256)) + b"{A1:2:3:0}${C1:2}$"
+    out = io.StringIO()
+    recorder = Recorder(out)
+    recorder("<", 0.0, stream)
+    recorder.close()
+    transcript = parse_transcript(out.getvalue())
+    assert b"".join(e.data for e in transcript.entries) == stream
+
+
+def test_reader_keeps_title_directives_and_entries(tmp_path: Path) -> None:
+    path = tmp_path / "t.transcript"
+    path.write_text(
+        f"{HEADER}\n# checks the C slot\n\n@tolerance 0.2\n0.100 > {{Q:P}}\n"
+        "0.150 < {C*:*:*:*:*:*:*:*:*}$\n"
+    )
+    transcript = read_transcript(path)
+    assert transcript.title == "checks the C slot"
+    assert transcript.items[0] == Directive(4, "tolerance", ("0.2",))
+    assert [(e.lineno, e.time, e.direction, e.data) for e in transcript.entries] == [
+        (5, 0.1, ">", b"{Q:P}"),
+        (6, 0.15, "<", b"{C*:*:*:*:*:*:*:*:*}$"),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ("0.1 > ", "expected 'TIME DIR PAYLOAD'"),
+        ("0.1>{Q:P}", "expected 'TIME DIR PAYLOAD'"),
+        ("soon > A", "time 'soon' is not seconds >= 0"),
+        ("-1 > A", "time '-1' is not seconds >= 0"),
+        ("nan > A", "time 'nan' is not seconds >= 0"),
+        ("0.1 = A", "direction '=' must be '>'"),
+        ("0.1 > A B", "column 2: ' ' cannot stand for itself"),
+        ("0.1 > \\q", "column 1: '\\\\' cannot stand for itself"),
+        ("@timeout 3", "unknown directive @timeout (known: @board, @tolerance"),
+        ("@", "unknown directive @ (known:"),  # found by fuzz/fuzz_decoders.py
+    ],
+)
+def test_malformed_lines_name_file_and_line(tmp_path: Path, line: str, message: str) -> None:
+    path = tmp_path / "bad.transcript"
+    path.write_text(f"{HEADER}\n0.0 > J\n{line}\n")
+    with pytest.raises(TranscriptError) as caught:
+        read_transcript(path)
+    assert str(caught.value).startswith(f"{path}:3: ")
+    assert message in str(caught.value)
+
+
+def test_other_versions_and_unreadable_files() -> None:
+    with pytest.raises(TranscriptError, match="v2' is not a version this appmode reads"):
+        parse_transcript("# appmode transcript v2\n", "x.transcript")
+    with pytest.raises(AppmodeError, match=r"cannot read transcript /no/such\.transcript"):
+        read_transcript("/no/such.transcript")
+
+
+def test_non_utf8_file_is_reported(tmp_path: Path) -> None:
+    path = tmp_path / "latin.transcript"
+    path.write_bytes(b"0.0 > \xff\n")
+    with pytest.raises(TranscriptError, match="not UTF-8"):
+        read_transcript(path)
+
+
+@given(st.text(max_size=300))
+def test_property_reader_never_fails_other_than_clearly(text: str) -> None:
+    try:
+        transcript = parse_transcript(text, "fuzz.transcript")
+    except TranscriptError as exc:
+        assert str(exc).startswith("fuzz.transcript:")
+    else:
+        assert all(e.direction in "<>" and e.time >= 0 for e in transcript.entries)
+
+
+@given(st.lists(st.tuples(st.sampled_from("<>"), st.binary(min_size=1, max_size=30)), max_size=10))
+def test_property_record_then_read_round_trip(chunks: list[tuple[str, bytes]]) -> None:
+    out = io.StringIO()
+    recorder = Recorder(out)
+    for k, (direction, data) in enumerate(chunks):
+        recorder(direction, k * 0.01, data)
+    recorder.close()
+    entries = parse_transcript(out.getvalue()).entries
+    for direction in "<>":
+        sent = b"".join(d for dr, d in chunks if dr == direction)
+        assert b"".join(e.data for e in entries if e.direction == direction) == sent

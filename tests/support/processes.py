@@ -1,0 +1,91 @@
+"""Start real appmode processes for end-to-end tests, and always stop them."""
+
+from __future__ import annotations
+
+import selectors
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def appmode_cmd(*args: str) -> list[str]:
+    return [sys.executable, "-m", "appmode", *args]
+
+
+def run(*args: str, timeout: float = 60, stdin: bytes = b"") -> subprocess.CompletedProcess[str]:
+    done = subprocess.run(
+        appmode_cmd(*args),
+        input=stdin.decode(),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=ROOT,
+        check=False,
+    )
+    return done
+
+
+class BoardProcess:
+    """`appmode board ...` running; `url` is what it printed after 'port: '."""
+
+    def __init__(self, *args: str) -> None:
+        self.proc = subprocess.Popen(
+            appmode_cmd("board", *args),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+        self.url = self._read_port_line()
+
+    def _read_port_line(self, timeout: float = 20.0) -> str:
+        assert self.proc.stdout is not None
+        sel = selectors.DefaultSelector()
+        sel.register(self.proc.stdout, selectors.EVENT_READ)
+        if not sel.select(timeout):
+            self.stop()
+            raise AssertionError(f"board printed no port line in {timeout} s")
+        first = self.proc.stdout.readline()
+        if not first.startswith("port: "):
+            err = self.stop()
+            raise AssertionError(f"board said {first!r}; stderr: {err}")
+        return first[len("port: ") :].strip()
+
+    def stop(self, sig: int = signal.SIGTERM) -> str:
+        """Stop it (SIGTERM by default); return its stderr."""
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            _, err = self.proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            _, err = self.proc.communicate()
+        return err
+
+    def kill(self) -> None:
+        self.proc.kill()
+        self.proc.communicate()
+
+
+@contextmanager
+def board_process(*args: str) -> Iterator[BoardProcess]:
+    board = BoardProcess(*args)
+    try:
+        yield board
+    finally:
+        board.stop()
+
+
+def wait_for(predicate: object, timeout: float = 10.0) -> None:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if predicate():  # type: ignore[operator]
+            return
+        time.sleep(0.05)
+    raise AssertionError("condition not met in time")

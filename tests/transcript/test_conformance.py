@@ -1,0 +1,154 @@
+"""Conformance: the suite in transcripts/ against the simulated board, and the matcher."""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from appmode.protocol.transcript import parse_transcript, read_transcript
+from appmode.transcript.runner import run_live, run_virtual
+from tests.support.processes import ROOT, board_process, run
+
+SUITE = sorted((ROOT / "appmode" / "transcript" / "suite").glob("*.transcript"))
+
+
+def virtual(text: str) -> tuple[bool, str | None]:
+    result = run_virtual(parse_transcript("# appmode transcript v1\n" + text, "t.transcript"))
+    return result.passed, result.failure
+
+
+def test_the_suite_covers_the_protocol_clauses() -> None:
+    clauses = set()
+    for path in SUITE:
+        title = read_transcript(path).title
+        assert title.startswith("docs/protocol.md §"), f"{path.name} must open naming its clause"
+        clauses |= set(re.findall(r"§(\d(?:\.\d)?)", title))
+    assert {"2.1", "2.2", "3.3", "3.4", "4", "5"} <= clauses
+
+
+@pytest.mark.parametrize("path", SUITE, ids=lambda p: p.name)
+def test_suite_passes_against_the_simulated_board(path: Path) -> None:
+    result = run_virtual(read_transcript(path))
+    assert result.passed, result.failure
+
+
+def test_whole_suite_runs_in_well_under_a_second() -> None:
+    done = run("conform", "appmode/transcript/suite")
+    assert done.returncode == 0, done.stdout
+    assert done.stdout.count("PASS") == len(SUITE)
+    walls = [float(m) for m in re.findall(r"virtual time in ([\d.]+) s", done.stdout)]
+    assert len(walls) == len(SUITE) and sum(walls) < 1.0
+
+
+@pytest.mark.parametrize("path", SUITE, ids=lambda p: p.name)
+def test_a_wrong_expectation_fails_at_its_line(path: Path, tmp_path: Path) -> None:
+    lines = path.read_text().splitlines()
+    field = re.compile(r"((?:\{[A-Z])|:)(-?\d+)(?=[:}])")
+    expectations = [i for i, line in enumerate(lines) if " < " in line]
+    concrete = [i for i in expectations if field.search(lines[i].split(" < ")[1])]
+    if concrete:  # change one concrete field of the last such expectation
+        target = concrete[-1]
+        lines[target] = field.sub(lambda m: f"{m[1]}{int(m[2]) + 7}", lines[target], count=1)
+    else:  # only wildcards: expect another record letter
+        target = expectations[-1]
+        lines[target] = re.sub(r"< \{([A-Z])", "< {X", lines[target])
+    broken = tmp_path / path.name
+    broken.write_text("\n".join(lines) + "\n")
+    done = run("conform", str(broken))
+    assert done.returncode == 1
+    assert f"{broken}:{target + 1}: expected " in done.stdout, done.stdout
+
+
+def test_wildcards_and_unmentioned_telemetry() -> None:
+    assert virtual("0.1 > {Q:P}\n0.15 < {C*:*:*:*:*:*:*:*:*}$\n")[0]
+    assert virtual("0.1 > {Q:P}\n0.15 < {C500:*:*:*:*:*:*:*:0}$\n")[0]
+    passed, failure = virtual("0.1 > {Q:P}\n0.15 < {C501:*:*:*:*:*:*:*:0}$\n")
+    assert not passed and failure is not None
+    assert failure.startswith("t.transcript:3: expected {C501:*:*:*:*:*:*:*:0}$")
+    assert "got {C500:10000:20:0:10:10:10:0:0}$ at 0.1" in failure
+
+
+def test_expectations_match_in_order_and_not_before_their_commands() -> None:
+    # the A record showing 500 can only come after 'A' is sent
+    passed, failure = virtual("0.9 < {A0:500:0:0}$\n1.0 > JA\n")
+    assert not passed and failure is not None and ":2:" in failure
+    assert virtual("0.1 > JA\n1.0 < {A0:500:0:0}$\n1.1 > Z\n2.0 < {A0:0:0:0}$\n")[0]
+    passed, _ = virtual("0.1 > JA\n2.0 < {A0:0:0:0}$\n1.0 < {A0:500:0:0}$\n")
+    assert not passed
+
+
+def test_strict_mode_allows_no_unmentioned_record() -> None:
+    strict_ok = "@strict on\n0.0 < {A*:*:*:0}$\n0.05 < {B*:*:*:*}$\n0.1 < {A*:*:*:0}$\n"
+    assert virtual(strict_ok)[0]
+    passed, failure = virtual("@strict on\n0.0 < {A*:*:*:0}$\n0.1 < {A*:*:*:0}$\n")
+    assert not passed and failure is not None and "got {B0:0:0:100}$" in failure
+
+
+def test_align_times_the_rest_from_the_first_match() -> None:
+    text = "@align\n5.0 < {A*:*:*:0}$\n@tolerance 0.01\n5.05 < {B*:*:*:*}$\n5.10 < {A*:*:*:0}$\n"
+    assert virtual(text)[0]
+
+
+@pytest.mark.parametrize(
+    ("directive", "message"),
+    [
+        ("@tolerance soon", "@tolerance takes seconds"),
+        ("@strict maybe", "@strict takes on"),
+        ("@board wheels=3", "@board knows drive="),
+        ("@board drive=tank", "unknown drive type"),
+    ],
+)
+def test_bad_directives_are_errors(directive: str, message: str, tmp_path: Path) -> None:
+    path = tmp_path / "d.transcript"
+    path.write_text(f"# appmode transcript v1\n{directive}\n0.1 > Z\n")
+    done = run("conform", str(path))
+    assert done.returncode == 2 and f"{path}:2: " in done.stderr and message in done.stderr
+
+
+def test_board_drive_is_used_virtually_and_checked_live(tmp_path: Path) -> None:
+    text = "@board drive=diff\n0.1 > JC\n1.0 < {A0:0:500:0}$\n"
+    assert virtual(text)[0]
+    with board_process("--pty", "--no-pace", "--quiet") as board:
+        result = run_live(parse_transcript(text, "needs_diff.transcript"), board.url)
+    assert not result.passed and result.failure is not None
+    assert "needs_diff.transcript: needs a diff drive; the board at" in result.failure
+    assert "reports omni" in result.failure
+
+
+def test_recorded_console_session_conforms_and_an_edit_fails(tmp_path: Path) -> None:
+    record = tmp_path / "s.transcript"
+    script = b"set max_speed 800\ndrive A\nwait 0.5\npage button\ndrive G\nwait 0.5\nstop\n"
+    assert (
+        run("drive", "sim://?drive=mecanum", "--record", str(record), stdin=script).returncode == 0
+    )
+    done = run("conform", str(record))
+    assert done.returncode == 0, done.stdout
+    lines = record.read_text().splitlines()
+    target = next(i for i, line in enumerate(lines) if re.search(r"< \{A0:[1-9]", line))
+    lines[target] = lines[target].replace("{A0:", "{A1:")
+    record.write_text("\n".join(lines) + "\n")
+    done = run("conform", str(record))
+    assert done.returncode == 1 and f"{record}:{target + 1}: expected {{A1:" in done.stdout
+
+
+def test_junit_report(tmp_path: Path) -> None:
+    report = tmp_path / "junit.xml"
+    run("conform", "appmode/transcript/suite/s2_2_read_params.transcript", "--junit", str(report))
+    suite = ET.parse(report).getroot()
+    assert suite.get("tests") == "1" and suite.get("failures") == "0"
+
+
+def test_missing_paths_are_one_line_errors() -> None:
+    done = run("conform", "nowhere")
+    assert done.returncode == 2 and "no such transcript or directory: nowhere" in done.stderr
+
+
+def test_the_suite_passes_in_real_time_against_a_board_process() -> None:
+    """The whole suite over a pty, paced: about 100 s."""
+    with board_process("--pty", "--quiet") as board:
+        done = run("conform", "--board", board.url, "appmode/transcript/suite", timeout=400)
+    assert done.returncode == 0, done.stdout
+    assert f"{len(SUITE)} passed, 0 failed against /dev/" in done.stdout

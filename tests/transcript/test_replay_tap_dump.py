@@ -1,0 +1,206 @@
+"""replay (absolute deadlines), tap (both directions recorded), dump and plot."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import pty
+import select
+import signal
+import subprocess
+import sys
+import time
+import tty
+from pathlib import Path
+
+import pytest
+import serial
+
+from appmode.protocol.transcript import parse_transcript, read_transcript
+from appmode.transcript.replay import plan, play
+from tests.support.processes import ROOT, board_process, run
+
+SESSION = """# appmode transcript v1
+# a short session
+0.0000 > J
+0.1000 < {A0:0:0:0}$
+0.2000 > A
+0.3000 < {B3:0:0:100}$
+0.5000 < {A0:432:0:0}$
+0.6000 > Z
+0.7000 < {B0:0:0:99}$
+"""
+
+
+def session_file(tmp_path: Path) -> Path:
+    path = tmp_path / "session.transcript"
+    path.write_text(SESSION)
+    return path
+
+
+def test_play_keeps_absolute_deadlines_on_a_virtual_clock() -> None:
+    clock = {"now": 0.0}
+    sent: list[tuple[float, bytes]] = []
+
+    def sleep(seconds: float) -> None:
+        clock["now"] += seconds + 0.004  # every sleep overshoots by 4 ms
+
+    late = play(
+        [(0.01 * k, b"A") for k in range(100)],
+        lambda d: sent.append((clock["now"], d)),
+        clock=lambda: clock["now"],
+        sleep=sleep,
+    )
+    assert max(late) <= 0.0041, "overshoot never accumulates"
+    assert sent[-1][0] == pytest.approx(0.99, abs=0.005)
+
+
+def test_plan_speed_and_loops() -> None:
+    entries = [(e.time, e.direction, e.data) for e in parse_transcript(SESSION).entries]
+    assert [d for _, d in plan(entries, "host")] == [b"J", b"A", b"Z"]
+    assert next(d for _, d in plan(entries, "board")) == b"{A0:0:0:0}$"
+    times: list[float] = []
+    start = time.monotonic()
+    play(plan(entries, "host"), lambda d: times.append(time.monotonic() - start), speed=2, loops=2)
+    assert [round(t, 2) for t in times] == [0.0, 0.1, 0.3, 0.3, 0.4, 0.6]
+
+
+def test_replay_as_host_drives_a_board_and_ends_with_z(tmp_path: Path) -> None:
+    board_log = tmp_path / "board.transcript"
+    with board_process("--listen", "0", "--quiet", "--record", str(board_log)) as board:
+        done = run("replay", str(session_file(tmp_path)), "--to", board.url)
+    assert done.returncode == 0, done.stderr
+    assert "replayed 3 commands" in done.stderr
+    sent = [
+        (float(t), p)
+        for t, d, p in (line.split(" ", 2) for line in board_log.read_text().splitlines()[1:])
+        if d == ">"
+    ]
+    assert [p for _, p in sent] == ["J", "A", "Z", "Z"]
+    gaps = [sent[1][0] - sent[0][0], sent[2][0] - sent[1][0]]
+    assert gaps == [pytest.approx(0.2, abs=0.03), pytest.approx(0.4, abs=0.03)]
+
+
+def test_replay_as_board_feeds_an_app_on_a_pty(tmp_path: Path) -> None:
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    try:
+        proc = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "appmode",
+                "replay",
+                str(session_file(tmp_path)),
+                "--to",
+                os.ttyname(slave),
+                "--side",
+                "board",
+            ],
+            cwd=ROOT,
+            stderr=subprocess.PIPE,
+        )
+        received = b""
+        end = time.monotonic() + 10
+        while proc.poll() is None and time.monotonic() < end:
+            if select.select([master], [], [], 0.05)[0]:
+                received += os.read(master, 4096)
+        while select.select([master], [], [], 0.1)[0]:
+            received += os.read(master, 4096)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert received == b"{A0:0:0:0}${B3:0:0:100}${A0:432:0:0}${B0:0:0:99}$"
+
+
+def test_replay_errors(tmp_path: Path) -> None:
+    only_host = tmp_path / "host.transcript"
+    only_host.write_text("0.0 > J\n")
+    done = run("replay", str(only_host), "--to", "sim://", "--side", "board")
+    assert done.returncode == 2 and "has no '<' lines to play as the board" in done.stderr
+    done = run("replay", str(only_host), "--to", "sim://", "--speed", "0")
+    assert done.returncode == 2 and "--speed must be > 0" in done.stderr
+
+
+def test_tap_forwards_and_records_both_ways(tmp_path: Path) -> None:
+    record = tmp_path / "tap.transcript"
+    with board_process("--listen", "0", "--quiet", "--record", str(tmp_path / "b.t")) as board:
+        tap = subprocess.Popen(
+            [sys.executable, "-m", "appmode", "tap", "pty", board.url, "--record", str(record)],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert tap.stdout is not None
+        path = tap.stdout.readline().split("port: ")[1].strip()
+        app = serial.Serial(path, 9600, timeout=0.2)
+        app.write(b"{Q:P}JA")
+        got = b""
+        end = time.monotonic() + 5
+        while b"{C" not in got and time.monotonic() < end:
+            got += app.read(256)
+        app.close()
+        tap.send_signal(signal.SIGINT)
+        _, err = tap.communicate(timeout=10)
+        board_log = board.stop()
+    assert b"{C500:10000:20:0:10:10:10:0:0}$" in got
+    lines = record.read_text().splitlines()
+    sent = [line.split(" ", 2)[2] for line in lines if " > " in line]
+    assert sent == ["{Q:P}", "J", "A", "Z"], "the tap stops the car on its way out"
+    assert any(" < {C500:" in line for line in lines)
+    assert "bytes app->board" in err and "Traceback" not in board_log
+    board_sent = [
+        line.split(" ", 2)[2]
+        for line in (tmp_path / "b.t").read_text().splitlines()
+        if " > " in line
+    ]
+    assert board_sent[-1] == "Z"
+
+
+def test_dump_text_json_csv(tmp_path: Path) -> None:
+    path = session_file(tmp_path)
+    text = run("dump", str(path)).stdout
+    assert "0.500 < {A0:432:0:0}$" in text and "velocity x=0 y=432 z=0" in text
+    objects = [json.loads(line) for line in run("dump", str(path), "--json").stdout.splitlines()]
+    assert objects[0] == {
+        "t": 0.0,
+        "dir": ">",
+        "kind": "page",
+        "letter": "J",
+        "page": "direction",
+        "mode": "joystick",
+        "raw": "J",
+    }
+    rows = list(csv.DictReader(io.StringIO(run("dump", str(path), "--csv").stdout)))
+    assert rows[4]["kind"] == "velocity" and rows[4]["y"] == "432"
+    assert len(rows) == 7
+
+
+def test_plot_writes_a_png(tmp_path: Path) -> None:
+    record = tmp_path / "drive.transcript"
+    run(
+        "drive",
+        "--record",
+        str(record),
+        stdin=b"drive A\nwait 0.5\npage button\ndrive C\nwait 0.5\nstop\nwait 0.3\n",
+    )
+    image = tmp_path / "out.png"
+    done = run("plot", str(record), "-o", str(image))
+    assert done.returncode == 0, done.stderr
+    assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and image.stat().st_size > 20_000
+
+
+def test_plot_without_records_is_a_clear_error(tmp_path: Path) -> None:
+    path = tmp_path / "empty.transcript"
+    path.write_text("0.0 > J\n")
+    done = run("plot", str(path), "-o", str(tmp_path / "x.png"))
+    assert done.returncode == 2 and "has no A or B records to plot" in done.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_read_transcript_of_the_suite_is_consistent() -> None:
+    for path in (ROOT / "appmode" / "transcript" / "suite").glob("*.transcript"):
+        assert read_transcript(path).entries
