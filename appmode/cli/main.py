@@ -25,6 +25,7 @@ from appmode.cli import (
     tap,
 )
 from appmode.errors import AppmodeError
+from appmode.host.signals import ENDING_SIGNALS
 
 COMMANDS: tuple[ModuleType, ...] = (
     drive,
@@ -63,7 +64,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler: Handler = args.handler
-    signal.signal(signal.SIGTERM, _interrupt)
+    for signum in ENDING_SIGNALS:
+        signal.signal(signum, _interrupt)
     try:
         return handler(args)
     except AppmodeError as exc:
@@ -80,7 +82,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _interrupt(signum: int, frame: object) -> None:
-    """SIGTERM ends a command the way Ctrl-C does: cleanly, the car stopped."""
+    """SIGTERM and SIGHUP end a command the way Ctrl-C does: cleanly, the car stopped."""
     raise KeyboardInterrupt
 
 

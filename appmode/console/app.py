@@ -8,7 +8,6 @@ history): the status panel, the 3×3 key grid and arrows to drive, and a command
 from __future__ import annotations
 
 import asyncio
-import signal
 import time
 from collections.abc import Iterable
 from typing import TextIO
@@ -33,6 +32,7 @@ from appmode.console.session import (
     Session,
     ShowStatus,
 )
+from appmode.host.signals import ENDING_SIGNALS
 from appmode.host.tokens import Wait
 from appmode.protocol import params
 from appmode.protocol.directions import grid_for
@@ -175,11 +175,13 @@ async def run_app(app: Application[None], session: Session) -> None:
         app.create_background_task(ticker())
 
     loop = asyncio.get_running_loop()
-    loop.add_signal_handler(signal.SIGTERM, app.exit)
+    for signum in ENDING_SIGNALS:
+        loop.add_signal_handler(signum, app.exit)
     try:
         await app.run_async(pre_run=start_ticker)
     finally:
-        loop.remove_signal_handler(signal.SIGTERM)
+        for signum in ENDING_SIGNALS:
+            loop.remove_signal_handler(signum)
 
 
 def run_drive(

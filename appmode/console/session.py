@@ -158,7 +158,8 @@ class Session:
         self._send(letter.encode())
 
     def _send_letter(self, letter: str) -> None:
-        self._send(letter.encode())
+        """Send a letter; a stop ends an open frame first (its `Z` would be swallowed)."""
+        self._send(self.host.state.end.stop if letter == STOP_LETTER else letter.encode())
 
     def _send(self, data: bytes) -> bool:
         """Send, then follow what was sent: the page and the direction in force."""

@@ -190,11 +190,12 @@ class Host:
     # ------------------------------------------------------------ end
 
     def close(self) -> None:
-        """Stop the car (`Z` is the last byte sent), then close the port."""
+        """Stop the car (`Z` is the last byte sent, after `{}` if a frame is open), then
+        close the port."""
         if self._port is None:
             return
         with contextlib.suppress(AppmodeError, serial.SerialException, OSError):
-            self.send(b"Z")
+            self.send(self.state.end.stop)
             self._port.flush()
         if self._port is not None:
             self._port.close()

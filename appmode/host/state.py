@@ -80,6 +80,7 @@ class HostState:
         self.query: ParamQuery | None = None
         self._errors_at_start = 0
         self._outbox = bytearray()
+        self.end = app.SessionEnd()
 
     def feed(self, data: bytes, now: float) -> list[app.BoardEvent | Outcome]:
         """Decode board bytes; returns the events, and the outcome of a query they end."""
@@ -94,6 +95,7 @@ class HostState:
 
     def sent(self, data: bytes) -> None:
         self.stats.bytes_out += len(data)
+        self.end.sent(data)
 
     def start_query(self, query: ParamQuery, now: float) -> None:
         """Begin a parameter read or set; its bytes wait in the outbox."""

@@ -367,6 +367,11 @@ class HostDecoder:
             self._skip_len = 0
         return stop
 
+    @property
+    def in_frame(self) -> bool:
+        """Whether the bytes so far leave a frame open (a `Z` now would be part of it)."""
+        return bool(self._buf) or self._skip_len > 0
+
     def flush(self) -> list[HostEvent]:
         """Report what is held at the end of the stream (an unterminated frame)."""
         if not self._buf:
@@ -380,6 +385,29 @@ class HostDecoder:
         raw = bytes(self._buf)
         self._buf.clear()
         return [BadFrame(raw, reason)]
+
+
+ABANDON_FRAME = b"{}"
+"""Ends an open frame without applying it: `{` abandons the open frame (§2.2) and `{}` is
+an empty frame, which changes nothing."""
+
+
+class SessionEnd:
+    """Follows what a host sends, so that its last bytes stop the car (§2.1).
+
+    A `Z` sent while a frame is open is swallowed by the frame: then `{}` goes first.
+    """
+
+    def __init__(self) -> None:
+        self._decoder = HostDecoder()
+
+    def sent(self, data: bytes) -> None:
+        self._decoder.feed(data)
+
+    @property
+    def stop(self) -> bytes:
+        """The bytes that end the session with the car stopped."""
+        return (ABANDON_FRAME if self._decoder.in_frame else b"") + encode(Stop())
 
 
 def _overlong(length: int, done: bool = False) -> str:

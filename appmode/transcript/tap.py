@@ -20,6 +20,7 @@ from typing import Protocol
 import serial
 
 from appmode.ports.link import open_link
+from appmode.protocol.app import SessionEnd
 from appmode.protocol.transcript import Recorder
 
 READ_TIMEOUT = 0.05
@@ -80,6 +81,7 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
     stop = threading.Event()
     origin = time.monotonic()
     counts = {">": 0, "<": 0}
+    end = SessionEnd()  # what the app sent: its frame may be open when it leaves
     errors: list[str] = []
 
     def forward(src: Port, dst: Port, direction: str, name: str) -> None:
@@ -95,6 +97,8 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
             if data:
                 with lock:
                     counts[direction] += len(data)
+                    if direction == ">":
+                        end.sent(data)
                     recorder(direction, time.monotonic() - origin, data)
 
     threads = [
@@ -119,8 +123,8 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
         for thread in threads:  # stop the readers before closing their ports
             thread.join(2)
         with contextlib.suppress(serial.SerialException, OSError):
-            board.write(b"Z")  # the app can no longer stop the car
-            recorder(">", time.monotonic() - origin, b"Z")
+            board.write(end.stop)  # the app can no longer stop the car
+            recorder(">", time.monotonic() - origin, end.stop)
         board.close()
         app.close()
         recorder.close()

@@ -11,7 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from tests.support.processes import ROOT, board_process
+from appmode.protocol import params
+from tests.support.processes import ROOT, board_process, board_state, sent_lines, wait_for
 
 SESSION = "appmode-test"
 
@@ -120,3 +121,22 @@ def test_sigterm_ends_script_mode_with_z_last(tmp_path: Path) -> None:
     proc.wait(10)
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
     assert "A" in sent and sent[-1] == "Z"
+
+
+def test_closing_the_terminal_ends_the_console_with_the_car_stopped(tmp_path: Path) -> None:
+    """tmux kill-session: the console gets SIGHUP, as from a closed terminal window."""
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched {board.url}"
+        tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+        try:
+            wait_screen(r"params\s+max_speed 500")
+            tmux("send-keys", "-t", SESSION, "w")
+            wait_screen(r"in force\s+A forward")
+            pid = int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+        finally:
+            tmux("kill-session", "-t", SESSION)
+        wait_for(lambda: not Path(f"/proc/{pid}").exists())
+        sent = sent_lines(record)
+        assert "A" in sent and sent[-1] == "Z", sent[-5:]
+        assert board_state(board.url) == ((0, 0, 0), tuple(params.DEFAULTS))

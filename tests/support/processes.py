@@ -89,3 +89,32 @@ def wait_for(predicate: object, timeout: float = 10.0) -> None:
             return
         time.sleep(0.05)
     raise AssertionError("condition not met in time")
+
+
+def board_state(url: str, seconds: float = 1.5) -> tuple[tuple[int, int, int], tuple[int, ...]]:
+    """What a served board is doing now, read from its own telemetry as a new client:
+    the last velocity (x, y, z) after `seconds` (long enough for a stopped car's speed
+    to decay to 0) and its parameters (`{Q:P}`, which changes no motion)."""
+    import serial
+
+    from appmode.protocol.app import BoardDecoder, ParamsRecord, Velocity
+
+    decoder = BoardDecoder()
+    velocity: tuple[int, int, int] | None = None
+    values: tuple[int, ...] = ()
+    with serial.serial_for_url(url, baudrate=9600, timeout=0.05) as port:
+        port.write(b"{Q:P}")
+        end = time.monotonic() + seconds
+        while time.monotonic() < end or velocity is None or not values:
+            assert time.monotonic() < end + 5, "the board sent no telemetry"
+            for event in decoder.feed(port.read(256)):
+                if isinstance(event, Velocity):
+                    velocity = (event.x, event.y, event.z)
+                elif isinstance(event, ParamsRecord):
+                    values = event.values
+    return velocity, values
+
+
+def sent_lines(record: Path) -> list[str]:
+    """The `>` payloads of a transcript, in order."""
+    return [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]

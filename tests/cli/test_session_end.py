@@ -1,0 +1,161 @@
+"""Whatever ends a host session, the car is stopped (docs/protocol.md §2.1, §2.2).
+
+SIGHUP (a closed terminal, a dropped SSH connection) ends every host command as SIGTERM
+and Ctrl-C do, and a session that leaves a frame open ends it before its `Z`, which a
+frame would otherwise swallow. Each test checks the board's own state afterwards.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+import serial
+
+from appmode.host.client import Host
+from appmode.ports.sim import SimSerial
+from appmode.protocol import params
+from tests.support.processes import (
+    ROOT,
+    appmode_cmd,
+    board_process,
+    board_state,
+    run,
+    sent_lines,
+    wait_for,
+)
+
+STOPPED = (0, 0, 0)
+DEFAULTS = tuple(params.DEFAULTS)
+
+LONG_REPLAY = "# appmode transcript v1\n0.000 > J\n0.050 > A\n30.000 > Z\n"
+OPEN_FRAME_REPLAY = "# appmode transcript v1\n0.000 > J\n0.050 > A\n0.100 > {0:8\n"
+
+
+def _start(args: list[str], stdin: bytes = b"") -> subprocess.Popen[bytes]:
+    proc = subprocess.Popen(
+        appmode_cmd(*args),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None
+    proc.stdin.write(stdin)
+    proc.stdin.flush()
+    return proc
+
+
+@pytest.mark.parametrize("command", ["send", "drive", "replay"])
+def test_sighup_ends_a_host_command_with_the_car_stopped(command: str, tmp_path: Path) -> None:
+    record = tmp_path / "board.transcript"
+    replay = tmp_path / "long.transcript"
+    replay.write_text(LONG_REPLAY)
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        args, stdin = {
+            "send": (["send", board.url, "J", "A", "wait:30"], b""),
+            "drive": (["drive", board.url], b"drive A\nwait 30\n"),
+            "replay": (["replay", str(replay), "--to", board.url], b""),
+        }[command]
+        proc = _start(args, stdin)
+        try:
+            wait_for(lambda: record.exists() and "A" in sent_lines(record))
+            proc.send_signal(signal.SIGHUP)
+            proc.communicate(timeout=10)
+        finally:
+            proc.kill()
+        sent = sent_lines(record)
+        assert sent[-1] == "Z", sent[-5:]
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_sighup_ends_monitor_with_its_summary(tmp_path: Path) -> None:
+    with board_process("--pty", "--quiet") as board:
+        proc = _start(["monitor", board.url])
+        try:
+            assert proc.stdout is not None
+            proc.stdout.readline()  # a record came: monitoring
+            proc.send_signal(signal.SIGHUP)
+            _, err = proc.communicate(timeout=10)
+        finally:
+            proc.kill()
+    assert "monitor: " in err.decode() and " records, " in err.decode()
+    assert "Traceback" not in err.decode()
+
+
+def test_sighup_ends_tap_with_the_car_stopped(tmp_path: Path) -> None:
+    record = tmp_path / "tap.transcript"
+    with board_process("--pty", "--quiet") as board:
+        proc = _start(["tap", "pty", board.url, "--record", str(record), "--quiet"])
+        try:
+            assert proc.stdout is not None
+            app_side = proc.stdout.readline().decode().removeprefix("port: ").strip()
+            with serial.Serial(app_side, 9600, timeout=0.1) as app:
+                app.write(b"JA")
+                wait_for(lambda: record.exists() and "A" in sent_lines(record))
+                proc.send_signal(signal.SIGHUP)
+                proc.communicate(timeout=10)
+        finally:
+            proc.kill()
+        assert sent_lines(record)[-1] == "Z"
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+@pytest.mark.parametrize(
+    "tokens",
+    [["J", "A", "\\x7b"], ["--raw", "J", "A", "{0:8"], ["--raw", "J", "A", "{Q:P"]],
+    ids=["escaped-brace", "raw-set-frame", "read-frame"],
+)
+def test_send_ending_inside_a_frame_still_stops_the_car(tokens: list[str]) -> None:
+    with board_process("--pty", "--quiet") as board:
+        done = run("send", board.url, *tokens, "--listen", "0")
+        assert done.returncode == 0, done.stderr
+        # the open frame is abandoned, never applied: max_speed is still the default
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_replay_ending_inside_a_frame_still_stops_the_car(tmp_path: Path) -> None:
+    replay = tmp_path / "open.transcript"
+    replay.write_text(OPEN_FRAME_REPLAY)
+    with board_process("--pty", "--quiet") as board:
+        done = run("replay", str(replay), "--to", board.url)
+        assert done.returncode == 0, done.stderr
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_an_app_leaving_tap_inside_a_frame_leaves_the_car_stopped(tmp_path: Path) -> None:
+    record = tmp_path / "tap.transcript"
+    with board_process("--pty", "--quiet") as board:
+        proc = _start(["tap", "pty", board.url, "--record", str(record), "--quiet"])
+        try:
+            assert proc.stdout is not None
+            app_side = proc.stdout.readline().decode().removeprefix("port: ").strip()
+            with serial.Serial(app_side, 9600, timeout=0.1) as app:
+                app.write(b"JA{0:8")
+                wait_for(lambda: record.exists() and "A" in sent_lines(record))
+                time.sleep(0.3)  # the open frame is held by the recorder, not yet written
+            proc.send_signal(signal.SIGTERM)
+            proc.communicate(timeout=10)
+        finally:
+            proc.kill()
+        assert sent_lines(record)[-2:] == ["{}", "Z"] or sent_lines(record)[-1] == "{}Z"
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_host_close_ends_an_open_frame_then_stops() -> None:
+    ports: list[SimSerial] = []
+
+    def opener(url: str) -> SimSerial:
+        ports.append(SimSerial(url, timeout=0.05))
+        return ports[-1]
+
+    with Host("sim://?pace=0", opener=opener) as host:
+        host.send(b"JA{0:8")
+        host.poll(0.2)
+        assert ports[0].board.direction != 0  # driving, inside a frame
+    board = ports[0].board
+    assert board.direction == 0
+    assert board.params == list(DEFAULTS)
