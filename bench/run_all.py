@@ -90,6 +90,10 @@ def bench_decoder(quick: bool) -> list[Row]:
             f"{r['naive_rps']:,.0f} records/s; appmode {r['speedup']:.1f}x",
             ">= 2x",
         ),
+        *(
+            (f"garbage: {name}", f"{rate:.2f} MB/s", "linear (MB/s of the order of clean)")
+            for name, rate in decoder.garbage(0.5 if quick else decoder.GARBAGE_MB).items()
+        ),
     ]
 
 

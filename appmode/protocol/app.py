@@ -449,11 +449,11 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
 
 
 _FAST = re.compile(
-    rb"(.*?)(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)",
-    re.DOTALL,
+    rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)"
 )
-"""What comes before the next complete A or B record, and that record: the common case,
-decoded without the general path."""
+"""A complete A or B record: the common case, decoded without the general path. It opens
+with a literal `{`, so the search skips to each `{` and fails within a few bytes there:
+linear in the input, whatever it holds."""
 _FAST_KIND = {0x41: Velocity, 0x42: Attitude}
 
 
@@ -475,8 +475,11 @@ class BoardDecoder:
         out: list[BoardEvent] = []
         append, general, kind = out.append, self._general, _FAST_KIND
         pos = 0
-        # findall does the scanning in C: each gap before a fast record goes the general way
-        for gap, raw, x, y, z, w in _FAST.findall(buf):
+        # split scans in C: [gap, record, x, y, z, w, gap, record, …, gap]; each gap
+        # goes the general way, the last one held if it may continue
+        parts = _FAST.split(buf)
+        for i in range(0, len(parts) - 1, 6):
+            gap, raw, x, y, z, w = parts[i : i + 6]
             if gap:
                 general(buf, pos, pos + len(gap), out, False)
                 pos += len(gap)

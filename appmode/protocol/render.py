@@ -97,21 +97,26 @@ def describe(event: p.Event) -> str:
 
 
 def coalesce(events: Iterable[p.Event]) -> Iterator[p.Event]:
-    """Merge adjacent Noise or Garbage events into one event per run of bytes."""
-    pending: p.Noise | p.Garbage | None = None
+    """Merge adjacent Noise or Garbage events into one event per run of bytes (in time
+    linear in the run: the pieces are joined once, when the run ends)."""
+    run: list[p.Noise | p.Garbage] = []
     for event in events:
-        if pending is not None and type(event) is type(pending):
-            pending = type(pending)(pending.raw + event.raw)
+        if run and type(event) is type(run[0]):
+            run.append(event)
             continue
-        if pending is not None:
-            yield pending
-            pending = None
+        if run:
+            yield _joined(run)
+            run = []
         if isinstance(event, (p.Noise, p.Garbage)):
-            pending = event
+            run.append(event)
         else:
             yield event
-    if pending is not None:
-        yield pending
+    if run:
+        yield _joined(run)
+
+
+def _joined(run: list[p.Noise | p.Garbage]) -> p.Noise | p.Garbage:
+    return run[0] if len(run) == 1 else type(run[0])(b"".join(e.raw for e in run))
 
 
 def line(time: float, direction: str, raw: bytes, text: str) -> str:

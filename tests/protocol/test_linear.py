@@ -1,0 +1,46 @@
+"""Every decoder runs in time linear in its input, whatever the input holds: a capture at
+the wrong baud rate is all garbage. The bound is generous (a quadratic decoder takes
+minutes on these inputs, a linear one well under a second); bench/decoder.py measures."""
+
+from __future__ import annotations
+
+import random
+import time
+
+import pytest
+
+from appmode.protocol.app import BoardDecoder, Garbage, HostDecoder, Noise
+from appmode.protocol.render import coalesce
+
+SIZE = 1_000_000
+BOUND = 20.0  # seconds, for a megabyte
+INPUTS = {
+    "random": random.Random(5).randbytes(SIZE),
+    "braces": b"{" * SIZE,
+    "digits": b"{A" + b"7" * SIZE,
+    "record-prefixes": b"{A1:2:3" * (SIZE // 7),
+}
+
+
+@pytest.mark.parametrize("decoder", [BoardDecoder, HostDecoder])
+@pytest.mark.parametrize("name", list(INPUTS))
+def test_a_megabyte_of_garbage_decodes_within_a_generous_bound(
+    decoder: type[BoardDecoder] | type[HostDecoder], name: str
+) -> None:
+    data = INPUTS[name]
+    start = time.perf_counter()
+    whole = decoder()
+    events = [*whole.feed(data), *whole.flush()]
+    elapsed = time.perf_counter() - start
+    assert b"".join(e.raw for e in events) == data
+    assert elapsed < BOUND, f"{name}: {elapsed:.1f} s for {len(data)} bytes"
+
+
+def test_coalescing_a_long_run_is_linear() -> None:
+    pieces = [Garbage(b"x")] * (2 * SIZE) + [Noise(b"q")] * 1000
+    start = time.perf_counter()
+    merged = list(coalesce(pieces))
+    elapsed = time.perf_counter() - start
+    assert [type(e) for e in merged] == [Garbage, Noise]
+    assert merged[0].raw == b"x" * (2 * SIZE) and merged[1].raw == b"q" * 1000
+    assert elapsed < BOUND
