@@ -24,20 +24,30 @@ def decode_chunks(chunks: Iterable[bytes], source: str) -> Iterator[app.Event]:
     yield from decoder.flush()
 
 
-def read_chunks(stream: BinaryIO) -> Iterator[bytes]:
-    """Chunks as they arrive (a pipe from a live port is decoded as it goes)."""
+def read_chunks(stream: BinaryIO, name: str, out: TextIO) -> Iterator[bytes]:
+    """Chunks as they arrive (a pipe from a live port is decoded as it goes): what was
+    written is flushed before each read, so output keeps up without a flush a line."""
     read = getattr(stream, "read1", stream.read)
-    while chunk := read(CHUNK):
+    while True:
+        out.flush()
+        try:
+            chunk = read(CHUNK)
+        except OSError as exc:
+            raise AppmodeError(f"cannot read {name}: {exc.strerror}") from None
+        if not chunk:
+            return
         yield chunk
 
 
-def run_decode(stream: BinaryIO, out: TextIO, source: str) -> int:
+def run_decode(stream: BinaryIO, out: TextIO, source: str, name: str = "standard input") -> int:
     """Write one JSON object a line; returns the number of undecodable runs."""
     errors = 0
-    for event in coalesce(decode_chunks(read_chunks(stream), source)):
+    encode = json.JSONEncoder(ensure_ascii=False).encode  # built once: dumps builds one a call
+    write = out.write
+    for event in coalesce(decode_chunks(read_chunks(stream, name, out), source)):
         errors += isinstance(event, app.ERRORS)
-        out.write(json.dumps(to_json(event), ensure_ascii=False) + "\n")
-        out.flush()
+        write(encode(to_json(event)) + "\n")
+    out.flush()
     return errors
 
 
@@ -64,8 +74,9 @@ def run(args: argparse.Namespace) -> int:
         run_decode(sys.stdin.buffer, sys.stdout, args.source)
         return 0
     try:
-        with open(args.file, "rb") as stream:
-            run_decode(stream, sys.stdout, args.source)
+        stream = open(args.file, "rb")  # noqa: SIM115 - closed below
     except OSError as exc:
         raise AppmodeError(f"cannot read {args.file}: {exc.strerror}") from None
+    with stream:
+        run_decode(stream, sys.stdout, args.source, args.file)
     return 0
