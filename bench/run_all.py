@@ -24,6 +24,7 @@ import tty
 from collections.abc import Callable
 from pathlib import Path
 
+import decode_command
 import decoder
 import link_pacing
 import link_roundtrip
@@ -94,6 +95,18 @@ def bench_decoder(quick: bool) -> list[Row]:
             (f"garbage: {name}", f"{rate:.2f} MB/s", "linear (MB/s of the order of clean)")
             for name, rate in decoder.garbage(0.5 if quick else decoder.GARBAGE_MB).items()
         ),
+    ]
+
+
+def bench_decode_command(quick: bool) -> list[Row]:
+    r = decode_command.compare(2.0 if quick else 10.0)
+    return [
+        (
+            f"appmode decode FILE, {r['mb']:.0f} MB, 1 % noise",
+            f"{r['mb'] / r['ours']:.2f} MB/s; the same-JSON byte loop "
+            f"{r['mb'] / r['loop']:.2f} MB/s; appmode {r['speedup']:.2f}x",
+            ">= 1.5x the loop",
+        )
     ]
 
 
@@ -357,6 +370,7 @@ def main() -> None:
         ("decoder", lambda: bench_decoder(quick)),
         ("board model", bench_model_steps),
         ("key latency", lambda: bench_key_latency(100 if quick else 300)),
+        ("decode command", lambda: bench_decode_command(quick)),
         ("board CPU", lambda: bench_board_cpu(10 if quick else 30)),
         ("drive CPU", lambda: bench_drive_cpu(10 if quick else 30)),
         ("200 boards", lambda: [bench_many_boards(200, 5 if quick else 15)]),

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Iterable, Iterator
 from typing import BinaryIO, TextIO
@@ -11,7 +10,7 @@ from typing import BinaryIO, TextIO
 from appmode.cli.options import Subparsers
 from appmode.errors import AppmodeError
 from appmode.protocol import app
-from appmode.protocol.render import coalesce, to_json
+from appmode.protocol.render import coalesce, json_line
 
 CHUNK = 65536
 
@@ -42,11 +41,10 @@ def read_chunks(stream: BinaryIO, name: str, out: TextIO) -> Iterator[bytes]:
 def run_decode(stream: BinaryIO, out: TextIO, source: str, name: str = "standard input") -> int:
     """Write one JSON object a line; returns the number of undecodable runs."""
     errors = 0
-    encode = json.JSONEncoder(ensure_ascii=False).encode  # built once: dumps builds one a call
     write = out.write
     for event in coalesce(decode_chunks(read_chunks(stream, name, out), source)):
         errors += isinstance(event, app.ERRORS)
-        write(encode(to_json(event)) + "\n")
+        write(json_line(event) + "\n")
     out.flush()
     return errors
 

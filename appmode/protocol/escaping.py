@@ -10,12 +10,16 @@ import re
 
 _TABLE = [chr(b) if 0x21 <= b <= 0x7E else f"\\x{b:02x}" for b in range(256)]
 _TABLE[0x5C] = "\\\\"
+_TEXT_TABLE = {b: text for b, text in enumerate(_TABLE) if text != chr(b)}
+_PLAIN = re.compile(rb"[\x21-\x5b\x5d-\x7e]*")
 _TOKEN = re.compile(r"\\(?:x([0-9a-fA-F]{2})|(\\))|([\x21-\x5b\x5d-\x7e])")
 
 
 def escape(data: bytes) -> str:
     """`data` as printable ASCII."""
-    return "".join(_TABLE[b] for b in data)
+    if _PLAIN.fullmatch(data):  # the common case: it stands for itself
+        return data.decode("ascii")
+    return data.decode("latin-1").translate(_TEXT_TABLE)
 
 
 def unescape(text: str) -> bytes:

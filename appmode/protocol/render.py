@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -65,6 +66,31 @@ def to_json(event: p.Event) -> dict[str, Any]:
         body["terminated"] = False
     body["raw"] = escape(event.raw)
     return body
+
+
+_JSON = json.JSONEncoder(ensure_ascii=False).encode
+
+
+def json_line(event: p.Event) -> str:
+    """`to_json(event)` as `json.dumps(…, ensure_ascii=False)` writes it. The common
+    records (whole A and B records) are formatted directly: `appmode decode` spends its
+    time here."""
+    kind = type(event)
+    if (kind is p.Velocity or kind is p.Attitude) and event.terminated:  # type: ignore[union-attr]
+        raw = escape(event.raw)
+        if '"' not in raw and "\\" not in raw:
+            if kind is p.Velocity:
+                v: p.Velocity = event  # type: ignore[assignment]
+                return (
+                    f'{{"kind": "velocity", "x": {v.x}, "y": {v.y}, "z": {v.z}, '
+                    f'"extra": {v.extra}, "raw": "{raw}"}}'
+                )
+            a: p.Attitude = event  # type: ignore[assignment]
+            return (
+                f'{{"kind": "attitude", "pitch": {a.pitch}, "roll": {a.roll}, '
+                f'"yaw": {a.yaw}, "battery": {a.battery}, "raw": "{raw}"}}'
+            )
+    return _JSON(to_json(event))
 
 
 def describe(event: p.Event) -> str:
