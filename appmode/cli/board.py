@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import Subparsers, add_record
+from appmode.cli.options import Subparsers, add_record, number_type
 from appmode.protocol.params import DRIVE_NAMES
 
 
@@ -33,7 +33,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     board.add_argument(
         "--count",
-        type=int,
+        type=number_type(1, 1000, whole=True),
         default=1,
         metavar="N",
         help="serve N boards, each on its own pty, from this one process (default 1)",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.cli.options import Subparsers, add_record
+from appmode.cli.options import Subparsers, add_record, number_type
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 
@@ -29,7 +29,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     drive.add_argument(
         "--hold-first",
-        type=float,
+        type=number_type(0, 60, low_open=True),
         default=FIRST_TIMEOUT,
         metavar="S",
         help="stop this long after a first key press with no repeat; longer "
@@ -37,7 +37,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     drive.add_argument(
         "--hold-repeat",
-        type=float,
+        type=number_type(0, 60, low_open=True),
         default=REPEAT_TIMEOUT,
         metavar="S",
         help=f"stop this long after the last auto-repeat (default {REPEAT_TIMEOUT})",

@@ -17,12 +17,18 @@ from appmode.protocol.transcript import Recorder
 
 
 def open_host(stack: ExitStack, url: str, record: str | None) -> Host:
-    recorder = (
-        stack.enter_context(closing(Recorder.create(record, 0.0, sim_directives(url))))
-        if record
-        else None
-    )
-    return stack.enter_context(Host(url, tap=recorder))
+    """The host, then its recording: a URL that does not open leaves the file untouched.
+    The recording is closed after the host, so it holds the final stop."""
+    host = Host(url)
+    try:
+        recorder = Recorder.create(record, 0.0, sim_directives(url)) if record else None
+    except BaseException:
+        host.close()
+        raise
+    if recorder is not None:
+        stack.enter_context(closing(recorder))
+        host.tap = recorder
+    return stack.enter_context(host)
 
 
 def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:

@@ -8,7 +8,7 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.cli.hostio import open_host, show
-from appmode.cli.options import Subparsers, add_record, add_url
+from appmode.cli.options import DAY, Subparsers, add_record, add_url, number_type
 from appmode.host.state import LinkStatus
 
 
@@ -21,8 +21,15 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_url(mon)
     mon.add_argument("--json", action="store_true", help="print JSON Lines")
-    mon.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
-    mon.add_argument("--count", type=int, metavar="N", help="stop after N records")
+    mon.add_argument(
+        "--duration",
+        type=number_type(0, DAY, low_open=True),
+        metavar="SECONDS",
+        help="stop after this long",
+    )
+    mon.add_argument(
+        "--count", type=number_type(1, 1e9, whole=True), metavar="N", help="stop after N records"
+    )
     add_record(mon)
     return mon
 

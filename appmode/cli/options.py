@@ -3,12 +3,18 @@
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable
 from typing import TypeAlias
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
     "rfc2217://HOST:PORT, loop:// or sim:// (the simulated board)"
 )
+
+
+DAY = 86400.0
+"""The longest wait any command takes: longer is surely a typing error."""
 
 
 def add_url(parser: argparse.ArgumentParser) -> None:
@@ -23,3 +29,26 @@ def add_record(parser: argparse.ArgumentParser) -> None:
 
 Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
 """What `add_subparsers()` returns."""
+
+
+def number_type(
+    low: float, high: float, *, whole: bool = False, low_open: bool = False
+) -> Callable[[str], float]:
+    """An argparse type: a finite number in [low, high] (or (low, high] with `low_open`),
+    written in ASCII; anything else is refused with the range, so nothing can hang on
+    `inf`, `nan` or a speed of 1e-308."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text) if text.isascii() else math.nan
+        except ValueError:
+            value = math.nan
+        inside = (low < value if low_open else low <= value) and value <= high
+        if not inside or (whole and value != int(value)):
+            kind = "a whole number" if whole else "a number"
+            left = "(" if low_open else "["
+            span = f"{left}{low:,.10g}, {high:,.10g}]"
+            raise argparse.ArgumentTypeError(f"{text!r} is not {kind} in {span}")
+        return int(value) if whole else value
+
+    return parse

@@ -50,12 +50,13 @@ def parse_assignment(text: str) -> tuple[int, int]:
     if not sep:
         raise AppmodeError(f"--set {text!r}: expected NAME=VALUE, e.g. max_speed=800")
     param = params.lookup(name.strip())
-    if not value.strip().isdigit():
+    number = params.whole(value)
+    if number is None:
         raise AppmodeError(
             f"--set {text!r}: {param.name} takes a whole number in {param.range_text}"
         )
-    params.check_value(param.index, int(value))
-    return param.index, int(value)
+    params.check_value(param.index, number)
+    return param.index, number
 
 
 def run_params(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, number_type
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -25,13 +25,17 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     replay.add_argument(
         "--speed",
-        type=float,
+        type=number_type(0.001, 1000),
         default=1.0,
         metavar="X",
         help="time factor: 2 plays twice as fast (default 1)",
     )
     replay.add_argument(
-        "--loop", type=int, default=1, metavar="N", help="play it N times (default 1)"
+        "--loop",
+        type=number_type(1, 1e6, whole=True),
+        default=1,
+        metavar="N",
+        help="play it N times (default 1)",
     )
     return replay
 

@@ -8,7 +8,7 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.cli.hostio import open_host, show
-from appmode.cli.options import Subparsers, add_record, add_url
+from appmode.cli.options import DAY, Subparsers, add_record, add_url, number_type
 from appmode.host.tokens import Wait, parse_token
 from appmode.protocol.app import HostDecoder
 from appmode.protocol.render import describe, line
@@ -27,7 +27,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     send.add_argument("tokens", nargs="+", metavar="TOKEN", help="what to send")
     send.add_argument(
         "--listen",
-        type=float,
+        type=number_type(0, DAY),
         default=0.3,
         metavar="SECONDS",
         help="how long to print replies after the last token (default 0.3)",

@@ -262,9 +262,10 @@ class Session:
         elif name in ("params", "read"):
             self.read_params()
         elif name == "set":
-            if len(args) != 2 or not args[1].isdigit():
+            value = params.whole(args[1]) if len(args) == 2 else None
+            if value is None:
                 raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
-            self.set_param(params.lookup(args[0]).index, int(args[1]))
+            self.set_param(params.lookup(args[0]).index, value)
         elif name == "save":
             self.save()
         elif name == "speed":
@@ -301,13 +302,13 @@ class Session:
         return None
 
     def _speed(self, args: list[str]) -> None:
-        if len(args) != 1 or not args[0].lstrip("+-").isdigit():
+        number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
+        if number is None:
             raise AppmodeError("usage: speed +N, speed -N or speed N")
-        text = args[0]
-        if text[0] in "+-":
-            self.change_speed(int(text))
+        if args[0][0] in "+-":
+            self.change_speed(-number if args[0][0] == "-" else number)
         else:
-            self.set_param(params.MAX_SPEED, int(text))
+            self.set_param(params.MAX_SPEED, number)
 
     def _send_tokens(self, tokens: list[str]) -> None:
         if not tokens:

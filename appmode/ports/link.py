@@ -18,6 +18,7 @@ from urllib.parse import parse_qs
 import serial
 
 from appmode.errors import AppmodeError
+from appmode.protocol import params
 
 if "appmode.ports" not in serial.protocol_handler_packages:
     serial.protocol_handler_packages.append("appmode.ports")  # sim:// (protocol_sim.py)
@@ -59,9 +60,9 @@ def parse_device(url: str) -> tuple[str, int]:
     for name, values in parse_qs(query, keep_blank_values=True).items():
         if name != "baud":
             raise AppmodeError(f"unknown option {name!r} in {url!r}: only ?baud=N is known")
-        if not values[-1].isdigit() or int(values[-1]) == 0:
+        if not params.whole(values[-1]):
             raise AppmodeError(f"bad baud rate {values[-1]!r} in {url!r}: use e.g. ?baud=9600")
-        baud = int(values[-1])
+        baud = int(values[-1].strip())
     return path, baud
 
 

@@ -25,6 +25,7 @@ from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.wire import Tap, Wire
 from appmode.ports.link import BAUD, explain_open_error, parse_device
+from appmode.protocol import params
 from appmode.protocol.params import DriveType
 from appmode.protocol.transcript import Recorder
 
@@ -254,9 +255,10 @@ Endpoint = PtyEndpoint | TcpEndpoint | SerialEndpoint
 def parse_listen(text: str) -> tuple[str, int]:
     """`PORT` or `HOST:PORT` (host 127.0.0.1 by default)."""
     host, _, port = text.rpartition(":")
-    if not port.isdigit() or int(port) > 65535:
+    number = params.whole(port)
+    if number is None or number > 65535:
         raise AppmodeError(f"--listen {text!r}: expected HOST:PORT or PORT, e.g. 127.0.0.1:5000")
-    return host.strip("[]") or "127.0.0.1", int(port)
+    return host.strip("[]") or "127.0.0.1", number
 
 
 @dataclass

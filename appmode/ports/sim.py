@@ -22,10 +22,14 @@ from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec, FaultyLine
 from appmode.line.wire import Wire
+from appmode.protocol import params
 from appmode.protocol.params import DriveType
 
 OPTIONS = ("drive", "flash", "pace", "baud", "faults")
 WRITE_BUFFER = 4096
+MIN_BAUD, MAX_BAUD = 300, 4_000_000
+"""Paced rates a simulated line takes: below 300 bps closing (which waits for what is
+queued to go out) could take minutes."""
 """Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
 USAGE = (
     "sim://[?drive=omni|mecanum|diff|diff-gyro][&flash=FILE][&pace=1|0][&baud=9600]"
@@ -86,9 +90,13 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         except ValueError as exc:
             raise SerialException(f"sim:// option drive: {exc}") from None
         if "baud" in options:
-            if not options["baud"].isdigit() or int(options["baud"]) <= 0:
-                raise SerialException(f"sim:// option baud={options['baud']!r}: use a number")
-            self._baudrate = int(options["baud"])
+            baud = params.whole(options["baud"])
+            if baud is None or not MIN_BAUD <= baud <= MAX_BAUD:
+                raise SerialException(
+                    f"sim:// option baud={options['baud']!r}: use a number in "
+                    f"{MIN_BAUD}–{MAX_BAUD}"
+                )
+            self._baudrate = baud
         pace = _flag("pace", options.get("pace", "1"))
         try:
             store = open_store(options.get("flash"))

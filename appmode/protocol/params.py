@@ -135,10 +135,19 @@ def check_value(index: int, value: int) -> None:
         raise ValueError(error)
 
 
+def whole(text: str) -> int | None:
+    """`text` as a whole number if it is one written in ASCII digits (not `١٢`, not `+1`),
+    short enough for Python to read (4,000 digits); else None."""
+    text = text.strip()
+    if text.isascii() and text.isdigit() and len(text) <= 4000:
+        return int(text)
+    return None
+
+
 def lookup(key: str | int) -> Param:
     """A parameter by name or index (as text or int); ValueError lists the valid names."""
-    if isinstance(key, int) or key.isdigit():
-        index = int(key)
+    index = key if isinstance(key, int) else whole(key)
+    if index is not None:
         if 0 <= index < PARAM_COUNT:
             return PARAMS[index]
     elif key in BY_NAME:

@@ -12,6 +12,9 @@ from appmode.protocol.escaping import escape, unescape
 
 HEADER = "# appmode transcript v1"
 SUFFIX = ".transcript"
+MAX_TIME = 86400.0
+"""The latest time a line may have: a day. Later is surely a mistake, and a run to it
+could not finish."""
 
 
 class Recorder:
@@ -123,7 +126,10 @@ def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
     """Read transcript text; TranscriptError names the file, the line and what is wrong."""
     items: list[Entry | Directive] = []
     title = ""
-    for lineno, line in enumerate(text.splitlines(), start=1):
+    text = text.removeprefix("\ufeff")  # a BOM some editors write
+    # lines end at \n only: form feeds and U+2028 in comments do not shift line numbers
+    for lineno, line in enumerate(text.split("\n"), start=1):
+        line = line.removesuffix("\r")
         where = f"{path}:{lineno}"
         stripped = line.strip()
         if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
@@ -155,11 +161,13 @@ def _entry(line: str, lineno: int, where: str) -> Entry:
         )
     time_text, direction, payload = parts
     try:
-        time = float(time_text)
+        time = float(time_text) if time_text.isascii() else -1.0
     except ValueError:
         time = -1.0
-    if not time >= 0 or not time < float("inf"):
-        raise TranscriptError(f"{where}: time {time_text!r} is not seconds >= 0")
+    if not 0 <= time <= MAX_TIME:
+        raise TranscriptError(
+            f"{where}: time {time_text!r} is not seconds in 0–{MAX_TIME:g} (a day at most)"
+        )
     if direction not in (">", "<"):
         raise TranscriptError(
             f"{where}: direction {direction!r} must be '>' (host to board) or '<' (board to host)"

@@ -21,7 +21,7 @@ from appmode.errors import AppmodeError
 from appmode.protocol import app
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
-from appmode.protocol.transcript import Directive, Entry, Transcript
+from appmode.protocol.transcript import MAX_TIME, Directive, Entry, Transcript
 
 TOLERANCE = 0.5
 _PATTERN = re.compile(r"\{([A-Za-z])((?:-?\d+|\*)(?::(?:-?\d+|\*))*)?\}\$?")
@@ -108,11 +108,14 @@ class Check:
         where = f"{self.transcript.path}:{item.lineno}"
         if item.name == "tolerance":
             try:
-                tolerance = float(item.args[0]) if len(item.args) == 1 else -1.0
+                ok = len(item.args) == 1 and item.args[0].isascii()
+                tolerance = float(item.args[0]) if ok else -1.0
             except ValueError:
                 tolerance = -1.0
-            if not tolerance >= 0:
-                raise AppmodeError(f"{where}: @tolerance takes seconds >= 0, e.g. @tolerance 0.3")
+            if not 0 <= tolerance <= MAX_TIME:
+                raise AppmodeError(
+                    f"{where}: @tolerance takes seconds in 0–{MAX_TIME:g}, e.g. @tolerance 0.3"
+                )
         elif item.name == "strict":
             if item.args not in (("on",), ("off",)):
                 raise AppmodeError(f"{where}: @strict takes on or off")

@@ -1,0 +1,70 @@
+"""Values that cannot finish or make no sense are refused with one line naming the range
+(nothing hangs on inf, nan or a speed of 1e-308), numbers are ASCII digits, and
+transcript lines are numbered as an editor numbers them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from appmode.protocol.transcript import parse_transcript
+from tests.support.processes import run
+
+REFUSED = [
+    ("send", "sim://", "Z", "--listen", "inf"),
+    ("send", "sim://", "Z", "--listen", "nan"),
+    ("send", "sim://", "Z", "--listen", "-1"),
+    ("monitor", "sim://", "--count", "0"),
+    ("monitor", "sim://", "--duration", "nan"),
+    ("replay", "x.transcript", "--to", "sim://", "--speed", "1e-308"),
+    ("replay", "x.transcript", "--to", "sim://", "--speed", "nan"),
+    ("drive", "--hold-first", "0"),
+    ("board", "--count", "10000"),
+    ("params", "sim://", "--set", "max_speed=٨٠٠"),
+    ("params", "sim://", "--set", "max_speed=" + "9" * 5000),
+    ("params", "sim://?baud=1"),
+]
+
+
+@pytest.mark.parametrize("args", REFUSED, ids=[" ".join(a)[:40] for a in REFUSED])
+def test_refused_with_one_line(args: tuple[str, ...]) -> None:
+    done = run(*args, timeout=20)
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert "error:" in last and ("in [" in last or "in (" in last or "–" in last), last
+
+
+@pytest.mark.parametrize(
+    "line, message",
+    [("1e308 > Z", "0–86400"), ("inf > Z", "0–86400"), ("１ > Z", "not seconds")],
+)
+def test_transcript_times_that_could_not_finish_are_refused(
+    tmp_path: Path, line: str, message: str
+) -> None:
+    path = tmp_path / "t.transcript"
+    path.write_text(f"# appmode transcript v1\n0.0 > J\n{line}\n")
+    done = run("conform", str(path), timeout=20)
+    assert done.returncode == 2 and f"{path}:3: " in done.stderr and message in done.stderr
+
+
+def test_tolerance_inf_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "t.transcript"
+    path.write_text("# appmode transcript v1\n@tolerance inf\n0.0 > Z\n")
+    done = run("conform", str(path), timeout=20)
+    assert done.returncode == 2 and f"{path}:2: @tolerance" in done.stderr
+
+
+def test_a_bom_and_odd_line_breaks_in_comments_keep_line_numbers() -> None:
+    text = "\ufeff# appmode transcript v1\n# a \x0c form feed and a \u2028 separator\n0.5 > Z\n"
+    transcript = parse_transcript(text)
+    assert [(e.lineno, e.data) for e in transcript.entries] == [(3, b"Z")]
+
+
+def test_a_bad_url_leaves_an_existing_recording_untouched(tmp_path: Path) -> None:
+    record = tmp_path / "precious.transcript"
+    record.write_text("precious\n")
+    done = run("send", "/dev/no-such-port", "Z", "--record", str(record), timeout=20)
+    assert done.returncode == 2 and "no such port" in done.stderr
+    assert record.read_text() == "precious\n"
