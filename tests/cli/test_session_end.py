@@ -86,7 +86,9 @@ def test_sighup_ends_monitor_with_its_summary(tmp_path: Path) -> None:
     assert "Traceback" not in err.decode()
 
 
-def test_sighup_ends_tap_with_the_car_stopped(tmp_path: Path) -> None:
+def _tap_session(tmp_path: Path, app_bytes: bytes, sig: int) -> list[str]:
+    """An app writes `app_bytes` through `tap`, which then gets `sig`: what the board
+    received, and its state afterwards must be stopped with its parameters untouched."""
     record = tmp_path / "tap.transcript"
     with board_process("--pty", "--quiet") as board:
         proc = _start(["tap", "pty", board.url, "--record", str(record), "--quiet"])
@@ -94,14 +96,24 @@ def test_sighup_ends_tap_with_the_car_stopped(tmp_path: Path) -> None:
             assert proc.stdout is not None
             app_side = proc.stdout.readline().decode().removeprefix("port: ").strip()
             with serial.Serial(app_side, 9600, timeout=0.1) as app:
-                app.write(b"JA")
+                app.write(app_bytes)
                 wait_for(lambda: record.exists() and "A" in sent_lines(record))
-                proc.send_signal(signal.SIGHUP)
+                time.sleep(0.3)  # an open frame is held by the recorder, not yet written
+                proc.send_signal(sig)
                 proc.communicate(timeout=10)
         finally:
             proc.kill()
-        assert sent_lines(record)[-1] == "Z"
         assert board_state(board.url) == (STOPPED, DEFAULTS)
+    return sent_lines(record)
+
+
+def test_sighup_ends_tap_with_the_car_stopped(tmp_path: Path) -> None:
+    assert _tap_session(tmp_path, b"JA", signal.SIGHUP)[-1] == "Z"
+
+
+def test_an_app_leaving_tap_inside_a_frame_leaves_the_car_stopped(tmp_path: Path) -> None:
+    sent = _tap_session(tmp_path, b"JA{0:8", signal.SIGTERM)
+    assert sent[-2:] == ["{}", "Z"] or sent[-1] == "{}Z"
 
 
 @pytest.mark.parametrize(
@@ -123,25 +135,6 @@ def test_replay_ending_inside_a_frame_still_stops_the_car(tmp_path: Path) -> Non
     with board_process("--pty", "--quiet") as board:
         done = run("replay", str(replay), "--to", board.url)
         assert done.returncode == 0, done.stderr
-        assert board_state(board.url) == (STOPPED, DEFAULTS)
-
-
-def test_an_app_leaving_tap_inside_a_frame_leaves_the_car_stopped(tmp_path: Path) -> None:
-    record = tmp_path / "tap.transcript"
-    with board_process("--pty", "--quiet") as board:
-        proc = _start(["tap", "pty", board.url, "--record", str(record), "--quiet"])
-        try:
-            assert proc.stdout is not None
-            app_side = proc.stdout.readline().decode().removeprefix("port: ").strip()
-            with serial.Serial(app_side, 9600, timeout=0.1) as app:
-                app.write(b"JA{0:8")
-                wait_for(lambda: record.exists() and "A" in sent_lines(record))
-                time.sleep(0.3)  # the open frame is held by the recorder, not yet written
-            proc.send_signal(signal.SIGTERM)
-            proc.communicate(timeout=10)
-        finally:
-            proc.kill()
-        assert sent_lines(record)[-2:] == ["{}", "Z"] or sent_lines(record)[-1] == "{}Z"
         assert board_state(board.url) == (STOPPED, DEFAULTS)
 
 
