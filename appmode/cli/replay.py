@@ -25,7 +25,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     replay.add_argument(
         "--speed",
-        type=number_type(0.001, 1000),
+        type=float,
         default=1.0,
         metavar="X",
         help="time factor: 2 plays twice as fast (default 1)",

@@ -164,9 +164,12 @@ def _entry(line: str, lineno: int, where: str) -> Entry:
         time = float(time_text) if time_text.isascii() else -1.0
     except ValueError:
         time = -1.0
-    if not 0 <= time <= MAX_TIME:
+    if not time >= 0:
+        raise TranscriptError(f"{where}: time {time_text!r} is not seconds >= 0")
+    if time > MAX_TIME:
         raise TranscriptError(
-            f"{where}: time {time_text!r} is not seconds in 0–{MAX_TIME:g} (a day at most)"
+            f"{where}: time {time_text!r} is more than a day (seconds in 0–{MAX_TIME:g}): "
+            "split the transcript"
         )
     if direction not in (">", "<"):
         raise TranscriptError(

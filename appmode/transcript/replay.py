@@ -63,8 +63,8 @@ def play(
 
 def run_replay(path: str, url: str, side: str, speed: float, loops: int) -> int:
     """The `appmode replay` command."""
-    if speed <= 0 or loops < 1:
-        raise AppmodeError("--speed must be > 0 and --loop at least 1")
+    if not (0.001 <= speed <= 1000 and loops >= 1):
+        raise AppmodeError("--speed must be > 0, in 0.001–1000, and --loop at least 1")
     transcript = read_transcript(path)
     items = plan([(e.time, e.direction, e.data) for e in transcript.entries], side)
     if not items:
