@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import os
 import signal
 import sys
@@ -43,6 +44,9 @@ COMMANDS: tuple[ModuleType, ...] = (
     plot,
 )
 """Each command's module: `register(sub)` adds its arguments, `run(args)` does the job."""
+
+OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
+"""The errors of a write that did not go through (other OSErrors are reported as they are)."""
 
 Handler = Callable[[argparse.Namespace], int]
 
@@ -93,10 +97,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # the reader left (`| head`): end quietly, as cat does
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except OSError as exc:  # writing the output failed: a full disk, a lost terminal
+    except OSError as exc:  # a full disk, a lost terminal: never a traceback
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        what = "cannot write the output" if exc.errno in OUTPUT_ERRORS else "failed"
         with contextlib.suppress(OSError):
-            print(f"appmode: error: cannot write the output: {exc.strerror}", file=sys.stderr)
+            print(f"appmode: error: {what}: {exc.strerror or exc}", file=sys.stderr)
         return 2
 
 

@@ -72,23 +72,20 @@ _JSON = json.JSONEncoder(ensure_ascii=False).encode
 
 
 def json_line(event: p.Event) -> str:
-    """`to_json(event)` as `json.dumps(…, ensure_ascii=False)` writes it. The common
-    records (whole A and B records) are formatted directly: `appmode decode` spends its
-    time here."""
-    kind = type(event)
-    if (kind is p.Velocity or kind is p.Attitude) and event.terminated:  # type: ignore[union-attr]
+    """`to_json(event)` as `json.dumps(…, ensure_ascii=False)` writes it. Whole A and B
+    records whose text needs no JSON escaping are formatted directly: `appmode decode`
+    spends its time here."""
+    if isinstance(event, (p.Velocity, p.Attitude)) and event.terminated:
         raw = escape(event.raw)
         if '"' not in raw and "\\" not in raw:
-            if kind is p.Velocity:
-                v: p.Velocity = event  # type: ignore[assignment]
+            if isinstance(event, p.Velocity):
                 return (
-                    f'{{"kind": "velocity", "x": {v.x}, "y": {v.y}, "z": {v.z}, '
-                    f'"extra": {v.extra}, "raw": "{raw}"}}'
+                    f'{{"kind": "velocity", "x": {event.x}, "y": {event.y}, "z": {event.z}, '
+                    f'"extra": {event.extra}, "raw": "{raw}"}}'
                 )
-            a: p.Attitude = event  # type: ignore[assignment]
             return (
-                f'{{"kind": "attitude", "pitch": {a.pitch}, "roll": {a.roll}, '
-                f'"yaw": {a.yaw}, "battery": {a.battery}, "raw": "{raw}"}}'
+                f'{{"kind": "attitude", "pitch": {event.pitch}, "roll": {event.roll}, '
+                f'"yaw": {event.yaw}, "battery": {event.battery}, "raw": "{raw}"}}'
             )
     return _JSON(to_json(event))
 

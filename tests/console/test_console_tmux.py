@@ -83,15 +83,20 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
     assert sent[-1] == "Z", sent[-5:]
 
 
+def _drive_forward(args: str) -> int:
+    """`appmode drive --latched ARGS` in a new tmux session, driving forward: its pid."""
+    command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched {args}"
+    tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+    wait_screen(r"params\s+max_speed 500")
+    tmux("send-keys", "-t", SESSION, "w")
+    wait_screen(r"in force\s+A forward")
+    return int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+
+
 def test_sigterm_ends_the_console_with_z_last(tmp_path: Path) -> None:
     record = tmp_path / "drive.transcript"
-    command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched --record {record}"
-    tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
     try:
-        wait_screen(r"params\s+max_speed 500")
-        tmux("send-keys", "-t", SESSION, "w")
-        wait_screen(r"in force\s+A forward")
-        pid = int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+        pid = _drive_forward(f"--record {record}")
         os.kill(pid, signal.SIGTERM)
         end = time.monotonic() + 5
         while time.monotonic() < end and _alive():
@@ -127,13 +132,8 @@ def test_closing_the_terminal_ends_the_console_with_the_car_stopped(tmp_path: Pa
     """tmux kill-session: the console gets SIGHUP, as from a closed terminal window."""
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet") as board:
-        command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched {board.url}"
-        tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
         try:
-            wait_screen(r"params\s+max_speed 500")
-            tmux("send-keys", "-t", SESSION, "w")
-            wait_screen(r"in force\s+A forward")
-            pid = int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+            pid = _drive_forward(board.url)
         finally:
             tmux("kill-session", "-t", SESSION)
         wait_for(lambda: not Path(f"/proc/{pid}").exists())
