@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from appmode.board.store import MemoryStore, Store
 from appmode.board.vehicle import Vehicle, wrap_degrees
+from appmode.errors import AppmodeError
 from appmode.protocol import app, params
 from appmode.protocol.directions import PAGE_LETTERS, Page, motion_for, target_velocity
 from appmode.protocol.escaping import escape
@@ -189,7 +190,7 @@ class Board:
         saved = params.saved_form(self.params)
         try:
             self.store.save(saved)
-        except OSError as exc:
+        except AppmodeError as exc:
             self.errors += 1
             self._note(now, "rejected", f"{shown}: save failed: {exc}")
             return

@@ -1,7 +1,7 @@
 """The board's non-volatile parameter store ("flash"), behind a small interface (§5).
 
 `load()` gives the saved parameters, or None with a warning when there are none or they
-cannot be read; it never raises. `save()` replaces them atomically.
+cannot be read; it never raises. `save()` replaces them whole.
 """
 
 from __future__ import annotations
@@ -9,16 +9,19 @@ from __future__ import annotations
 import fcntl
 import json
 import os
-import tempfile
+import stat
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol
 
 from appmode.errors import AppmodeError
+from appmode.files import remove_leftovers, write_whole
 from appmode.protocol import params
 
 FORMAT = "appmode-flash"
 VERSION = 1
+MAX_SIZE = 64 * 1024
+"""Bytes read at most: a flash file is a few hundred."""
 
 
 class Store(Protocol):
@@ -26,7 +29,9 @@ class Store(Protocol):
         """(saved values or None, warning or None)."""
         ...
 
-    def save(self, values: Sequence[int]) -> None: ...
+    def save(self, values: Sequence[int]) -> None:
+        """Keep `values`; AppmodeError (saying why) if they could not be kept."""
+        ...
 
     def close(self) -> None:
         """Release the store (a file lock)."""
@@ -50,51 +55,74 @@ class MemoryStore:
 
 
 class JsonFileStore:
-    """Flash in a JSON file, written atomically (temporary file, fsync, rename)."""
+    """Flash in a JSON file, replaced whole on each save (`appmode.files.write_whole`).
+
+    The file must be a regular file (or not exist yet): a device or a FIFO is refused.
+    """
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
+        real = Path(os.path.realpath(path))
+        self._lock_path = real.with_name(f".{real.name}.appmode-lock")
         self._lock: int | None = None
 
     def lock(self) -> None:
         """Take the file for this board alone; AppmodeError if another board has it.
 
-        The lock is an flock on FILE.lock, held until `close` or the process ends.
+        The lock is an flock on `.NAME.appmode-lock` beside the file, removed on `close`.
         """
-        lock_path = f"{self.path}.lock"
         try:
-            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+            kind = os.stat(self.path).st_mode
+        except FileNotFoundError:
+            kind = None
         except OSError as exc:
             raise AppmodeError(f"cannot use flash file {self.path}: {exc.strerror}") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            holder = os.read(fd, 32).decode(errors="replace").strip() or "another process"
-            os.close(fd)
+        if kind is not None and not stat.S_ISREG(kind):
             raise AppmodeError(
-                f"flash file {self.path} is in use by another board (pid {holder}): give "
-                f"each board its own --flash file, or stop the other one"
-            ) from None
+                f"flash file {self.path} is not a regular file: name a file "
+                f"(it is created on the first save)"
+            )
+        while True:
+            try:
+                fd = os.open(self._lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+            except OSError as exc:
+                raise AppmodeError(
+                    f"cannot use flash file {self.path}: cannot create its lock "
+                    f"{self._lock_path}: {exc.strerror}"
+                ) from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                holder = os.read(fd, 32).decode(errors="replace").strip() or "another process"
+                os.close(fd)
+                raise AppmodeError(
+                    f"flash file {self.path} is in use by another board (pid {holder}): give "
+                    f"each board its own --flash file, or stop the other one"
+                ) from None
+            if _same_file(fd, self._lock_path):
+                break
+            os.close(fd)  # its holder removed it as we opened it: take the new one
         os.ftruncate(fd, 0)
         os.write(fd, str(os.getpid()).encode())
         self._lock = fd
-        for stale in self.path.parent.glob(f".{self.path.name}.*"):
-            stale.unlink(missing_ok=True)  # temporary files of a save that was killed
+        remove_leftovers(self.path)  # of a save that was killed
 
     def close(self) -> None:
         if self._lock is not None:
+            self._lock_path.unlink(missing_ok=True)
             os.close(self._lock)
             self._lock = None
 
     def load(self) -> tuple[tuple[int, ...] | None, str | None]:
         try:
-            text = self.path.read_text(encoding="utf-8")
+            with open(self.path, "rb") as handle:
+                data = handle.read(MAX_SIZE + 1)
         except FileNotFoundError:
             return None, f"{self.path}: no saved parameters yet, using factory defaults"
         except OSError as exc:
             return None, f"{self.path}: cannot read ({exc.strerror}), using factory defaults"
         try:
-            values = _parse(text)
+            values = _parse(data)
         except ValueError as exc:
             return None, f"{self.path}: {exc}; using factory defaults"
         return values, None
@@ -106,38 +134,31 @@ class JsonFileStore:
             "params": {p.name: v for p, v in zip(params.PARAMS, values, strict=True)},
         }
         text = json.dumps(document, indent=2) + "\n"
-        directory = self.path.parent
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", dir=directory)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as handle:
-                handle.write(text)
-                handle.flush()
-                os.fsync(handle.fileno())
-            os.replace(tmp, self.path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        _fsync_directory(directory)
+        write_whole(self.path, text.encode(), "flash file")
 
 
-def _fsync_directory(directory: Path) -> None:
+def _same_file(fd: int, path: Path) -> bool:
     try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:
-        return
+        on_disk = os.stat(path)
+    except FileNotFoundError:
+        return False
+    held = os.fstat(fd)
+    return (held.st_dev, held.st_ino) == (on_disk.st_dev, on_disk.st_ino)
+
+
+def _parse(data: bytes) -> tuple[int, ...]:
+    if len(data) > MAX_SIZE:
+        raise ValueError(f"over {MAX_SIZE:,} bytes, too large for a flash file")
     try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
-def _parse(text: str) -> tuple[int, ...]:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"not UTF-8 text (byte {exc.start + 1})") from None
     try:
         document = json.loads(text)
     except json.JSONDecodeError as exc:
         raise ValueError(f"not valid JSON (line {exc.lineno}: {exc.msg})") from None
+    except RecursionError:
+        raise ValueError("not a flash file (nested too deeply)") from None
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         raise ValueError(f"not an {FORMAT} file")
     if document.get("version") != VERSION:

@@ -7,6 +7,7 @@ blocks: parameter reads and sets run as queries whose outcome arrives with `tick
 
 from __future__ import annotations
 
+import contextlib
 import shlex
 from collections import deque
 from collections.abc import Callable
@@ -89,7 +90,11 @@ class Session:
         self.in_force = STOP_LETTER
         self._sent = HostDecoder()
         if record:
-            self.start_recording(record)
+            try:
+                self.start_recording(record)
+            except BaseException:
+                self.host.close()
+                raise
 
     # ------------------------------------------------------------ life cycle
 
@@ -103,9 +108,7 @@ class Session:
         try:
             self.host.close()
         finally:
-            if self.recorder is not None:
-                self.recorder.close()
-                self.recorder = None
+            self._drop_recorder()
 
     def say(self, text: str) -> None:
         self.messages.append(text)
@@ -113,8 +116,19 @@ class Session:
             self.on_message(text)
 
     def _tap(self, direction: str, time: float, data: bytes) -> None:
-        if self.recorder is not None:
+        if self.recorder is None:
+            return
+        try:
             self.recorder(direction, time, data)
+        except AppmodeError as exc:
+            self._drop_recorder()
+            self.say(f"{exc}; recording stopped")
+
+    def _drop_recorder(self) -> None:
+        recorder, self.recorder = self.recorder, None
+        if recorder is not None:
+            with contextlib.suppress(AppmodeError):
+                recorder.close()
 
     # ------------------------------------------------------------ time
 
@@ -219,17 +233,21 @@ class Session:
     # ------------------------------------------------------------ recording
 
     def start_recording(self, path: str) -> None:
-        if self.recorder is not None:
-            self.recorder.close()
-        self.recorder = Recorder.create(path, self.host.now(), sim_directives(self.url))
+        try:
+            recorder = Recorder.create(path, self.host.now(), sim_directives(self.url))
+        except AppmodeError as exc:
+            if self.recorder is None:
+                raise
+            raise AppmodeError(f"{exc}; still recording to {self.recorder.name}") from None
+        self._drop_recorder()
+        self.recorder = recorder
         self.say(f"recording to {path}")
 
     def stop_recording(self) -> None:
         if self.recorder is None:
             self.say("not recording")
             return
-        self.recorder.close()
-        self.recorder = None
+        self._drop_recorder()
         self.say("recording stopped")
 
     # ------------------------------------------------------------ commands

@@ -195,9 +195,10 @@ class Host:
         if self._port is None:
             return
         with contextlib.suppress(AppmodeError, serial.SerialException, OSError):
-            self.send(self.state.end.stop)
-            self._port.flush()
+            self.send(self.state.end.stop)  # a failing recording must not keep it in
         if self._port is not None:
+            with contextlib.suppress(serial.SerialException, OSError):
+                self._port.flush()
             self._port.close()
             self._port = None
 

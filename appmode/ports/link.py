@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import errno
 import os
-from urllib.parse import parse_qs
+from urllib.parse import parse_qs, urlsplit
 
 import serial
 
@@ -25,6 +25,7 @@ if "appmode.ports" not in serial.protocol_handler_packages:
 
 BAUD = 9600
 SCHEMES = ("sim", "socket", "rfc2217", "loop")
+NETWORK_SCHEMES = ("socket", "rfc2217")
 URL_HELP = (
     "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
     "rfc2217://HOST:PORT, loop:// or sim://"
@@ -41,6 +42,8 @@ def open_link(url: str, timeout: float | None = 0.05) -> serial.SerialBase:
         scheme = url.split("://", 1)[0].lower()
         if scheme not in SCHEMES:
             raise AppmodeError(f"unknown URL scheme {scheme + '://'!r} in {url!r}: {URL_HELP}")
+        if scheme in NETWORK_SCHEMES:
+            _check_address(url, scheme)
         try:
             return serial.serial_for_url(url, baudrate=BAUD, timeout=timeout)
         except (serial.SerialException, ValueError, OSError) as exc:
@@ -50,6 +53,20 @@ def open_link(url: str, timeout: float | None = 0.05) -> serial.SerialBase:
         return serial.Serial(path, baudrate=baud, timeout=timeout, exclusive=os.name == "posix")
     except (serial.SerialException, ValueError, OSError) as exc:
         raise AppmodeError(explain_open_error(path, exc)) from None
+
+
+def _check_address(url: str, scheme: str) -> None:
+    """HOST:PORT must be there before pyserial sees the URL (its messages are Python's)."""
+    parts = urlsplit(url)
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if not parts.hostname or port is None or not 0 < port < 65536:
+        raise AppmodeError(
+            f"{url!r} needs a host and a port 1–65535: {scheme}://HOST:PORT, "
+            f"e.g. {scheme}://127.0.0.1:5000"
+        )
 
 
 def parse_device(url: str) -> tuple[str, int]:

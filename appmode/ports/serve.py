@@ -23,7 +23,7 @@ import serial
 from appmode.board.firmware import Board
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
-from appmode.line.wire import Tap, Wire
+from appmode.line.wire import Wire
 from appmode.ports.link import BAUD, explain_open_error, parse_device
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
@@ -72,7 +72,13 @@ class PtyEndpoint:
     """
 
     def __init__(self, sel: selectors.BaseSelector, log: Log, link: str | None = None) -> None:
-        self._master, self._slave = pty.openpty()
+        try:
+            self._master, self._slave = pty.openpty()
+        except OSError as exc:
+            raise AppmodeError(
+                f"cannot open another pseudo-terminal: {exc.strerror or exc}; serve fewer "
+                f"boards (--count), or raise the open-file limit (ulimit -n)"
+            ) from None
         tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
         os.set_blocking(self._master, False)
         self._out = Outbox()
@@ -309,18 +315,25 @@ def serve(
     pace: bool,
     log: Log,
     announce: Callable[[str], None],
-    tap: Tap | None = None,
+    record: str | None = None,
     banner: str = "",
 ) -> None:
-    """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line."""
+    """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line.
+
+    The recording (`record`) is created once every port is open: a port that cannot be
+    opened leaves an existing file untouched."""
     sel = selectors.DefaultSelector()
+    endpoints: list[Endpoint] = []
     served: list[Served] = []
     by_endpoint: dict[int, Served] = {}
+    recorder: Recorder | None = None
     try:
-        for make, board in zip(make_endpoints, boards, strict=True):
-            endpoint = make(sel, log)
+        for make in make_endpoints:
+            endpoints.append(make(sel, log))
+        recorder = Recorder.create(record) if record else None
+        for endpoint, board in zip(endpoints, boards, strict=True):
             baud = getattr(endpoint, "baud", BAUD)
-            one = Served(endpoint, Wire(board, baud if pace else None, tap))
+            one = Served(endpoint, Wire(board, baud if pace else None, recorder))
             served.append(one)
             by_endpoint[id(endpoint)] = one
             announce(f"port: {endpoint.url}")
@@ -345,9 +358,11 @@ def serve(
                 if data:
                     one.receive(data, time.monotonic() - origin)
     finally:
-        for one in served:
-            one.endpoint.close()
+        for endpoint in endpoints:
+            endpoint.close()
         sel.close()
+        if recorder is not None:
+            recorder.close()
 
 
 def run_board(
@@ -393,7 +408,6 @@ def run_board(
         f"simulated board{'s' if count > 1 else ''}, {boards[0].drive_type.cli_name} drive, "
         f"flash {flash or 'in memory'}, {'paced at the line rate' if pace else 'not paced'}"
     )
-    recorder = Recorder.create(record) if record else None
     try:
         serve(
             [make] * count,
@@ -401,7 +415,7 @@ def run_board(
             pace=pace,
             log=log,
             announce=announce,
-            tap=recorder,
+            record=record,
             banner=banner,
         )
     except KeyboardInterrupt:
@@ -409,8 +423,6 @@ def run_board(
     finally:
         for board in boards:
             board.store.close()
-        if recorder is not None:
-            recorder.close()
     return 0
 
 

@@ -93,21 +93,20 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             baud = params.whole(options["baud"])
             if baud is None or not MIN_BAUD <= baud <= MAX_BAUD:
                 raise SerialException(
-                    f"sim:// option baud={options['baud']!r}: use a number in "
-                    f"{MIN_BAUD}–{MAX_BAUD}"
+                    f"sim:// option baud={options['baud']!r}: use a number in {MIN_BAUD}–{MAX_BAUD}"
                 )
             self._baudrate = baud
         pace = _flag("pace", options.get("pace", "1"))
-        try:
-            store = open_store(options.get("flash"))
-        except AppmodeError as exc:
-            raise SerialException(str(exc)) from None
         try:
             spec = FaultSpec.parse(options.get("faults", ""))
         except ValueError as exc:
             raise SerialException(f"sim:// option faults: {exc}") from None
         rng = random.Random(spec.seed)
         self._faults = (FaultyLine(spec, rng), FaultyLine(spec, rng)) if spec.active else None
+        try:  # the flash is opened last: nothing after it can fail and leave it locked
+            store = open_store(options.get("flash"))
+        except AppmodeError as exc:
+            raise SerialException(str(exc)) from None
         self.board = Board(store, drive=drive)
         self._wire = Wire(self.board, self._baudrate if pace else None)
         self._rx.clear()

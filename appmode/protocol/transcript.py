@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from dataclasses import dataclass
 from typing import TextIO
@@ -27,16 +28,15 @@ class Recorder:
     def __init__(self, out: TextIO, origin: float = 0.0, directives: tuple[str, ...] = ()) -> None:
         self._out = out
         self._owned = False  # a stream given by the caller stays open
+        self.name = str(getattr(out, "name", "the transcript"))
+        self._failed = False
         self._origin = origin
         self._decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
             ">": app.HostDecoder(),
             "<": app.BoardDecoder(),
         }
         self._last = {">": origin, "<": origin}
-        out.write(HEADER + "\n")
-        for directive in directives:
-            out.write(f"@{directive}\n")
-        out.flush()
+        self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
 
     @classmethod
     def create(
@@ -48,7 +48,12 @@ class Recorder:
             raise AppmodeError(
                 f"cannot write transcript {os.fspath(path)}: {exc.strerror}"
             ) from None
-        recorder = cls(out, origin, directives)
+        try:
+            recorder = cls(out, origin, directives)
+        except AppmodeError:
+            with contextlib.suppress(OSError):
+                out.close()
+            raise
         recorder._owned = True
         return recorder
 
@@ -58,18 +63,36 @@ class Recorder:
             self._line(time, direction, event.raw)
 
     def _line(self, time: float, direction: str, raw: bytes) -> None:
-        self._out.write(f"{max(0.0, time - self._origin):.4f} {direction} {escape(raw)}\n")
-        self._out.flush()
+        self._write(f"{max(0.0, time - self._origin):.4f} {direction} {escape(raw)}\n")
+
+    def _write(self, text: str) -> None:
+        try:
+            self._out.write(text)
+            self._out.flush()
+        except OSError as exc:
+            self._failed = True
+            reason = "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror
+            raise AppmodeError(f"cannot write transcript {self.name}: {reason}") from None
 
     def close(self) -> None:
-        """Write what the decoders still hold, and close the file (if it opened it)."""
+        """Write what the decoders still hold, and close the file (if it opened it).
+
+        After a failed write it only closes the file: that failure was reported."""
         if self._out.closed:
+            return
+        if self._failed:
+            if self._owned:
+                with contextlib.suppress(OSError):
+                    self._out.close()
             return
         for direction, decoder in self._decoders.items():
             for event in decoder.flush():
                 self._line(self._last[direction], direction, event.raw)
         if self._owned:
-            self._out.close()
+            try:
+                self._out.close()
+            except OSError as exc:
+                raise AppmodeError(f"cannot write transcript {self.name}: {exc.strerror}") from None
 
 
 # ---------------------------------------------------------------- reading

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import csv
 import json
-import os
-import tempfile
 from collections.abc import Iterator
+from io import BytesIO
 from pathlib import Path
 from typing import Any, TextIO
 
 from appmode.errors import AppmodeError
+from appmode.files import check_writable, write_whole
 from appmode.protocol import app
 from appmode.protocol.render import describe, line, to_json
 from appmode.protocol.transcript import Transcript, read_transcript
@@ -78,6 +78,7 @@ def run_dump(path: str, fmt: str, out: TextIO) -> int:
 
 def run_plot(path: str, output: str) -> int:
     """Velocities, attitude and battery over time, with the commands marked."""
+    check_writable(output, "plot")
     try:
         import matplotlib
 
@@ -137,15 +138,10 @@ def run_plot(path: str, output: str) -> int:
     vel.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     att.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.suptitle(f"{Path(path).name} — {transcript.title or 'telemetry'}", fontsize=11)
-    directory = os.path.dirname(os.path.abspath(output))
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=directory)
-    os.close(fd)
+    image = BytesIO()
     try:
-        fig.savefig(tmp, dpi=110)
-        os.replace(tmp, output)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise AppmodeError(f"cannot write {output}: {exc.strerror}") from None
+        fig.savefig(image, format="png", dpi=110)
     finally:
         plt.close(fig)
+    write_whole(output, image.getvalue(), "plot")
     return 0

@@ -2,18 +2,19 @@
 
 from __future__ import annotations
 
-import os
 import sys
 import time
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
+from io import BytesIO
 from pathlib import Path
 from typing import TextIO
 
 from appmode.board.firmware import Board
 from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
+from appmode.files import check_writable, write_whole
 from appmode.host.client import Host, LinkLost
 from appmode.line.wire import Wire
 from appmode.protocol import app, params
@@ -158,17 +159,15 @@ def write_junit(path: str, results: list[Result]) -> None:
         if result.failure is not None:
             failure = ET.SubElement(case, "failure", message=result.failure.splitlines()[0])
             failure.text = result.failure
-    tmp = f"{path}.tmp"
-    try:
-        ET.ElementTree(suite).write(tmp, encoding="utf-8", xml_declaration=True)
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise AppmodeError(f"cannot write {path}: {exc.strerror}") from None
+    data = BytesIO()
+    ET.ElementTree(suite).write(data, encoding="utf-8", xml_declaration=True)
+    write_whole(path, data.getvalue(), "JUnit report")
 
 
 def run_conform(paths: list[str], board: str | None, junit: str | None, out: TextIO) -> int:
     """Run every transcript; one line each; exit status 1 on any failure."""
+    if junit:
+        check_writable(junit, "JUnit report")
     if paths:
         transcripts = [read_transcript(path) for path in collect(paths)]
     else:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import random
 import signal
 import subprocess
@@ -9,7 +10,12 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+import serial
+
+import appmode.ports.link  # noqa: F401 - registers sim://
 from appmode.board.store import JsonFileStore, open_store
+from appmode.errors import AppmodeError
 from appmode.protocol import params
 from tests.support.processes import ROOT
 
@@ -43,10 +49,12 @@ def test_a_save_killed_midway_leaves_old_or_new_never_broken(tmp_path: Path) -> 
         proc.wait()
         values, warning = JsonFileStore(path).load()
         assert warning is None and values in expected
+    (tmp_path / ".flash.json.swp").write_bytes(b"an editor's")
     store = open_store(str(path))  # a board taking the file tidies killed saves away
-    leftovers = [p.name for p in tmp_path.iterdir() if p.name.startswith(".flash.json.")]
+    leftovers = sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".flash.json."))
     store.close()
-    assert leftovers == []
+    assert leftovers == [".flash.json.appmode-lock", ".flash.json.swp"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".flash.json.swp", "flash.json"]
 
 
 def test_a_second_board_on_the_same_flash_refuses(tmp_path: Path) -> None:
@@ -81,3 +89,37 @@ def test_a_second_board_on_the_same_flash_refuses(tmp_path: Path) -> None:
     assert third.stdout is not None and third.stdout.readline().startswith("port: ")
     third.terminate()
     third.wait(10)
+
+
+def test_a_flash_that_is_not_a_regular_file_is_refused_and_nothing_made_beside_it(
+    tmp_path: Path,
+) -> None:
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    with pytest.raises(AppmodeError, match=f"flash file {fifo} is not a regular file"):
+        open_store(str(fifo))
+    assert [p.name for p in tmp_path.iterdir()] == ["pipe"]
+
+
+@pytest.mark.parametrize(
+    ("content", "why"),
+    [
+        (b"[" * 30_000, "nested too deeply"),
+        (b'\xff{"format": "appmode-flash"}', "not UTF-8 text"),
+        (b" " * 100_000, "too large for a flash file"),
+    ],
+)
+def test_an_odd_flash_file_is_a_warning_naming_it(tmp_path: Path, content: bytes, why: str) -> None:
+    path = tmp_path / "flash.json"
+    path.write_bytes(content)
+    values, warning = JsonFileStore(path).load()
+    assert values is None and warning is not None
+    assert warning.startswith(f"{path}: ") and why in warning
+
+
+def test_a_sim_url_that_fails_to_open_does_not_keep_its_flash_locked(tmp_path: Path) -> None:
+    flash = tmp_path / "flash.json"
+    with pytest.raises(serial.SerialException, match="faults"):
+        serial.serial_for_url(f"sim://?flash={flash}&faults=nonsense")
+    open_store(str(flash)).close()  # free: nothing holds it
+    assert list(tmp_path.iterdir()) == []

@@ -24,6 +24,8 @@ REFUSED = [
     ("params", "sim://", "--set", "max_speed=٨٠٠"),
     ("params", "sim://", "--set", "max_speed=" + "9" * 5000),
     ("params", "sim://?baud=1"),
+    ("params", "socket://localhost"),
+    ("params", "rfc2217://localhost:99999"),
 ]
 
 

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import errno
+import io
+import os
 import time
 from pathlib import Path
 
 from appmode.console.hold import HoldToDrive
 from appmode.console.session import Session
-from tests.support.processes import BoardProcess, run
+from appmode.protocol.transcript import Recorder
+from tests.support.processes import BoardProcess, run, sent_lines
 
 
 def test_script_mode_reads_commands_from_stdin(tmp_path: Path) -> None:
@@ -61,3 +65,48 @@ def test_help_lists_every_command() -> None:
     done = run("drive", stdin=b"help\n")
     for name in ("params", "set NAME VALUE", "save", "speed", "record FILE|stop", "quit"):
         assert name in done.stdout
+
+
+def test_a_recording_that_fails_never_ends_the_session(tmp_path: Path) -> None:
+    first, second = tmp_path / "first.transcript", tmp_path / "second.transcript"
+    script = (
+        f"record {first}\ndrive A\nwait 0.2\n"
+        f"record {tmp_path}/no/such/folder.transcript\n"
+        "record /dev/full\ndrive B\nwait 0.2\n"
+        f"record {second}\ndrive C\nwait 0.2\nquit\n"
+    )
+    done = run("drive", stdin=script.encode())
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert f"{tmp_path}/no/such/folder.transcript: No such file or directory; still " in done.stdout
+    assert "/dev/full: No space left on device; still recording to" in done.stdout
+    assert sent_lines(first)[-2:] == ["A", "B"], "the first recording went on, then closed"
+    assert sent_lines(second)[-2:] == ["C", "Z"]
+
+
+class _FailingStream(io.StringIO):
+    """A recording file on a disk that fills up after its header."""
+
+    name = "full.transcript"
+
+    def write(self, text: str) -> int:
+        if self.getvalue():
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return super().write(text)
+
+
+def test_a_recording_failing_midway_stops_with_a_message_and_driving_goes_on() -> None:
+    session = Session("sim://", HoldToDrive(latched=True))
+    try:
+        session.recorder = Recorder(_FailingStream())
+        session.start()
+        session.run("drive A")
+        assert session.recorder is None
+        assert any(
+            "cannot write transcript full.transcript: No space left on device; recording "
+            "stopped" in m
+            for m in session.messages
+        )
+        session.run("drive B")
+        assert session.in_force == "B"
+    finally:
+        session.close()

@@ -1,0 +1,115 @@
+"""Writing the files a user names, without touching any they did not.
+
+A regular file (or a new one) is replaced whole: a temporary file beside it, fsync, then
+rename, so a reader never sees half of it. Anything else — a device such as /dev/null, a
+FIFO, a terminal — is written in place, as a shell redirection would. A symbolic link
+stays a link: its target is written. New files honour the umask; a replaced file keeps
+its mode. Temporary files carry a name that only appmode uses (`LEFTOVER`).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import secrets
+import stat
+from pathlib import Path
+
+from appmode.errors import AppmodeError
+
+LEFTOVER = re.compile(r"\.(?P<name>.+)\.[0-9a-f]{8}\.appmode-tmp")
+"""The name of a temporary file of ours: `.NAME.XXXXXXXX.appmode-tmp` beside NAME."""
+
+
+def write_whole(path: str | os.PathLike[str], data: bytes, what: str) -> None:
+    """Make `data` the content of `path`; AppmodeError naming `what` and the path if not."""
+    shown = os.fspath(path)
+    target = Path(os.path.realpath(path))
+    try:
+        existing = os.stat(target)
+    except FileNotFoundError:
+        existing = None
+    except OSError as exc:
+        raise AppmodeError(f"cannot write {what} {shown}: {exc.strerror}") from None
+    try:
+        if existing is not None and not stat.S_ISREG(existing.st_mode):
+            _write_in_place(target, data)
+        else:
+            _replace(target, data, existing)
+    except OSError as exc:
+        folder = target.parent
+        if not folder.is_dir():
+            raise AppmodeError(
+                f"cannot write {what} {shown}: there is no folder {folder}; create it first"
+            ) from None
+        raise AppmodeError(f"cannot write {what} {shown}: {exc.strerror}") from None
+
+
+def check_writable(path: str | os.PathLike[str], what: str) -> None:
+    """Before long work whose result goes to `path`: AppmodeError if it could not be
+    written (no folder, no permission, a folder in its place)."""
+    shown = os.fspath(path)
+    target = Path(os.path.realpath(path))
+    if target.is_dir():
+        raise AppmodeError(f"cannot write {what} {shown}: it is a folder; name a file")
+    if not target.parent.is_dir():
+        raise AppmodeError(
+            f"cannot write {what} {shown}: there is no folder {target.parent}; create it first"
+        )
+    regular = not target.exists() or target.is_file()
+    if not os.access(target.parent if regular else target, os.W_OK):
+        raise AppmodeError(f"cannot write {what} {shown}: permission denied")
+
+
+def remove_leftovers(path: str | os.PathLike[str]) -> None:
+    """Delete the temporary files a killed write of `path` left beside it (ours only)."""
+    target = Path(os.path.realpath(path))
+    for entry in target.parent.glob(f".{target.name}.*.appmode-tmp"):
+        match = LEFTOVER.fullmatch(entry.name)
+        if match is not None and match["name"] == target.name and entry.is_file():
+            entry.unlink(missing_ok=True)
+
+
+def _write_in_place(target: Path, data: bytes) -> None:
+    fd = os.open(target, os.O_WRONLY | os.O_CLOEXEC)
+    try:
+        _write_all(fd, data)
+    finally:
+        os.close(fd)
+
+
+def _replace(target: Path, data: bytes, existing: os.stat_result | None) -> None:
+    tmp = target.with_name(f".{target.name}.{secrets.token_hex(4)}.appmode-tmp")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
+    try:
+        try:
+            if existing is not None:
+                os.fchmod(fd, stat.S_IMODE(existing.st_mode))
+            _write_all(fd, data)
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.replace(tmp, target)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    _fsync_directory(target.parent)
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+def _fsync_directory(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
