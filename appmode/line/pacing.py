@@ -45,13 +45,6 @@ class Line:
         start, _ = self._bursts[0]
         return start + (self._taken + 1) * self.byte_time
 
-    def burst_due(self) -> float | None:
-        """When the whole of the oldest pending burst (a record) has been delivered."""
-        if not self._bursts:
-            return None
-        start, data = self._bursts[0]
-        return start + len(data) * self.byte_time
-
     def take(self, now: float) -> bytes:
         """Every byte delivered by `now`."""
         return b"".join(data for _, data in self.take_timed(now))

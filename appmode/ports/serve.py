@@ -7,6 +7,7 @@ client does: a pty's other end closing, a TCP client leaving, nobody listening.
 from __future__ import annotations
 
 import errno
+import math
 import os
 import pty
 import selectors
@@ -33,6 +34,9 @@ Log = Callable[[str], None]
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
+RUN = 0.004
+"""Seconds of wire time written at most at once to a paced client: bytes trickle in as
+from a real UART (a C record over 32 ms at 9600 bps), not a record at a time."""
 INPUT_BACKLOG = 256
 """Bytes received but not yet on the simulated line beyond which the server stops reading:
 the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
@@ -277,18 +281,22 @@ class Served:
     last_write: float = float("-inf")
 
     def wakeup(self) -> float:
-        """When this board next has something to do. Paced output is written a record at a
-        time, when its last byte would have arrived on a real line: never early, and one
-        wake-up per record rather than one per byte."""
+        """When this board next has something to do. On a paced line that is a point of a
+        grid of RUN seconds: the board has run to then (every byte and record at its own
+        time) and the bytes whose stop bit is done are written, never early, never more
+        than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
-        times = [wire.board.next_slot()]
-        if (due := wire.to_board.next_due()) is not None:
-            times.append(due)
-        if (due := wire.to_host.burst_due()) is not None:
-            times.append(due)
+        step = wire.to_host.byte_time
+        due = wire.board.next_slot() + step  # the next slot's record: its first byte
+        if (line := wire.to_board.next_due()) is not None:
+            due = min(due, line)
+        if (line := wire.to_host.next_due()) is not None:
+            due = min(due, line)
+        if step:
+            due = math.ceil(due / RUN - 1e-9) * RUN
         if self.endpoint.backlog:
-            times.append(self.last_write + RETRY_WRITE)
-        return min(times)
+            due = min(due, self.last_write + RETRY_WRITE)
+        return due
 
     def pump(self, now: float) -> None:
         out = self.wire.pump(now)
@@ -344,12 +352,14 @@ def serve(
             now = time.monotonic() - origin
             wake = float("inf")
             for one in served:
-                if one.wakeup() <= now:
+                due = one.wakeup()
+                if due <= now:
                     one.pump(now)
-                for note in one.wire.board.take_notes():
-                    log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
-                one.throttle()
-                wake = min(wake, one.wakeup())
+                    for note in one.wire.board.take_notes():
+                        log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
+                    one.throttle()
+                    due = one.wakeup()
+                wake = min(wake, due)
             timeout = max(0.0, wake - (time.monotonic() - origin))
             for key, _ in sel.select(timeout):
                 reader = key.data
@@ -357,6 +367,7 @@ def serve(
                 data = reader(max(1, INPUT_BACKLOG - len(one.wire.to_board)))
                 if data:
                     one.receive(data, time.monotonic() - origin)
+                    one.throttle()
     finally:
         for endpoint in endpoints:
             endpoint.close()

@@ -1,0 +1,58 @@
+"""A paced board's bytes trickle in as from a real UART: never faster than the line,
+never a whole record at once (a host that expects whole records per read must fail
+here as it would on a car)."""
+
+from __future__ import annotations
+
+import os
+import selectors
+import time
+import tty
+
+from appmode.line.pacing import byte_time
+from appmode.protocol.app import BoardDecoder, ParamsRecord
+from tests.support.processes import board_process
+
+BYTE = byte_time(9600)
+
+
+def _read_timed(fd: int, seconds: float) -> list[tuple[float, bytes]]:
+    sel = selectors.DefaultSelector()
+    sel.register(fd, selectors.EVENT_READ)
+    chunks = []
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if sel.select(0.05):
+            chunks.append((time.monotonic(), os.read(fd, 4096)))
+    return chunks
+
+
+def test_a_c_record_arrives_over_its_wire_time_and_never_faster() -> None:
+    with board_process("--quiet") as board:
+        fd = os.open(board.url, os.O_RDWR | os.O_NOCTTY)
+        try:
+            tty.setraw(fd)
+            os.write(fd, b"{Q:P}")
+            chunks = _read_timed(fd, 1.0)
+        finally:
+            os.close(fd)
+    data = b"".join(c for _, c in chunks)
+    events = BoardDecoder().feed(data)
+    assert any(isinstance(e, ParamsRecord) for e in events), data[:200]
+    # where the C record's first and last bytes arrived
+    start = data.index(b"{C")
+    end = start + len(next(e for e in events if isinstance(e, ParamsRecord)).raw) - 1
+    offsets, pos = [], 0
+    for t, chunk in chunks:
+        offsets.append((pos, pos + len(chunk), t))
+        pos += len(chunk)
+    first = next(t for a, b, t in offsets if a <= start < b)
+    last = next(t for a, b, t in offsets if a <= end < b)
+    wire = (end - start + 1) * BYTE  # 31 bytes: 32 ms
+    assert last - first > wire / 2, f"the C record came in {1000 * (last - first):.1f} ms"
+    # never faster than the line: after the first read, bytes come at most one per byte
+    # time (one read's worth of slack for a reader that was late)
+    t0, before = chunks[0][0], 0
+    for t, chunk in chunks[1:]:
+        before += len(chunk)
+        assert before <= (t - t0) / BYTE + 8, f"{before} bytes in {1000 * (t - t0):.1f} ms"
