@@ -13,6 +13,7 @@ import io
 import os
 import platform
 import random
+import select
 import shutil
 import statistics
 import subprocess
@@ -24,6 +25,7 @@ import tty
 from collections.abc import Callable
 from pathlib import Path
 
+import conform_timing
 import decode_command
 import decoder
 import link_pacing
@@ -361,9 +363,59 @@ def bench_replay(events: int) -> list[Row]:
     return rows
 
 
+def bench_trickle(seconds: float) -> list[Row]:
+    """How a paced board's bytes reach a client reading as soon as they come."""
+    proc, [url] = start_board("--pty")
+    fd = open_raw(url)
+    sizes: list[int] = []
+    spans: list[float] = []
+    try:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            os.write(fd, b"{Q:P}")  # a C record: 31 bytes, 32 ms of wire
+            first = None
+            until = time.monotonic() + 0.3
+            while time.monotonic() < until:
+                ready, _, _ = select.select([fd], [], [], 0.05)
+                if ready:
+                    chunk = os.read(fd, 4096)
+                    sizes.append(len(chunk))
+                    if b"{C" in chunk:
+                        first = time.monotonic()
+                    if first is not None and b"}$" in chunk and b"{C" not in chunk:
+                        spans.append(time.monotonic() - first)
+                        first = None
+    finally:
+        os.close(fd)
+        stop(proc)
+    return [
+        (
+            "paced output: reads as the bytes come (9600 bps)",
+            f"median read {statistics.median(sizes):.0f} bytes, p99 "
+            f"{percentile([float(x) for x in sizes], 99):.0f}; a C record arrives over "
+            f"{statistics.median(spans) * 1000:.1f} ms (median)",
+            "runs of about 4 ms (4 bytes), C over ~32 ms",
+        )
+    ]
+
+
+def bench_conform_timing(sends: int) -> list[Row]:
+    late = [x * 1000 for x in conform_timing.measure(sends)]
+    return [
+        (
+            f"conform --board: {sends} sends, lateness at the board",
+            f"median {statistics.median(late):.2f} ms, p99 {percentile(late, 99):.2f} ms",
+            "p99 < 2 ms",
+        )
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="shorter runs (about 2 min)")
+    parser.add_argument(
+        "--only", action="append", metavar="NAME", help="run only this part (repeatable)"
+    )
     args = parser.parse_args()
     quick = args.quick
     plan: list[tuple[str, Callable[[], list[Row]]]] = [
@@ -374,6 +426,7 @@ def main() -> None:
         ("board CPU", lambda: bench_board_cpu(10 if quick else 30)),
         ("drive CPU", lambda: bench_drive_cpu(10 if quick else 30)),
         ("200 boards", lambda: [bench_many_boards(200, 5 if quick else 15)]),
+        ("trickle", lambda: bench_trickle(3 if quick else 10)),
         ("links", lambda: bench_links(quick)),
         (
             "floods",
@@ -383,7 +436,13 @@ def main() -> None:
             ],
         ),
         ("replay", lambda: bench_replay(1000 if quick else 10_000)),
+        ("conform timing", lambda: bench_conform_timing(200 if quick else 600)),
     ]
+    if args.only:
+        unknown = set(args.only) - {name for name, _ in plan}
+        if unknown:
+            parser.error(f"no part {', '.join(sorted(unknown))}; parts: {[n for n, _ in plan]}")
+        plan = [(name, run) for name, run in plan if name in args.only]
     rows: list[Row] = []
     for name, run in plan:
         print(f"running: {name} …", file=sys.stderr, flush=True)

@@ -23,6 +23,8 @@ from appmode.ports.link import open_link
 from appmode.protocol import app, params
 
 RETRY = 0.5
+STEP = 0.001
+"""Seconds between looks at the port while waiting less than its read timeout."""
 
 Event = app.BoardEvent | LinkStatus | Outcome
 
@@ -104,14 +106,20 @@ class Host:
         self.send(app.encode(command))
 
     def poll(self, timeout: float) -> list[Event]:
-        """What arrives within `timeout` seconds (returns as soon as something does)."""
+        """What arrives within `timeout` seconds: returns as soon as something does, and
+        never after the deadline. A wait longer than the port's read timeout blocks in
+        the port; a shorter one looks every STEP seconds, so a caller with something to
+        send at the deadline (conform, replay) is not held up by the read."""
         deadline = self.now() + timeout
         while True:
-            events = self._read_once(block=True)
-            if events or self.now() >= deadline:
+            wait = None if self._port is None else self._port.timeout
+            block = wait is not None and deadline - self.now() >= wait
+            events = self._read_once(block=block)
+            left = deadline - self.now()
+            if events or left <= 0:
                 return events
-            if self._port is None:
-                time.sleep(min(RETRY / 5, max(0.0, deadline - self.now())))
+            if not block:
+                time.sleep(min(RETRY / 5 if self._port is None else STEP, left))
 
     def poll_nowait(self) -> list[Event]:
         """What has arrived, without waiting."""

@@ -155,12 +155,18 @@ class FaultyPort:
             self.port.write(sent)
 
     @property
+    def timeout(self) -> float | None:
+        """The read timeout of the port behind."""
+        timeout: float | None = self.port.timeout
+        return timeout
+
+    @property
     def in_waiting(self) -> int:
         self._pump()
         return len(self._rx)
 
     def read(self, size: int = 1) -> bytes:
-        deadline = time.monotonic() + (self.port.timeout or 0.0)
+        deadline = time.monotonic() + (self.timeout or 0.0)
         self._pump()
         while len(self._rx) < size and time.monotonic() < deadline:
             time.sleep(0.001)

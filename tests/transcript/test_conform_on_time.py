@@ -1,0 +1,30 @@
+"""`conform` against a real-time board sends each `>` line at its time, whatever the
+reader is doing (the port's 50 ms read timeout used to hold sends back)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from appmode.protocol.transcript import read_transcript
+from tests.support.processes import board_process, run
+
+SPACING = 0.017  # off the board's 50 ms slots: telemetry keeps arriving between sends
+SENDS = 80
+
+
+def test_sends_reach_a_live_board_at_their_time(tmp_path: Path) -> None:
+    lines = ["# appmode transcript v1", "0.0000 > J"]
+    lines += [f"{k * SPACING:.4f} > {'ABCDEFGH'[k % 8]}" for k in range(1, SENDS)]
+    script = tmp_path / "sends.transcript"
+    script.write_text("\n".join(lines) + "\n")
+    record = tmp_path / "board.transcript"
+    with board_process("--quiet", "--record", str(record)) as board:
+        done = run("conform", "--board", board.url, str(script), timeout=60)
+        assert done.returncode == 0, done.stdout + done.stderr
+    got = [e.time for e in read_transcript(record).entries if e.direction == ">"][:SENDS]
+    assert len(got) == SENDS
+    late = sorted((t - got[0]) - k * SPACING for k, t in enumerate(got))
+    # measured where the board received them (0.1 ms resolution), on a machine that may
+    # be loaded: most within a few ms, none held for a read timeout
+    assert late[0] > -0.002, f"a send went {-1000 * late[0]:.1f} ms early"
+    assert late[int(0.9 * SENDS)] < 0.008, [round(1000 * x, 1) for x in late]
