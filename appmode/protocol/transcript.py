@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import codecs
 import contextlib
+import itertools
 import os
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import TextIO
+from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
 from appmode.protocol import app
@@ -16,6 +19,8 @@ SUFFIX = ".transcript"
 MAX_TIME = 86400.0
 """The latest time a line may have: a day. Later is surely a mistake, and a run to it
 could not finish."""
+MAX_LINE = 64 * 1024
+"""Bytes a line may have: a recorded line is one command or record, well under this."""
 
 
 class Recorder:
@@ -147,17 +152,53 @@ class TranscriptError(AppmodeError):
 
 def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
     """Read transcript text; TranscriptError names the file, the line and what is wrong."""
+    # lines end at \n only: form feeds and U+2028 in comments do not shift line numbers
+    lines = text.removeprefix("\ufeff").split("\n")  # a BOM some editors write
+    return _parse(enumerate(lines, start=1), path)
+
+
+def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
+    """Read a transcript file; TranscriptError (file:line, with `name` in place of the
+    path if given) or AppmodeError if unreadable. Read a line at a time, each at most
+    MAX_LINE bytes: a file that is no transcript (/dev/zero, a binary) fails at once."""
+    name = name or os.fspath(path)
+    try:
+        with open(path, "rb") as handle:
+            return _parse(_file_lines(handle, name), name)
+    except OSError as exc:
+        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
+
+
+def _file_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, str]]:
+    for lineno in itertools.count(1):
+        raw = handle.readline(MAX_LINE + 1)
+        if not raw:
+            return
+        if len(raw) > MAX_LINE:
+            raise TranscriptError(
+                f"{name}:{lineno}: a line of over {MAX_LINE:,} bytes: not a transcript"
+            )
+        if lineno == 1:
+            raw = raw.removeprefix(codecs.BOM_UTF8)
+        try:
+            yield lineno, raw.decode("utf-8").removesuffix("\n")
+        except UnicodeDecodeError as exc:
+            raise TranscriptError(
+                f"{name}:{lineno}: not UTF-8 text (byte {exc.start + 1} of the line)"
+            ) from None
+
+
+def _parse(lines: Iterable[tuple[int, str]], path: str) -> Transcript:
     items: list[Entry | Directive] = []
     title = ""
-    text = text.removeprefix("\ufeff")  # a BOM some editors write
-    # lines end at \n only: form feeds and U+2028 in comments do not shift line numbers
-    for lineno, line in enumerate(text.split("\n"), start=1):
+    for lineno, line in lines:
         line = line.removesuffix("\r")
         where = f"{path}:{lineno}"
         stripped = line.strip()
         if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
             raise TranscriptError(
-                f"{where}: {stripped[2:]!r} is not a version this appmode reads (it reads v1)"
+                f"{where}: {_cut(stripped[2:])!r} is not a version this appmode reads "
+                "(it reads v1)"
             )
         if not stripped:
             continue
@@ -169,18 +210,25 @@ def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
             name, *args = stripped[1:].split() or [""]
             if name not in DIRECTIVES:
                 known = ", ".join(f"@{d}" for d in DIRECTIVES)
-                raise TranscriptError(f"{where}: unknown directive @{name} (known: {known})")
+                raise TranscriptError(
+                    f"{where}: unknown directive @{_cut(name)} (known: {known})"
+                )
             items.append(Directive(lineno, name, tuple(args)))
             continue
         items.append(_entry(line.rstrip("\r\n"), lineno, where))
     return Transcript(path, tuple(items), title)
 
 
+def _cut(text: str, limit: int = 60) -> str:
+    """`text` for a message, cut short if long."""
+    return text if len(text) <= limit else f"{text[:limit]}… ({len(text):,} chars)"
+
+
 def _entry(line: str, lineno: int, where: str) -> Entry:
     parts = line.split(" ", 2)
     if len(parts) != 3 or not parts[2]:
         raise TranscriptError(
-            f"{where}: expected 'TIME DIR PAYLOAD' (e.g. 0.050 > {{Q:P}}), got {line!r}"
+            f"{where}: expected 'TIME DIR PAYLOAD' (e.g. 0.050 > {{Q:P}}), got {_cut(line)!r}"
         )
     time_text, direction, payload = parts
     try:
@@ -188,32 +236,19 @@ def _entry(line: str, lineno: int, where: str) -> Entry:
     except ValueError:
         time = -1.0
     if not time >= 0:
-        raise TranscriptError(f"{where}: time {time_text!r} is not seconds >= 0")
+        raise TranscriptError(f"{where}: time {_cut(time_text)!r} is not seconds >= 0")
     if time > MAX_TIME:
         raise TranscriptError(
-            f"{where}: time {time_text!r} is more than a day (seconds in 0–{MAX_TIME:g}): "
+            f"{where}: time {_cut(time_text)!r} is more than a day (seconds in 0–{MAX_TIME:g}): "
             "split the transcript"
         )
     if direction not in (">", "<"):
         raise TranscriptError(
-            f"{where}: direction {direction!r} must be '>' (host to board) or '<' (board to host)"
+            f"{where}: direction {_cut(direction)!r} must be '>' (host to board) or '<' "
+            "(board to host)"
         )
     try:
         data = unescape(payload)
     except ValueError as exc:
         raise TranscriptError(f"{where}: {exc}") from None
     return Entry(lineno, time, direction, data, payload)
-
-
-def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
-    """Read a transcript file; TranscriptError (file:line, with `name` in place of the
-    path if given) or AppmodeError if unreadable."""
-    name = name or os.fspath(path)
-    try:
-        with open(path, encoding="utf-8") as handle:
-            text = handle.read()
-    except UnicodeDecodeError as exc:
-        raise TranscriptError(f"{name}: not UTF-8 text (byte {exc.start})") from None
-    except OSError as exc:
-        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
-    return parse_transcript(text, name)

@@ -176,6 +176,9 @@ def run_conform(paths: list[str], board: str | None, junit: str | None, out: Tex
             read_transcript(path, name=str(path.relative_to(SUITE.parent)))
             for path in collect([str(SUITE)])
         ]  # all readable before any runs
+    for transcript in transcripts:
+        if not transcript.entries:
+            raise AppmodeError(f"{transcript.path} has no '>' or '<' lines: nothing to check")
     interactive = sys.stderr.isatty()
 
     def progress(text: str) -> None:

@@ -70,3 +70,11 @@ def test_a_bad_url_leaves_an_existing_recording_untouched(tmp_path: Path) -> Non
     done = run("send", "/dev/no-such-port", "Z", "--record", str(record), timeout=20)
     assert done.returncode == 2 and "no such port" in done.stderr
     assert record.read_text() == "precious\n"
+
+
+def test_a_transcript_with_nothing_to_check_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "empty.transcript"
+    path.write_text("# appmode transcript v1\n# only a comment\n")
+    done = run("conform", str(path), timeout=20)
+    assert done.returncode == 2 and "PASS" not in done.stdout
+    assert done.stderr == f"appmode: error: {path} has no '>' or '<' lines: nothing to check\n"

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from appmode.errors import AppmodeError
 from appmode.protocol.transcript import (
     HEADER,
+    MAX_LINE,
     Directive,
     Recorder,
     TranscriptError,
@@ -98,11 +99,30 @@ def test_other_versions_and_unreadable_files() -> None:
         read_transcript("/no/such.transcript")
 
 
-def test_non_utf8_file_is_reported(tmp_path: Path) -> None:
+def test_non_utf8_file_is_reported_at_its_line(tmp_path: Path) -> None:
     path = tmp_path / "latin.transcript"
-    path.write_bytes(b"0.0 > \xff\n")
-    with pytest.raises(TranscriptError, match="not UTF-8"):
+    path.write_bytes(HEADER.encode() + b"\n0.0 > A\n0.0 > \xff\n")
+    with pytest.raises(TranscriptError, match=r"latin\.transcript:3: not UTF-8 text \(byte 7 "):
         read_transcript(path)
+
+
+def test_a_file_that_is_no_transcript_fails_at_once_with_a_short_message(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "zeros"
+    path.write_bytes(b"\0" * (MAX_LINE + 1))  # like /dev/zero, which never ends
+    with pytest.raises(TranscriptError, match=r"zeros:1: a line of over 65,536 bytes"):
+        read_transcript(path)
+    path.write_text("9" * 5000 + " > A\n")
+    with pytest.raises(TranscriptError) as caught:
+        read_transcript(path)
+    assert len(str(caught.value)) < 150 + len(str(path)) and "(5,000 chars)" in str(caught.value)
+
+
+@pytest.mark.skipif(not Path("/dev/zero").exists(), reason="needs /dev/zero")
+def test_dev_zero_is_refused_not_read_to_the_end() -> None:
+    with pytest.raises(TranscriptError, match="/dev/zero:1: a line of over"):
+        read_transcript("/dev/zero")
 
 
 @given(st.text(max_size=300))
