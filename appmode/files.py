@@ -70,6 +70,11 @@ def remove_leftovers(path: str | os.PathLike[str]) -> None:
             entry.unlink(missing_ok=True)
 
 
+def temporary_beside(target: Path) -> Path:
+    """A new name for a temporary file beside `target`, of the LEFTOVER form."""
+    return target.with_name(f".{target.name}.{secrets.token_hex(4)}.appmode-tmp")
+
+
 def _write_in_place(target: Path, data: bytes) -> None:
     fd = os.open(target, os.O_WRONLY | os.O_CLOEXEC)
     try:
@@ -79,7 +84,7 @@ def _write_in_place(target: Path, data: bytes) -> None:
 
 
 def _replace(target: Path, data: bytes, existing: os.stat_result | None) -> None:
-    tmp = target.with_name(f".{target.name}.{secrets.token_hex(4)}.appmode-tmp")
+    tmp = temporary_beside(target)
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
     try:
         try:

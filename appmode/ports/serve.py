@@ -18,12 +18,14 @@ import tty
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
+from pathlib import Path
 
 import serial
 
 from appmode.board.firmware import Board
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
+from appmode.files import temporary_beside
 from appmode.line.wire import Wire
 from appmode.ports.link import BAUD, explain_open_error, parse_device
 from appmode.protocol import params
@@ -126,11 +128,12 @@ def _symlink(target: str, link: str) -> None:
     """Point `link` at `target`, replacing an older link atomically (not a real file)."""
     if os.path.exists(link) and not os.path.islink(link):
         raise AppmodeError(f"--link {link}: a file is already there; choose another path")
-    tmp = f"{link}.{os.getpid()}.tmp"
+    tmp = temporary_beside(Path(link))
     try:
         os.symlink(target, tmp)
         os.replace(tmp, link)
     except OSError as exc:
+        tmp.unlink(missing_ok=True)
         raise AppmodeError(f"--link {link}: cannot create the link: {exc.strerror}") from None
 
 
