@@ -14,6 +14,7 @@ import os
 import platform
 import random
 import select
+import selectors
 import shutil
 import statistics
 import subprocess
@@ -132,8 +133,36 @@ def bench_board_cpu(seconds: float) -> list[Row]:
             "appmode board streaming telemetry (paced)",
             f"{share:.2f} % of a core ({received / seconds:.0f} bytes/s out)",
             "< 1 %",
-        )
+        ),
+        (
+            "its floor: a bare loop, same wake-ups and pty writes",
+            f"{wakeup_floor(seconds, received / seconds / 4):.2f} % of a core",
+            "",
+        ),
     ]
+
+
+def wakeup_floor(seconds: float, rate: float) -> float:
+    """CPU of a loop doing nothing but what trickled output needs: `rate` timed wake-ups
+    a second, each writing 4 bytes into a pty (the machine's cost, not appmode's)."""
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    idle, _ = os.pipe()
+    sel = selectors.DefaultSelector()
+    sel.register(idle, selectors.EVENT_READ)
+    start_cpu, start = time.process_time(), time.monotonic()
+    wakeups = 0
+    while time.monotonic() - start < seconds:
+        sel.select(1 / rate)
+        os.write(master, b"abcd")
+        wakeups += 1
+        if wakeups % 64 == 0:
+            os.read(slave, 4096)
+    share = (time.process_time() - start_cpu) / (time.monotonic() - start) * 100
+    sel.close()
+    for fd in (master, slave, idle):
+        os.close(fd)
+    return share
 
 
 def bench_drive_cpu(seconds: float) -> list[Row]:
