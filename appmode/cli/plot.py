@@ -13,7 +13,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "plot",
         help="draw a transcript's telemetry (needs matplotlib)",
         description="Draw velocities, attitude and battery over time, with the commands "
-        "marked, to a PNG. Needs the plot extra: pip install 'appmode[plot]'.",
+        "marked, to a PNG. Needs matplotlib: pip install matplotlib.",
     )
     plot.add_argument("file", metavar="FILE", help="the transcript")
     plot.add_argument("-o", "--output", required=True, metavar="PNG", help="the image to write")

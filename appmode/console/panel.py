@@ -35,7 +35,9 @@ def _size(count: int) -> str:
 
 
 def _bar(percent: int) -> str:
-    filled = round(percent / 100 * BAR)
+    """A BAR-wide gauge; a reading outside 0–100 (a garbled or odd board) fills it to
+    its end, never beyond."""
+    filled = round(min(100, max(0, percent)) / 100 * BAR)
     return "[" + "#" * filled + "." * (BAR - filled) + "]"
 
 

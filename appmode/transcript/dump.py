@@ -85,7 +85,10 @@ def run_plot(path: str, output: str) -> int:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise AppmodeError("appmode plot needs matplotlib: pip install 'appmode[plot]'") from None
+        raise AppmodeError(
+            "appmode plot needs matplotlib: pip install matplotlib (or, in a checkout of "
+            "appmode, pip install '.[plot]')"
+        ) from None
     transcript = read_transcript(path)
     series: dict[str, list[Any]] = {
         k: [] for k in ("tA", "x", "y", "z", "tB", "pitch", "roll", "yaw", "battery")

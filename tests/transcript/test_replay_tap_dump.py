@@ -204,3 +204,16 @@ def test_plot_without_records_is_a_clear_error(tmp_path: Path) -> None:
 def test_read_transcript_of_the_suite_is_consistent() -> None:
     for path in (ROOT / "appmode" / "transcript" / "suite").glob("*.transcript"):
         assert read_transcript(path).entries
+
+
+def test_plot_without_matplotlib_names_the_package_to_install(tmp_path: Path) -> None:
+    path = tmp_path / "t.transcript"
+    path.write_text("# appmode transcript v1\n0.0 < {A0:0:0:0}$\n")
+    code = (
+        "import sys; sys.modules['matplotlib'] = None\n"
+        "from appmode.cli.main import main\n"
+        f"sys.exit(main(['plot', {str(path)!r}, '-o', {str(tmp_path / 'x.png')!r}]))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "pip install matplotlib" in done.stderr and "appmode[plot]" not in done.stderr
