@@ -197,18 +197,24 @@ class Host:
 
     # ------------------------------------------------------------ end
 
-    def close(self) -> None:
+    def close(self) -> bytes | None:
         """Stop the car (`Z` is the last byte sent, after `{}` if a frame is open), then
-        close the port."""
+        close the port. Returns the bytes of that stop, or None if the link was down."""
         if self._port is None:
-            return
-        with contextlib.suppress(AppmodeError, serial.SerialException, OSError):
-            self.send(self.state.end.stop)  # a failing recording must not keep it in
+            return None
+        stop = self.state.end.stop
+        try:
+            self.send(stop)
+        except LinkLost:
+            return self.close()  # the port is gone: nothing was sent
+        except AppmodeError:
+            pass  # written; only its recording failed, which must not keep the port open
         if self._port is not None:
             with contextlib.suppress(serial.SerialException, OSError):
                 self._port.flush()
             self._port.close()
             self._port = None
+        return stop
 
     def __enter__(self) -> Host:
         return self

@@ -127,6 +127,15 @@ def test_send_ending_inside_a_frame_still_stops_the_car(tokens: list[str]) -> No
         assert done.returncode == 0, done.stderr
         # the open frame is abandoned, never applied: max_speed is still the default
         assert board_state(board.url) == (STOPPED, DEFAULTS)
+    assert done.stdout.splitlines()[-1].split()[1:] == [
+        ">", "{}Z", "closes", "the", "open", "frame,", "then", "stop"
+    ], "the user sees how the car was stopped"
+
+
+def test_send_prints_the_final_z_it_sends() -> None:
+    done = run("send", "sim://", "J", "A", "--listen", "0")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1].split()[1:] == [">", "Z", "stop"]
 
 
 def test_replay_ending_inside_a_frame_still_stops_the_car(tmp_path: Path) -> None:
