@@ -16,10 +16,12 @@ from appmode.protocol.render import describe, line, to_json
 from appmode.protocol.transcript import Recorder
 
 
-def open_host(stack: ExitStack, url: str, record: str | None) -> Host:
+def open_host(
+    stack: ExitStack, url: str, record: str | None, stop_on_close: bool = True
+) -> Host:
     """The host, then its recording: a URL that does not open leaves the file untouched.
     The recording is closed after the host, so it holds the final stop."""
-    host = Host(url)
+    host = Host(url, stop_on_close=stop_on_close)
     try:
         recorder = Recorder.create(record, 0.0, sim_directives(url)) if record else None
     except BaseException:

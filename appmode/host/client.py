@@ -42,9 +42,11 @@ class Host:
         tap: Tap | None = None,
         clock: Callable[[], float] = time.monotonic,
         opener: Callable[[str], serial.SerialBase] = open_link,
+        stop_on_close: bool = True,
     ) -> None:
         self.url = url
         self.tap = tap
+        self.stop_on_close = stop_on_close
         self.state = HostState()
         self._clock = clock
         self._opener = opener
@@ -199,12 +201,14 @@ class Host:
 
     def close(self) -> bytes | None:
         """Stop the car (`Z` is the last byte sent, after `{}` if a frame is open), then
-        close the port. Returns the bytes of that stop, or None if the link was down."""
+        close the port. Returns the bytes of that stop, or None if the link was down.
+        A passive host (`stop_on_close=False`, a monitor) sends nothing."""
         if self._port is None:
             return None
-        stop = self.state.end.stop
+        stop = self.state.end.stop if self.stop_on_close else b""
         try:
-            self.send(stop)
+            if stop:
+                self.send(stop)
         except LinkLost:
             return self.close()  # the port is gone: nothing was sent
         except AppmodeError:

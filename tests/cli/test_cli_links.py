@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.support.processes import board_process, run
+from tests.support.processes import board_process, run, sent_lines
 
 
 def test_done_when_params_set_save_survives_a_board_restart(tmp_path: Path) -> None:
@@ -174,3 +174,25 @@ def test_board_serves_on_a_real_port_like_a_bluetooth_module() -> None:
         os.close(master)
         os.close(slave)
     assert b"{C500:10000:20:0:10:10:10:0:0}$" in received
+
+
+@pytest.mark.parametrize("stop_on_exit", [False, True])
+def test_monitor_writes_nothing_to_the_port_unless_asked(
+    tmp_path: Path, stop_on_exit: bool
+) -> None:
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--quiet", "--record", str(record)) as board:
+        extra = ["--stop-on-exit"] if stop_on_exit else []
+        done = run("monitor", board.url, "--duration", "0.4", *extra)
+        assert done.returncode == 0, done.stderr
+    assert " < {" in done.stdout
+    assert sent_lines(record) == (["Z"] if stop_on_exit else [])
+
+
+def test_monitor_count_counts_records_only() -> None:
+    noisy = "sim://?faults=chatter:0.05,seed:3"
+    done = run("monitor", noisy, "--count", "5", "--json")
+    assert done.returncode == 0, done.stderr
+    kinds = [json.loads(text)["kind"] for text in done.stdout.splitlines()]
+    records = [k for k in kinds if k in ("velocity", "attitude", "params")]
+    assert len(records) == 5 and len(kinds) > 5, kinds
