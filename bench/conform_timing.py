@@ -19,6 +19,7 @@ from common import board, summary_ms
 from appmode.protocol.transcript import read_transcript
 
 SPACING = 0.017
+SENT = {bytes([c]) for c in b"ABCDEFGHJ"}
 
 
 def measure(sends: int) -> list[float]:
@@ -31,13 +32,14 @@ def measure(sends: int) -> list[float]:
         record = folder / "board.transcript"
         with board("--pty", "--record", str(record)) as url:
             done = subprocess.run(
-                [sys.executable, "-m", "appmode", "conform", "--board", url, str(script)],
+                [sys.executable, "-m", "appmode", "conform", "--board", url, "--yes", str(script)],
                 capture_output=True,
                 text=True,
             )
             if done.returncode != 0:
                 raise SystemExit(f"conform failed: {done.stdout}{done.stderr}")
-        received = [e for e in read_transcript(record).entries if e.direction == ">"]
+        entries = read_transcript(record).entries  # also the reads (and Z) around the run
+        received = [e for e in entries if e.direction == ">" and e.data in SENT]
     due = [0.0] + [k * SPACING for k in range(1, sends)]
     got = [e.time for e in received[:sends]]
     if len(got) != sends:

@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.options import Subparsers
+from appmode.errors import AppmodeError
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -29,10 +30,32 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--board", metavar="URL", help="run in real time against this board instead"
     )
     conform.add_argument("--junit", metavar="FILE", help="also write a JUnit XML report")
+    conform.add_argument(
+        "--yes",
+        action="store_true",
+        help="with --board: run without asking first (the car moves and its parameters "
+        "are changed, then restored)",
+    )
     return conform
 
 
+WARNING = (
+    "conform drives the board at {url}: the car moves (the suite tries every letter, a "
+    "second each) and its parameters are changed and saved; the ones found now are "
+    "restored at the end. Put the car on a stand."
+)
+
+
 def run(args: argparse.Namespace) -> int:
+    from appmode.ports.link import is_simulated
     from appmode.transcript.runner import run_conform
 
+    if args.board and not is_simulated(args.board) and not args.yes:
+        warning = WARNING.format(url=args.board)
+        if not sys.stdin.isatty():
+            raise AppmodeError(f"{warning} Add --yes to run it without asking.")
+        print(f"{warning}\nGo on? [y/N] ", end="", file=sys.stderr, flush=True)
+        if sys.stdin.readline().strip().lower() not in ("y", "yes"):
+            print("not run", file=sys.stderr)
+            return 1
     return run_conform(args.paths, args.board, args.junit, sys.stdout)

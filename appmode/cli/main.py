@@ -22,6 +22,7 @@ from appmode.cli import (
     monitor,
     params,
     plot,
+    ports,
     replay,
     send,
     tap,
@@ -42,6 +43,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     tap,
     dump,
     plot,
+    ports,
 )
 """Each command's module: `register(sub)` adds its arguments, `run(args)` does the job."""
 

@@ -224,7 +224,11 @@ class Session:
             self.read_params()
             return
         top = params.PARAMS[params.MAX_SPEED].maximum
-        self.set_param(params.MAX_SPEED, min(top, max(0, current.values[0] + delta)))
+        wanted = current.values[params.MAX_SPEED] + delta
+        value = min(top, max(0, wanted))
+        if value != wanted:
+            self.say(f"max_speed {wanted} is out of 0–{top}: setting {value}")
+        self.set_param(params.MAX_SPEED, value)
 
     def save(self) -> None:
         if self._send(b"{Q:W}"):

@@ -89,7 +89,7 @@ def explain_open_error(where: str, exc: Exception) -> str:
     if code == errno.ENOENT or "No such file" in text:
         return (
             f"no such port {where}: check the adapter is plugged in (and paired, for "
-            f"Bluetooth); list ports with: python -m serial.tools.list_ports"
+            f"Bluetooth); list ports with: appmode ports"
         )
     if code == errno.EACCES or "Permission denied" in text:
         return (

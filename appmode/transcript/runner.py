@@ -17,6 +17,7 @@ from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.host.client import Host, LinkLost
 from appmode.line.wire import Wire
+from appmode.ports.link import is_simulated
 from appmode.protocol import app, params
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
 from appmode.transcript.matcher import Check
@@ -185,7 +186,30 @@ def run_conform(paths: list[str], board: str | None, junit: str | None, out: Tex
         if interactive:
             print(f"\r\033[K{text}", end="", file=sys.stderr, flush=True)
 
+    live = board is not None and not is_simulated(board)  # sim:// is a new board each time
+    found = _read_params(board) if live and board is not None else None
     results: list[Result] = []
+    try:
+        _run_all(transcripts, board, progress, interactive, results, out)
+    finally:
+        if board is not None and found is not None:
+            out.write(restore_params(board, found) + "\n")
+    failed = sum(not r.passed for r in results)
+    target = "the embedded simulated board" if board is None else board
+    out.write(f"{len(results) - failed} passed, {failed} failed against {target}\n")
+    if junit:
+        write_junit(junit, results)
+    return 1 if failed else 0
+
+
+def _run_all(
+    transcripts: list[Transcript],
+    board: str | None,
+    progress: Progress,
+    interactive: bool,
+    results: list[Result],
+    out: TextIO,
+) -> None:
     for transcript in transcripts:
         if board is None:
             result = run_virtual(transcript)
@@ -203,9 +227,30 @@ def run_conform(paths: list[str], board: str | None, junit: str | None, out: Tex
         if result.failure is not None:
             out.write(f"      {result.failure}\n")
         out.flush()
-    failed = sum(not r.passed for r in results)
-    target = "the embedded simulated board" if board is None else board
-    out.write(f"{len(results) - failed} passed, {failed} failed against {target}\n")
-    if junit:
-        write_junit(junit, results)
-    return 1 if failed else 0
+
+
+def _read_params(url: str) -> tuple[int, ...]:
+    with Host(url) as host:
+        try:
+            return host.read_params()
+        except AppmodeError as exc:
+            raise AppmodeError(f"before running: {exc}") from None
+
+
+def restore_params(url: str, values: tuple[int, ...]) -> str:
+    """Set the board's parameters back to `values` (verified) and send `{Q:W}`: what a
+    run against a real board changed is undone. Returns what was done, in a line."""
+    try:
+        with Host(url) as host:
+            now = host.read_params()
+            changed = [i for i, (a, b) in enumerate(zip(now, values, strict=True)) if a != b]
+            for index in changed:
+                host.set_param(index, values[index])
+            host.save()
+    except AppmodeError as exc:
+        shown = ", ".join(f"{p.name}={v}" for p, v in zip(params.PARAMS, values, strict=True))
+        return f"could not restore the parameters found at the start ({shown}): {exc}"
+    return (
+        f"restored the parameters found at the start ({len(changed)} had changed) and "
+        "sent {Q:W} to save them"
+    )

@@ -110,3 +110,10 @@ def test_a_recording_failing_midway_stops_with_a_message_and_driving_goes_on() -
         assert session.in_force == "B"
     finally:
         session.close()
+
+
+def test_a_speed_step_past_the_range_says_what_it_set() -> None:
+    done = run("drive", stdin=b"wait 0.3\nspeed -5000\nwait 0.5\nquit\n")
+    assert done.returncode == 0, done.stderr
+    assert "max_speed -4500 is out of 0–65535: setting 0" in done.stdout
+    assert "max_speed = 0 (verified)" in done.stdout

@@ -8,9 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from appmode.protocol import params
 from appmode.protocol.transcript import parse_transcript, read_transcript
 from appmode.transcript.runner import run_live, run_virtual
-from tests.support.processes import ROOT, board_process, run
+from tests.support.processes import ROOT, board_process, board_state, run
 
 SUITE = sorted((ROOT / "appmode" / "transcript" / "suite").glob("*.transcript"))
 
@@ -147,8 +148,24 @@ def test_missing_paths_are_one_line_errors() -> None:
 
 
 def test_the_suite_passes_in_real_time_against_a_board_process() -> None:
-    """The whole suite over a pty, paced: about 100 s."""
+    """The whole suite over a pty, paced: about 100 s. The parameters the board had
+    before are restored afterwards."""
     with board_process("--pty", "--quiet") as board:
-        done = run("conform", "--board", board.url, "appmode/transcript/suite", timeout=400)
-    assert done.returncode == 0, done.stdout
+        assert run("params", board.url, "--set", "max_speed=800").returncode == 0
+        done = run(
+            "conform", "--board", board.url, "--yes", "appmode/transcript/suite", timeout=400
+        )
+        assert done.returncode == 0, done.stdout
+        _, values = board_state(board.url)
     assert f"{len(SUITE)} passed, 0 failed against /dev/" in done.stdout
+    assert "restored the parameters found at the start (" in done.stdout
+    assert values == (800, *params.DEFAULTS[1:])
+
+
+def test_a_real_board_is_driven_only_when_the_user_agrees() -> None:
+    with board_process("--pty", "--quiet") as board:
+        refused = run("conform", "--board", board.url, timeout=30)
+    assert refused.returncode == 2 and "PASS" not in refused.stdout
+    assert "the car moves" in refused.stderr and "Add --yes" in refused.stderr
+    simulated = run("conform", "--board", "sim://", "appmode/transcript/suite/s5_save.transcript")
+    assert simulated.returncode == 0, simulated.stderr
