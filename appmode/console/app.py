@@ -8,29 +8,52 @@ history): the status panel, the 3×3 key grid and arrows to drive, and a command
 from __future__ import annotations
 
 import asyncio
+import os
+import sys
 import time
 from collections.abc import Iterable
+from pathlib import Path
 from typing import TextIO
 
 from prompt_toolkit.application import Application
 from prompt_toolkit.buffer import Buffer
 from prompt_toolkit.completion import NestedCompleter
+from prompt_toolkit.data_structures import Point
 from prompt_toolkit.filters import Condition
-from prompt_toolkit.history import InMemoryHistory
+from prompt_toolkit.history import FileHistory, History, InMemoryHistory
 from prompt_toolkit.input import Input
 from prompt_toolkit.key_binding import KeyBindings, KeyPressEvent
-from prompt_toolkit.layout import ConditionalContainer, HSplit, Layout, VSplit, Window
+from prompt_toolkit.layout import (
+    ConditionalContainer,
+    Float,
+    FloatContainer,
+    HSplit,
+    Layout,
+    VSplit,
+    Window,
+)
 from prompt_toolkit.layout.controls import BufferControl, FormattedTextControl
+from prompt_toolkit.layout.dimension import Dimension
+from prompt_toolkit.layout.menus import CompletionsMenu
 from prompt_toolkit.output import Output
 
-from appmode.console.panel import ARROWS, KEY_GRID, status_fragments, status_text
+from appmode.console.panel import (
+    ARROWS,
+    KEY_GRID,
+    WIDTH,
+    Fragments,
+    status_fragments,
+    status_text,
+)
 from appmode.console.session import (
     COMMAND_NAMES,
     MESSAGES,
     PAGE_WORDS,
+    QUIT_WORDS,
     Quit,
     Session,
     ShowStatus,
+    help_lines,
 )
 from appmode.host.signals import ENDING_SIGNALS
 from appmode.host.tokens import Wait
@@ -58,20 +81,54 @@ def _completer() -> NestedCompleter:
 
 
 def build_app(
-    session: Session, input: Input | None = None, output: Output | None = None
+    session: Session,
+    input: Input | None = None,
+    output: Output | None = None,
+    history: History | None = None,
 ) -> Application[None]:
     """The console's Application over a started session."""
-    history = InMemoryHistory()
+    # Completions show on Tab only, not while typing.
     command = Buffer(
-        multiline=False, completer=_completer(), history=history, complete_while_typing=True
+        multiline=False,
+        completer=_completer(),
+        history=history or InMemoryHistory(),
+        complete_while_typing=False,
     )
+    warned = False
+
+    def leave(app: Application[None]) -> None:
+        """Quit; the first time, if parameters were set and not saved, only say so."""
+        nonlocal warned
+        warning = session.unsaved_warning()
+        if warning is not None and not warned:
+            warned = True
+            session.say(f"{warning} — :save keeps it; quit again to leave")
+            return
+        app.exit()
+    view = View()
     status = Window(
-        FormattedTextControl(lambda: status_fragments(session), focusable=True),
+        FormattedTextControl(lambda: _top(session, view), focusable=True),
         wrap_lines=False,
         dont_extend_height=True,
     )
+
+    def shown() -> list[str]:
+        """The log up to its newest line, or to `view.back` lines before it."""
+        log = list(session.messages)
+        return log[: len(log) - view.back]
+
+    def bottom() -> Point:  # the window follows this point: the end of what is shown
+        log = shown()
+        return Point(len(log[-1]) if log else 0, max(0, len(log) - 1))
+
     messages = Window(
-        FormattedTextControl(lambda: "\n".join(session.messages)), height=MESSAGES, wrap_lines=True
+        FormattedTextControl(lambda: "\n".join(shown()), get_cursor_position=bottom),
+        height=Dimension(min=3, preferred=3),  # the panel first, the log in what is left
+        wrap_lines=True,
+        always_hide_cursor=True,
+    )
+    rule = Window(
+        FormattedTextControl(lambda: _rule(view)), height=1, style="fg:ansibrightblack"
     )
     command_line = VSplit(
         [Window(FormattedTextControl(":"), width=1), Window(BufferControl(command), height=1)]
@@ -99,7 +156,21 @@ def build_app(
     keys.add("=", filter=driving)(lambda e: session.run("speed +100"))
     keys.add("-", filter=driving)(lambda e: session.run("speed -100"))
     keys.add("p", filter=driving)(lambda e: session.run("params"))
-    keys.add("?", filter=driving)(lambda e: session.run("help"))
+    keys.add("?", filter=driving)(lambda e: view.toggle("help"))
+    keys.add("v", filter=driving)(lambda e: view.toggle("waves"))
+    keys.add("escape", filter=driving & Condition(lambda: view.top != "panel"))(
+        lambda e: view.toggle(view.top)
+    )
+
+    def scroll(lines: int) -> None:
+        height = messages.render_info.window_height if messages.render_info else MESSAGES
+        step = max(1, height - 1) * lines
+        oldest = max(0, len(session.messages) - height)  # the first page, full
+        view.back = min(oldest, max(0, view.back + step))
+
+    keys.add("pageup")(lambda e: scroll(1))
+    keys.add("pagedown")(lambda e: scroll(-1))
+    keys.add("end", filter=driving)(lambda e: setattr(view, "back", 0))
 
     @keys.add(":", filter=driving)
     def _command(event: KeyPressEvent) -> None:
@@ -111,35 +182,51 @@ def build_app(
         command.reset()
         event.app.layout.focus(status)
 
+    # While typing, ↑ and ↓ walk the history, never a completion menu (Tab and Shift-Tab
+    # do): `:`, Tab, ↑ used to pick the menu's last entry, `quit`.
+    @keys.add("up", filter=typing)
+    def _older(event: KeyPressEvent) -> None:
+        command.cancel_completion()
+        command.history_backward()
+
+    @keys.add("down", filter=typing)
+    def _newer(event: KeyPressEvent) -> None:
+        command.cancel_completion()
+        command.history_forward()
+
     @keys.add("enter", filter=typing)
     def _run(event: KeyPressEvent) -> None:
         text = command.text
-        command.append_to_history()
+        if not is_quit(text):  # never one ↑ and Enter away
+            command.append_to_history()
         command.reset()
         event.app.layout.focus(status)
+        if text.strip().lower() in ("help", "?"):
+            view.top = "help"
+            return
         try:
             step = session.run(text)
         except Quit:
-            event.app.exit()
+            leave(event.app)
             return
         if isinstance(step, Wait):
             session.say("wait is for script mode")
         _show(session, step)
 
-    @keys.add("c-c")
-    @keys.add("c-q")
-    @keys.add("Q", filter=driving)
-    def _quit(event: KeyPressEvent) -> None:
-        event.app.exit()
+    keys.add("c-c")(lambda e: e.app.exit())  # at once: the session's close says what
+    keys.add("c-q")(lambda e: leave(e.app))
 
     layout = Layout(
-        HSplit(
-            [
-                status,
-                Window(height=1, char="─"),
-                messages,
-                ConditionalContainer(command_line, filter=typing),
-            ]
+        FloatContainer(
+            HSplit(
+                [
+                    status,
+                    rule,
+                    messages,
+                    ConditionalContainer(command_line, filter=typing),
+                ]
+            ),
+            floats=[Float(xcursor=True, ycursor=True, content=CompletionsMenu(max_height=8))],
         ),
         focused_element=status,
     )
@@ -147,6 +234,33 @@ def build_app(
         layout=layout, key_bindings=keys, full_screen=True, input=input, output=output
     )
     return app
+
+
+class View:
+    """What the console shows above its messages, and how far back they are scrolled."""
+
+    def __init__(self) -> None:
+        self.top = "panel"
+        """"panel", "waves" (the panel with waveforms) or "help"."""
+        self.back = 0
+        """Message lines scrolled back from the newest (PageUp / PageDown)."""
+
+    def toggle(self, name: str) -> None:
+        self.top = "panel" if self.top == name else name
+
+
+def _top(session: Session, view: View) -> Fragments:
+    if view.top == "help":
+        return [("", "\n".join(help_lines()))]
+    fragments = status_fragments(session, waveforms=view.top == "waves")
+    style, text, *_ = fragments[-1]
+    return [*fragments[:-1], (style, text.rstrip("\n"))]  # no blank line under it
+
+
+def _rule(view: View) -> str:
+    if view.back:
+        return f"── {view.back} lines back · PgUp/PgDn scroll · End: newest ".ljust(WIDTH, "─")
+    return "─" * WIDTH
 
 
 async def run_app(app: Application[None], session: Session) -> None:
@@ -192,16 +306,47 @@ def run_drive(
     input: Input | None = None,
     output: Output | None = None,
 ) -> int:
-    """Start the session, run the console (or script mode), and always close it: `Z` last."""
+    """Start the session, run the console (or script mode), and always close it: `Z` last.
+    Parameters set and not saved are named at the end."""
     try:
         session.start()
         if interactive:
-            asyncio.run(run_app(build_app(session, input, output), session))
+            app = build_app(session, input, output, command_history())
+            asyncio.run(run_app(app, session))
         else:
             run_script(session, script, out)
     finally:
+        warning = session.unsaved_warning()
         session.close()
+        if warning is not None:
+            print(
+                f"appmode: {warning}: the board keeps it until it is switched off",
+                file=sys.stderr,
+            )
     return 0
+
+
+def is_quit(text: str) -> bool:
+    return text.strip().lower() in QUIT_WORDS
+
+
+def command_history() -> History:
+    """The commands typed, kept across sessions in the user's data folder (in memory
+    when that cannot be written)."""
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA", Path.home() / "AppData" / "Local"))
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Application Support"
+    else:
+        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    folder = base / "appmode"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / "history"
+        path.touch()
+    except OSError:
+        return InMemoryHistory()
+    return FileHistory(str(path))
 
 
 def run_script(session: Session, lines: Iterable[str], out: TextIO) -> int:
@@ -214,7 +359,7 @@ def run_script(session: Session, lines: Iterable[str], out: TextIO) -> int:
         try:
             step = session.run(raw)
         except Quit:
-            break
+            break  # run_drive names what was not saved
         _show(session, step)
         _settle(session, step.seconds if isinstance(step, Wait) else 0.0)
     out.flush()

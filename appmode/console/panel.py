@@ -6,6 +6,9 @@ from typing import TYPE_CHECKING
 
 from prompt_toolkit.formatted_text import StyleAndTextTuples
 
+from appmode.console.session import KEYS_HELP
+from appmode.console.waves import waveform_lines
+from appmode.host.state import TRACE_SECONDS
 from appmode.protocol import params
 from appmode.protocol.directions import grid_for, letter_name
 
@@ -20,14 +23,15 @@ ARROWS = {"up": (0, 1), "down": (2, 1), "left": (1, 0), "right": (1, 2)}
 """Arrow keys by grid position."""
 GLYPHS = (("↖", "↑", "↗"), ("←", "■", "→"), ("↙", "↓", "↘"))
 BAR = 20
-KEYS_HELP = (
-    "arrows or q w e / a s d / z x c drive (hold) · space stop · i j k page · l latch\n"
-    " + - speed · p params · : command line · ? help · Ctrl-C quit"
-)
+WIDTH = 80
+"""Columns every panel line fits in."""
 
 
 STALE = 0.5
 """Seconds without a record after which the panel shows how long it has been."""
+SILENT = 2.0
+"""Seconds after opening with nothing received after which the panel says what to check."""
+SILENT_HINT = "check the baud rate (9600), that the car is on, and Bluetooth is paired"
 
 
 def _size(count: int) -> str:
@@ -41,8 +45,8 @@ def _bar(percent: int) -> str:
     return "[" + "#" * filled + "." * (BAR - filled) + "]"
 
 
-def status_fragments(session: Session) -> Fragments:
-    """The whole panel."""
+def status_fragments(session: Session, waveforms: bool = False) -> Fragments:
+    """The whole panel; the waveforms in place of the key grid if asked."""
     host = session.host
     now = host.now()
     stats = host.state.stats
@@ -53,48 +57,48 @@ def status_fragments(session: Session) -> Fragments:
         out.append(("reverse bold fg:ansigreen", " REAL BOARD "))
     out.append(("", f"  {session.url}\n"))
 
-    if host.connected:
-        age = stats.since_last(now)
-        if age is None:
-            last = "no record yet"
-        else:
-            last = "records live" if age < STALE else f"last record {age:.1f} s ago"
-        stale = age is None or age > 1.0
+    age = stats.since_last(now)
+    if not host.connected:
+        out.append(("reverse bold fg:ansired", " LINK LOST — retrying; keys do nothing "))
+        out.append(("", "\n"))
+    elif age is None:  # open, but nothing has come: it is not known to be up
+        waiting = now > SILENT
+        out.append(("reverse bold fg:ansired" if waiting else "", " port open, nothing received "))
+        out.append(("", f"  {SILENT_HINT if waiting else ''}\n"))
+    else:
+        last = "records live" if age < STALE else f"last record {age:.1f} s ago"
         recent = stats.recent_errors(now)
         if recent:
             out.append(("reverse bold fg:ansiyellow", f" link DEGRADED: {recent} errors in 5 s "))
         else:
-            out.append(("fg:ansired bold" if stale else "fg:ansigreen", " link up"))
+            out.append(("fg:ansired bold" if age > 1.0 else "fg:ansigreen", " link up"))
         out.append(
             (
                 "",
-                f"   {stats.rate(now):3.0f} records/s · in {_size(stats.bytes_in)} · "
+                f"  {stats.rate(now):3.0f} records/s · in {_size(stats.bytes_in)} · "
                 f"out {_size(stats.bytes_out)} · errors {stats.errors} · {last}\n",
             )
         )
-    else:
-        out.append(("reverse bold fg:ansired", " LINK LOST — retrying; keys do nothing "))
-        out.append(("", "\n"))
 
-    v, a = host.state.velocity, host.state.attitude
+    state = host.state
+    v, a = state.velocity, state.attitude
     velocity = "  —" if v is None else f"x {v.x:6d}   y {v.y:6d}   z {v.z:6d}"
     attitude = "  —" if a is None else f"pitch {a.pitch:4d}   roll {a.roll:4d}   yaw {a.yaw:4d}"
-    out.append(("bold", " velocity "))
-    out.append(("", f" {velocity}\n"))
-    out.append(("bold", " attitude "))
-    out.append(("", f" {attitude}\n"))
+    out += _reading(" velocity ", velocity, state.velocities.age(now))
+    out += _reading(" attitude ", attitude, state.attitudes.age(now))
     out.append(("bold", " battery  "))
     if a is None:
         out.append(("", "  —\n"))
     else:
-        style = "fg:ansired" if a.battery < 20 else "fg:ansigreen"
+        old = (state.attitudes.age(now) or 0.0) > STALE
+        style = "fg:ansibrightblack" if old else "fg:ansired" if a.battery < 20 else "fg:ansigreen"
         out.append((style, f" {a.battery:3d} % {_bar(a.battery)}\n"))
 
+    driving = session.driving
     mode = (
         "latched"
-        if session.driving.latched
-        else f"hold (release after {session.driving.first_timeout:g} s, "
-        f"then {session.driving.repeat_timeout:g} s)"
+        if driving.latched
+        else f"hold {driving.first_timeout:g}/{driving.repeat_timeout:g} s"
     )
     out.append(("bold", " page     "))
     out.append(("", f" {session.page_text}   "))
@@ -113,6 +117,11 @@ def status_fragments(session: Session) -> Fragments:
             prefix = " " if row == 0 else "           "
             out.append(("", prefix + " · ".join(pairs[row : row + 3]) + "\n"))
 
+    if waveforms:
+        out.append(("bold", f" last {TRACE_SECONDS:g} s (v: the key grid)\n"))
+        out += [("", line + "\n") for line in waveform_lines(state, now, WIDTH)]
+        out.append(("fg:ansibrightblack", f" {KEYS_HELP.replace(chr(10), chr(10) + ' ')}\n"))
+        return out
     out.append(("", "\n"))
     letters = grid_for(session.page)
     for r in range(3):
@@ -123,8 +132,16 @@ def status_fragments(session: Session) -> Fragments:
             cell = f"{KEY_GRID[r][c]} {letter} {GLYPHS[r][c]} {letter_name(session.page, letter)}"
             out.append((style, cell.ljust(22)))
         out.append(("", "\n"))
-    out.append(("fg:ansibrightblack", f" {KEYS_HELP}\n"))
+    out.append(("fg:ansibrightblack", f" {KEYS_HELP.replace(chr(10), chr(10) + ' ')}\n"))
     return out
+
+
+def _reading(label: str, text: str, age: float | None) -> Fragments:
+    """A line of values; greyed, with their age, once they are not fresh (a silent or
+    lost link must not show a car that looks as if it were moving)."""
+    if age is None or age <= STALE:
+        return [("bold", label), ("", f" {text}\n")]
+    return [("bold", label), ("fg:ansibrightblack", f" {text}   ({age:.1f} s ago)\n")]
 
 
 def status_text(session: Session) -> str:

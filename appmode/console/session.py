@@ -28,6 +28,9 @@ from appmode.protocol.transcript import Recorder
 
 SPEED_STEP = 100
 MESSAGES = 8
+"""Message lines shown when the terminal's height cannot be known."""
+LOG = 500
+"""Messages kept for scrolling back."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,21 +43,35 @@ class CommandSpec:
 COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("params", "", "read the nine parameters"),
     CommandSpec("set", "NAME VALUE", "set a parameter, verified by reading back"),
-    CommandSpec("save", "", "save the parameters to the board's flash"),
+    CommandSpec("save", "", "save the parameters to the board's flash ({Q:W})"),
     CommandSpec("speed", "+N|-N|N", f"change max_speed (keys + and - step {SPEED_STEP})"),
     CommandSpec("drive", "A-H", "drive in a direction (latched: until stop)"),
     CommandSpec("stop", "", "stop the car (Z)"),
-    CommandSpec("page", "direction|button|gravity|joystick", "switch page (I, J, K)"),
+    CommandSpec("page", "NAME", "switch page: direction, button, gravity (I, J, K)"),
     CommandSpec("latch", "on|off", "latched driving: a direction stays until stop"),
     CommandSpec("send", "TOKEN...", "send raw tokens: letters, {frames}, \\xNN"),
     CommandSpec("record", "FILE|stop", "start or stop recording a transcript"),
     CommandSpec("wait", "SECONDS", "script mode: let time pass"),
     CommandSpec("status", "", "print the status panel (script mode)"),
-    CommandSpec("help", "", "list the commands"),
-    CommandSpec("quit", "", "stop the car and leave"),
+    CommandSpec("help", "", "list the commands and keys"),
+    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)"),
 )
 COMMAND_NAMES = tuple(c.name for c in COMMANDS)
 PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}
+QUIT_WORDS = ("quit", "exit", "q")
+
+
+KEYS_HELP = (
+    "arrows, q w e / a s d / z x c drive · space stop · i j k page · l latch\n"
+    "+ - speed · p params · v waveforms · : command · ? help · Ctrl-Q quit"
+)
+"""The console's keys, as its panel and help show them."""
+
+
+def help_lines() -> list[str]:
+    """The commands, a line each, then the keys."""
+    lines = [f"{spec.name} {spec.args}".strip().ljust(18) + spec.help for spec in COMMANDS]
+    return [*lines, "", *KEYS_HELP.splitlines(), "PgUp/PgDn scroll the messages · ? or Esc close"]
 
 
 class Quit(Exception):
@@ -81,7 +98,7 @@ class Session:
         self.url = url
         self.simulated = is_simulated(url)
         self.driving = driving or HoldToDrive()
-        self.messages: deque[str] = deque(maxlen=MESSAGES)
+        self.messages: deque[str] = deque(maxlen=LOG)
         self.on_message = on_message
         self.recorder: Recorder | None = None
         self.host = Host(url, tap=self._tap)
@@ -89,6 +106,8 @@ class Session:
         self.page_letter = "J"
         self.in_force = STOP_LETTER
         self._sent = HostDecoder()
+        self.baseline: tuple[int, ...] | None = None
+        """The parameters as first read, or as last sent to flash: what a quit would keep."""
         if record:
             try:
                 self.start_recording(record)
@@ -144,6 +163,8 @@ class Session:
                     self.driving.stop()
                     self.in_force = STOP_LETTER
             elif isinstance(event, QueryDone):
+                if self.baseline is None:
+                    self.baseline = event.values
                 self.say(event.text)
             elif isinstance(event, QueryFailed):
                 self.say(f"error: {event.text}")
@@ -232,7 +253,25 @@ class Session:
 
     def save(self) -> None:
         if self._send(b"{Q:W}"):
-            self.say("saved to the board's flash ({Q:W})")
+            current = self.host.state.params
+            if current is not None:
+                self.baseline = current.values
+            self.say("sent {Q:W}: the board saves its parameters to flash (it sends no reply)")
+
+    def unsaved_warning(self) -> str | None:
+        """What was set in this session and not sent to flash since, in a line; None if
+        nothing was."""
+        current = self.host.state.params
+        if current is None or self.baseline is None:
+            return None
+        changed = [
+            f"{p.name} {old} → {new}"
+            for p, old, new in zip(params.PARAMS, self.baseline, current.values, strict=True)
+            if old != new
+        ]
+        if not changed:
+            return None
+        return f"not saved: {', '.join(changed)}"
 
     # ------------------------------------------------------------ recording
 
@@ -276,11 +315,11 @@ class Session:
             return None
 
     def _dispatch(self, name: str, args: list[str]) -> Wait | ShowStatus | None:
-        if name in ("quit", "exit", "q"):
+        if name in QUIT_WORDS:
             raise Quit
         if name in ("help", "?"):
-            for spec in COMMANDS:
-                self.say(f"{spec.name} {spec.args}".strip().ljust(42) + spec.help)
+            for text in help_lines():
+                self.say(text)
         elif name in ("params", "read"):
             self.read_params()
         elif name == "set":

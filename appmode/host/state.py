@@ -1,7 +1,8 @@
 """The host side as a state machine, with no I/O: what the host knows of the board.
 
-`HostState.feed(data, now)` decodes board bytes and keeps the last A, B and C records and
-the link statistics; a view (console, monitor) reads them.
+`HostState.feed(data, now)` decodes board bytes and keeps the last A, B and C records (and
+the last seconds of A and B, for waveforms) and the link statistics; a view (console,
+monitor) reads them.
 """
 
 from __future__ import annotations
@@ -14,6 +15,24 @@ from appmode.protocol import app
 
 RATE_WINDOW = 2.0
 DEGRADED_WINDOW = 5.0
+TRACE_SECONDS = 10.0
+"""How much of the telemetry the host keeps, for waveforms."""
+
+
+class Trace:
+    """The last TRACE_SECONDS of one kind of record, each with the time it came."""
+
+    def __init__(self) -> None:
+        self.points: deque[tuple[float, app.Velocity | app.Attitude]] = deque(maxlen=4096)
+
+    def add(self, now: float, event: app.Velocity | app.Attitude) -> None:
+        self.points.append((now, event))
+        while self.points and self.points[0][0] < now - TRACE_SECONDS:
+            self.points.popleft()
+
+    def age(self, now: float) -> float | None:
+        """Seconds since the last record, or None if none came."""
+        return now - self.points[-1][0] if self.points else None
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,6 +95,8 @@ class HostState:
         self.stats = LinkStats()
         self.velocity: app.Velocity | None = None
         self.attitude: app.Attitude | None = None
+        self.velocities = Trace()
+        self.attitudes = Trace()
         self.params: app.ParamsRecord | None = None
         self.query: ParamQuery | None = None
         self._errors_at_start = 0
@@ -141,8 +162,10 @@ class HostState:
         self.stats.count_record(now)
         if isinstance(event, app.Velocity):
             self.velocity = event
+            self.velocities.add(now, event)
         elif isinstance(event, app.Attitude):
             self.attitude = event
+            self.attitudes.add(now, event)
         elif isinstance(event, app.ParamsRecord):
             self.params = event
             if self.query is not None:

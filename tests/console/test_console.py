@@ -145,3 +145,51 @@ def test_a_crash_in_the_console_still_sends_z_last(
         run_console(tmp_path, [("w", 0.0), ("w", 5.0)], latched=True)
     payloads = [p for _, p in sent(tmp_path / "app.transcript")]
     assert "A" in payloads and payloads[-1] == "Z"
+
+
+TAB = "\t"
+
+
+@pytest.mark.parametrize("typed", ["params", "set max_speed 800", "page button"])
+def test_up_recalls_the_previous_command_not_a_completion(tmp_path: Path, typed: str) -> None:
+    # typed a key at a time; then `:`, Tab (the menu of commands), ↑ and Enter: this used
+    # to pick the menu's last entry, quit
+    keys = [(":", 0.1), *((c, 0.02) for c in typed), ("\r", 0.6), (":", 0.1), (TAB, 0.2)]
+    keys += [(UP, 0.2), ("\r", 0.6), (CTRL_C, 0.0)]
+    session, record, _ = run_console(tmp_path, keys)
+    assert not session.host.connected
+    lines = [p for _, p in sent(record)]
+    if typed == "page button":
+        assert lines.count("K") == 2, lines
+    elif typed == "params":  # once at the start, then twice
+        assert session.messages.count("parameters read") == 3, session.messages
+    else:
+        assert session.messages.count("max_speed = 800 (verified)") == 2, session.messages
+
+
+def test_quit_with_unsaved_parameters_asks_once(tmp_path: Path) -> None:
+    keys = [(":", 0.1), ("set max_speed 800\r", 0.8), (":", 0.1), ("quit\r", 0.3)]
+    keys += [("w", 0.3)]  # still driving (w: A, forward): the first quit only warned
+    keys += [(":", 0.1), ("quit\r", 0.0)]
+    session, record, _ = run_console(tmp_path, keys)
+    warning = "not saved: max_speed 500 → 800 — :save keeps it; quit again to leave"
+    assert any(m.startswith(warning) for m in session.messages), session.messages
+    payloads = [p for _, p in sent(record)]
+    assert "A" in payloads and payloads[-1] == "Z"
+
+
+def test_caps_lock_q_drives_front_left_and_does_not_quit(tmp_path: Path) -> None:
+    _, record, _ = run_console(tmp_path, [("Q", 0.3), (" ", 0.3), (CTRL_C, 0.0)])
+    payloads = [p for _, p in sent(record)]
+    assert payloads.count("H") == 1 and payloads[-1] == "Z"
+
+
+def test_history_is_kept_across_sessions_without_quit(
+    tmp_path: Path, private_data_folder: Path
+) -> None:
+    first = [(":", 0.1), ("latch on\r", 0.3), (":", 0.1), ("quit\r", 0.0)]
+    run_console(tmp_path, first)
+    history = (private_data_folder / "appmode" / "history").read_text()
+    assert "+latch on" in history and "+quit" not in history
+    session, _, _ = run_console(tmp_path, [(":", 0.1), (UP, 0.2), ("\r", 0.3), (CTRL_C, 0.0)])
+    assert session.messages.count("latched driving on") == 1  # recalled from the file

@@ -140,3 +140,36 @@ def test_closing_the_terminal_ends_the_console_with_the_car_stopped(tmp_path: Pa
         sent = sent_lines(record)
         assert "A" in sent and sent[-1] == "Z", sent[-5:]
         assert board_state(board.url) == ((0, 0, 0), tuple(params.DEFAULTS))
+
+
+def test_at_80x24_help_waveforms_and_the_message_log(tmp_path: Path) -> None:
+    command = f"cd {ROOT} && XDG_DATA_HOME={tmp_path} {sys.executable} -m appmode drive"
+    tmux("new-session", "-d", "-s", SESSION, "-x", "80", "-y", "24", command)
+    try:
+        wait_screen(r"\nparameters read")
+        assert "Ctrl-Q quit" in screen()  # the key hints fit
+        for speed in range(600, 1200, 100):  # more messages than the log shows
+            tmux("send-keys", "-t", SESSION, "-l", "l")
+            tmux("send-keys", "-t", SESSION, "-l", "+")
+            wait_screen(rf"max_speed = {speed} \(verified\)")
+        tmux("send-keys", "-t", SESSION, "PageUp")
+        wait_screen(r"── \d+ lines back · PgUp/PgDn scroll")
+        assert "parameters read" in screen()  # the oldest message is back in view
+        tmux("send-keys", "-t", SESSION, "End")
+        wait_screen(r"max_speed = 1100 \(verified\)\s*$")
+        tmux("send-keys", "-t", SESSION, "-l", "?")
+        help_screen = wait_screen(r"quit\s+stop the car and leave").string
+        assert "params            read the nine parameters" in help_screen  # all of it
+        tmux("send-keys", "-t", SESSION, "Escape")
+        tmux("send-keys", "-t", SESSION, "-l", "v")
+        waves = wait_screen(r" vy\s+[▁▂▃▄▅▆▇█]+").string
+        assert " battery " in waves and "not saved" not in waves
+        assert all(len(line) <= 80 for line in waves.splitlines())
+        tmux("send-keys", "-t", SESSION, "C-q")  # max_speed was changed and not saved
+        wait_screen(r"not saved: max_speed 500 → 1100 — :save keeps it; quit again to leave")
+        assert _alive()
+        tmux("send-keys", "-t", SESSION, "C-q")
+        wait_for(lambda: not _alive())
+    finally:
+        if _alive():
+            tmux("kill-session", "-t", SESSION)

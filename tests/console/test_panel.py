@@ -2,8 +2,18 @@
 
 from __future__ import annotations
 
-from appmode.console.panel import BAR, status_fragments
-from appmode.console.session import Session
+import os
+import pty
+import time
+import tty
+
+from prompt_toolkit.formatted_text import StyleAndTextTuples
+from prompt_toolkit.utils import get_cwidth
+
+from appmode.console.hold import HoldToDrive
+from appmode.console.panel import BAR, WIDTH, status_fragments
+from appmode.console.session import Session, help_lines
+from appmode.console.waves import LEVELS
 
 
 def test_a_battery_out_of_range_fills_the_gauge_and_no_more() -> None:
@@ -18,3 +28,70 @@ def test_a_battery_out_of_range_fills_the_gauge_and_no_more() -> None:
             assert gauge == "#" * filled + "." * (BAR - filled)
     finally:
         session.close()
+
+
+def _settled(url: str = "sim://", seconds: float = 1.2, letter: str | None = None) -> Session:
+    session = Session(url, HoldToDrive(latched=True))
+    session.start()
+    if letter:
+        session.press(letter)
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        session.tick()
+        time.sleep(0.02)
+    return session
+
+
+def _lines(fragments: StyleAndTextTuples) -> list[str]:
+    return "".join(part[1] for part in fragments).splitlines()
+
+
+def test_every_line_fits_80_columns_with_the_grid_the_waveforms_and_the_help() -> None:
+    session = _settled(letter="A")
+    try:
+        session.switch_page("K")
+        session.driving.latched = False
+        session.press("H")  # the longest direction name, in hold mode
+        views = {
+            "grid": _lines(status_fragments(session)),
+            "waves": _lines(status_fragments(session, waveforms=True)),
+            "help": help_lines(),
+        }
+    finally:
+        session.close()
+    for name, lines in views.items():
+        widths = [sum(get_cwidth(ch) for ch in line) for line in lines]
+        assert max(widths) <= WIDTH, (name, lines[widths.index(max(widths))])
+    waves = views["waves"]
+    vy = next(line for line in waves if line.startswith(" vy"))
+    assert any(block in vy for block in LEVELS[4:]), vy  # the car sped up: a rising line
+    assert len(views["grid"]) + 1 + 3 <= 24 and len(waves) + 1 + 3 <= 24  # + rule + log
+
+
+def test_a_silent_port_is_not_called_up() -> None:
+    master, slave = pty.openpty()  # nothing will ever answer on it
+    tty.setraw(slave)
+    try:
+        session = _settled(os.ttyname(slave), seconds=2.3)
+        try:
+            text = "\n".join(_lines(status_fragments(session)))
+        finally:
+            session.close()
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert "port open, nothing received" in text and "check the baud rate" in text
+    assert "link up" not in text
+
+
+def test_old_readings_are_shown_with_their_age() -> None:
+    session = _settled(letter="A")
+    try:
+        session.host.close()  # the link is lost: no more records
+        time.sleep(0.8)
+        text = "\n".join(_lines(status_fragments(session)))
+    finally:
+        session.close()
+    assert "LINK LOST" in text
+    velocity = next(line for line in text.splitlines() if "velocity" in line)
+    assert " s ago)" in velocity, velocity
