@@ -73,7 +73,10 @@ def run_params(
         if save:
             host.save()
             values = host.read_params()
-            print("saved to the board's flash", file=sys.stderr)
+            print(
+                "sent {Q:W}: the board saves its parameters to flash (it sends no reply)",
+                file=sys.stderr,
+            )
     if as_json:
         out.write(
             json.dumps({p.name: v for p, v in zip(params.PARAMS, values, strict=True)}) + "\n"
