@@ -9,23 +9,41 @@ from typing import Any
 from appmode.protocol import app as p
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape
+from appmode.protocol.params import PARAMS
+
+RECORD_FIELDS: dict[str, tuple[str, ...]] = {
+    "A": ("x", "y", "z", "extra"),
+    "B": ("pitch", "roll", "yaw", "battery"),
+    "C": tuple(param.name for param in PARAMS),
+}
+"""The names of each record's fields, in order."""
+JSON_KEYS: tuple[str, ...] = (
+    "kind",
+    *dict.fromkeys(name for names in RECORD_FIELDS.values() for name in names),
+    "letter",
+    "values",
+    "direction",
+    "numeric",
+    "page",
+    "mode",
+    "index",
+    "name",
+    "value",
+    "warning",
+    "reason",
+    "terminated",
+    "raw",
+)
+"""Every key `to_json` may write, in the order a table (CSV) shows them."""
 
 
 def to_json(event: p.Event) -> dict[str, Any]:
     """One JSON-ready object: `kind`, the integer values, and `raw` (escaped bytes)."""
     body: dict[str, Any]
-    if isinstance(event, p.Velocity):
-        body = {"kind": "velocity", "x": event.x, "y": event.y, "z": event.z, "extra": event.extra}
-    elif isinstance(event, p.Attitude):
-        body = {
-            "kind": "attitude",
-            "pitch": event.pitch,
-            "roll": event.roll,
-            "yaw": event.yaw,
-            "battery": event.battery,
-        }
-    elif isinstance(event, p.ParamsRecord):
-        body = {"kind": "params", **event.as_dict()}
+    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord)):
+        letter, values = p.record_fields(event)
+        kind = {"A": "velocity", "B": "attitude", "C": "params"}[letter]
+        body = {"kind": kind, **dict(zip(RECORD_FIELDS[letter], values, strict=True))}
     elif isinstance(event, p.OtherRecord):
         body = {"kind": "record", "letter": event.letter, "values": list(event.values)}
     elif isinstance(event, p.Move):

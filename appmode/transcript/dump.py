@@ -12,41 +12,16 @@ from typing import Any, TextIO
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.protocol import app
-from appmode.protocol.render import describe, line, to_json
+from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, describe, line, to_json
 from appmode.protocol.transcript import Transcript, read_transcript
+from appmode.transcript.matcher import Pattern, parse_pattern
 
-CSV_FIELDS = (
-    "t",
-    "dir",
-    "kind",
-    "x",
-    "y",
-    "z",
-    "pitch",
-    "roll",
-    "yaw",
-    "battery",
-    "max_speed",
-    "max_position",
-    "position_kp",
-    "position_ki",
-    "position_kd",
-    "velocity_kp",
-    "velocity_ki",
-    "gyro_compensation",
-    "system_mode",
-    "letter",
-    "direction",
-    "index",
-    "name",
-    "value",
-    "reason",
-    "raw",
-)
+CSV_FIELDS = ("t", "dir", *JSON_KEYS)
 
 
-def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event]]:
-    """(time, direction, event) for every command and record of the transcript."""
+def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event | Pattern]]:
+    """(time, direction, event) for every command and record of the transcript; a `<`
+    line with `*` fields is an expectation (a Pattern), not bytes."""
     decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
         ">": app.HostDecoder(),
         "<": app.BoardDecoder(),
@@ -54,11 +29,27 @@ def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event]]:
     last = {">": 0.0, "<": 0.0}
     for entry in transcript.entries:
         last[entry.direction] = entry.time
+        pattern = parse_pattern(entry.text) if entry.direction == "<" else None
+        if pattern is not None and None in pattern.fields:
+            yield entry.time, "<", pattern
+            continue
         for event in decoders[entry.direction].feed(entry.data):
             yield entry.time, entry.direction, event
     for direction, decoder in decoders.items():
         for event in decoder.flush():
             yield last[direction], direction, event
+
+
+def expectation_json(pattern: Pattern) -> dict[str, Any]:
+    """An expectation as `to_json` shows records, `"*"` for a field that matches any."""
+    names = RECORD_FIELDS.get(pattern.letter, ())
+    values: list[int | str] = ["*" if v is None else v for v in pattern.fields]
+    body: dict[str, Any] = {"kind": "expectation", "letter": pattern.letter}
+    if len(names) == len(values):
+        body.update(zip(names, values, strict=True))
+    else:
+        body["values"] = values
+    return {**body, "raw": pattern.text}
 
 
 def run_dump(path: str, fmt: str, out: TextIO) -> int:
@@ -67,12 +58,22 @@ def run_dump(path: str, fmt: str, out: TextIO) -> int:
         writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
         writer.writeheader()
     for t, direction, event in decoded(transcript):
-        if fmt == "json":
-            out.write(json.dumps({"t": t, "dir": direction, **to_json(event)}) + "\n")
-        elif fmt == "csv":
-            writer.writerow({"t": t, "dir": direction, **to_json(event)})
+        if isinstance(event, Pattern):
+            body = expectation_json(event)
+            raw = event.text.encode()
+            text = "expectation " + " ".join(
+                f"{k}={v}" for k, v in body.items() if k not in ("kind", "letter", "raw")
+            )
         else:
-            out.write(line(t, direction, event.raw, describe(event)) + "\n")
+            body = to_json(event)
+            raw, text = event.raw, describe(event)
+        if fmt == "json":
+            out.write(json.dumps({"t": t, "dir": direction, **body}) + "\n")
+        elif fmt == "csv":
+            row = {k: ":".join(map(str, v)) if isinstance(v, list) else v for k, v in body.items()}
+            writer.writerow({"t": t, "dir": direction, **row})
+        else:
+            out.write(line(t, direction, raw, text) + "\n")
     return 0
 
 
@@ -103,7 +104,7 @@ def run_plot(path: str, output: str) -> int:
             series["tB"].append(t)
             for k in ("pitch", "roll", "yaw", "battery"):
                 series[k].append(getattr(event, k))
-        elif direction == ">" and not isinstance(event, app.ERRORS):
+        elif direction == ">" and not isinstance(event, (Pattern, *app.ERRORS)):
             commands.append((t, event.raw.decode("latin-1")))
     if not series["tA"] and not series["tB"]:
         raise AppmodeError(f"{path} has no A or B records to plot")

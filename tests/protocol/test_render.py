@@ -29,3 +29,19 @@ def test_json_line_is_json_dumps_of_to_json(data: bytes) -> None:
 def test_escape_is_the_table_byte_by_byte(data: bytes) -> None:
     assert escape(data) == "".join(_TABLE[b] for b in data)
     assert unescape(escape(data)) == data
+
+
+def test_json_keys_name_every_key_to_json_writes() -> None:
+    from appmode.protocol import app
+    from appmode.protocol.render import JSON_KEYS, to_json
+
+    events = [
+        *app.BoardDecoder().feed(b"{A1:2:3:4}${B1:2:3:4}${C1:2:3:4:5:6:7:8:9}${D1:2}$x{A1"),
+        *app.BoardDecoder().flush(),
+        *app.HostDecoder().feed(b"AZJ{Q:P}{Q;W}{0:800}{0:x}\x01{" + b"9" * 60 + b"}"),
+        *app.HostDecoder().flush(),
+    ]
+    kinds = {to_json(e)["kind"] for e in events}
+    assert len(kinds) >= 12, kinds
+    for event in events:
+        assert set(to_json(event)) <= set(JSON_KEYS), to_json(event)

@@ -217,3 +217,22 @@ def test_plot_without_matplotlib_names_the_package_to_install(tmp_path: Path) ->
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 2
     assert "pip install matplotlib" in done.stderr and "appmode[plot]" not in done.stderr
+
+
+def test_dump_shows_wildcard_lines_as_expectations_and_csv_every_field(tmp_path: Path) -> None:
+    path = tmp_path / "w.transcript"
+    path.write_text(
+        "# appmode transcript v1\n0.0 > {Q:P}\n0.1 < {C*:*:*:*:*:*:*:*:*}$\n"
+        "0.2 < {A0:*:0:0}$\n0.3 < {A1:2:3:4}$\n0.4 > \\x01\n"
+    )
+    text = run("dump", str(path)).stdout
+    assert "expectation x=0 y=* z=0 extra=0" in text and "error" not in text
+    objects = [json.loads(line) for line in run("dump", str(path), "--json").stdout.splitlines()]
+    assert objects[2] == {
+        "t": 0.2, "dir": "<", "kind": "expectation", "letter": "A",
+        "x": 0, "y": "*", "z": 0, "extra": 0, "raw": "{A0:*:0:0}$",
+    }
+    rows = list(csv.DictReader(io.StringIO(run("dump", str(path), "--csv").stdout)))
+    for row, obj in zip(rows, objects, strict=True):  # every field of the JSON is a column
+        assert {k: str(v) for k, v in obj.items()} == {k: v for k, v in row.items() if v}
+    assert rows[3]["extra"] == "4"
