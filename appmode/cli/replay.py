@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import Subparsers, number_type
+from appmode.cli.options import DAY, Subparsers, number_type
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -37,10 +37,35 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         metavar="N",
         help="play it N times (default 1)",
     )
+    replay.add_argument(
+        "--gap",
+        type=number_type(0, DAY),
+        default=0.0,
+        metavar="S",
+        help="make every pause between two lines at least S seconds",
+    )
+    replay.add_argument(
+        "--skip",
+        type=number_type(0, DAY, low_open=True),
+        metavar="S",
+        help="shorten every pause longer than S seconds to S",
+    )
+    replay.add_argument(
+        "-v", "--verbose", action="store_true", help="print each line as it is played"
+    )
     return replay
 
 
 def run(args: argparse.Namespace) -> int:
     from appmode.transcript.replay import run_replay
 
-    return run_replay(args.file, args.to, args.side, args.speed, args.loop)
+    return run_replay(
+        args.file,
+        args.to,
+        args.side,
+        args.speed,
+        args.loop,
+        gap=args.gap,
+        skip=args.skip,
+        verbose=args.verbose,
+    )

@@ -16,6 +16,8 @@ import serial
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.ports.link import open_link
+from appmode.protocol.app import BoardDecoder, HostDecoder
+from appmode.protocol.render import describe, line
 from appmode.protocol.transcript import read_transcript
 
 Item = tuple[float, bytes]
@@ -25,6 +27,18 @@ def plan(entries: Sequence[tuple[float, str, bytes]], side: str) -> list[Item]:
     """The (time, bytes) a side sends: `>` lines for the host, `<` lines for the board."""
     direction = ">" if side == "host" else "<"
     return sorted(((t, data) for t, d, data in entries if d == direction), key=lambda i: i[0])
+
+
+def retime(items: Sequence[Item], gap: float = 0.0, skip: float | None = None) -> list[Item]:
+    """The items with every pause between two made at least `gap` and at most `skip`
+    seconds (python-can's player's --gap and --skip); the first keeps its time."""
+    out: list[Item] = []
+    for i, (t, data) in enumerate(items):
+        if i:
+            pause = max(t - items[i - 1][0], gap)
+            t = out[-1][0] + (pause if skip is None else min(pause, skip))
+        out.append((t, data))
+    return out
 
 
 def play(
@@ -61,21 +75,51 @@ def play(
     return lateness
 
 
-def run_replay(path: str, url: str, side: str, speed: float, loops: int) -> int:
+def run_replay(
+    path: str,
+    url: str,
+    side: str,
+    speed: float,
+    loops: int,
+    *,
+    gap: float = 0.0,
+    skip: float | None = None,
+    verbose: bool = False,
+) -> int:
     """The `appmode replay` command."""
     if not (0.001 <= speed <= 1000 and loops >= 1):
         raise AppmodeError("--speed must be > 0, in 0.001–1000, and --loop at least 1")
     transcript = read_transcript(path)
-    items = plan([(e.time, e.direction, e.data) for e in transcript.entries], side)
+    entries = [(e.time, e.direction, e.data) for e in transcript.entries]
+    items = retime(plan(entries, side), gap, skip)
     if not items:
         mark = ">" if side == "host" else "<"
         raise AppmodeError(f"{path} has no '{mark}' lines to play as the {side}")
-    show = _progress(path) if sys.stderr.isatty() else None
+    show = _progress(path) if sys.stderr.isatty() and not verbose else None
+    mark = ">" if side == "host" else "<"
+    started = time.monotonic()
+
+    def shown(write: Callable[[bytes], object]) -> Callable[[bytes], None]:
+        """`write`, printing each unit as it goes (-v)."""
+        def write_only(data: bytes) -> None:
+            write(data)
+
+        if not verbose:
+            return write_only
+        decoder = HostDecoder() if side == "host" else BoardDecoder()
+
+        def write_and_print(data: bytes) -> None:
+            write(data)
+            text = ", ".join(describe(e) for e in decoder.feed(data))
+            print(line(time.monotonic() - started, mark, data, text), flush=True)
+
+        return write_and_print
+
     if side == "host":
         with Host(url) as host:
             late = play(
                 items,
-                host.send,
+                shown(host.send),
                 speed=speed,
                 loops=loops,
                 idle=lambda: _discard(host.poll_nowait),
@@ -86,7 +130,7 @@ def run_replay(path: str, url: str, side: str, speed: float, loops: int) -> int:
         try:
             late = play(
                 items,
-                port.write,
+                shown(port.write),
                 speed=speed,
                 loops=loops,
                 idle=lambda: _discard(lambda: port.read(port.in_waiting)),

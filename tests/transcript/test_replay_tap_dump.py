@@ -236,3 +236,24 @@ def test_dump_shows_wildcard_lines_as_expectations_and_csv_every_field(tmp_path:
     for row, obj in zip(rows, objects, strict=True):  # every field of the JSON is a column
         assert {k: str(v) for k, v in obj.items()} == {k: v for k, v in row.items() if v}
     assert rows[3]["extra"] == "4"
+
+
+def test_gap_and_skip_retime_the_pauses_as_python_can_player_does() -> None:
+    from appmode.transcript.replay import retime
+
+    items = [(1.0, b"J"), (1.05, b"A"), (9.0, b"B"), (9.5, b"Z")]
+    assert [t for t, _ in retime(items)] == [1.0, 1.05, 9.0, 9.5]
+    assert [t for t, _ in retime(items, gap=0.2)] == pytest.approx([1.0, 1.2, 9.15, 9.65])
+    assert [t for t, _ in retime(items, skip=1.0)] == pytest.approx([1.0, 1.05, 2.05, 2.55])
+    assert [t for t, _ in retime(items, gap=0.2, skip=1.0)] == pytest.approx([1.0, 1.2, 2.2, 2.7])
+
+
+def test_replay_verbose_prints_each_line_as_it_is_played(tmp_path: Path) -> None:
+    path = tmp_path / "r.transcript"
+    path.write_text("# appmode transcript v1\n0.0 > J\n0.1 > A\n30.0 > Z\n")
+    done = run("replay", str(path), "--to", "sim://", "-v", "--skip", "0.3", timeout=20)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert [line.split()[1:3] for line in lines] == [[">", "J"], [">", "A"], [">", "Z"]]
+    assert "move A (direction 1)" in lines[1]
+    assert 0.3 <= float(lines[2].split()[0]) < 1.0  # 30 s skipped down to 0.3
