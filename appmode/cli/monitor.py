@@ -9,6 +9,7 @@ from typing import TextIO
 
 from appmode.cli.hostio import open_host, show
 from appmode.cli.options import DAY, Subparsers, add_record, add_url, number_type
+from appmode.host.client import Event
 from appmode.protocol import app
 
 
@@ -22,18 +23,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_url(mon)
     mon.add_argument("--json", action="store_true", help="print JSON Lines")
-    mon.add_argument(
-        "--duration",
-        type=number_type(0, DAY, low_open=True),
-        metavar="SECONDS",
-        help="stop after this long",
-    )
-    mon.add_argument(
-        "--count",
-        type=number_type(1, 1e9, whole=True),
-        metavar="N",
-        help="stop after N records (A, B or C; undecodable bytes do not count)",
-    )
+    add_limits(mon, "show and count only these")
     mon.add_argument(
         "--stop-on-exit",
         action="store_true",
@@ -41,6 +31,28 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_record(mon)
     return mon
+
+
+def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
+    """--duration, --count and --filter, as monitor and record share them."""
+    parser.add_argument(
+        "--duration",
+        type=number_type(0, DAY, low_open=True),
+        metavar="SECONDS",
+        help="stop after this long",
+    )
+    parser.add_argument(
+        "--count",
+        type=number_type(1, 1e9, whole=True),
+        metavar="N",
+        help="stop after N records (of the --filter kinds; undecodable bytes do not count)",
+    )
+    parser.add_argument(
+        "--filter",
+        type=parse_kinds,
+        metavar="KINDS",
+        help=f"{filtering}: record letters and 'errors', e.g. A,B or C",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -51,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
         count=args.count,
         record=args.record,
         stop_on_exit=args.stop_on_exit,
+        kinds=args.filter,
         out=sys.stdout,
     )
 
@@ -62,25 +75,52 @@ def run_monitor(
     duration: float | None,
     count: int | None,
     record: str | None,
-    out: TextIO,
+    out: TextIO | None,
     stop_on_exit: bool = False,
+    kinds: frozenset[str] | None = None,
+    name: str = "monitor",
 ) -> int:
-    """Print records as they arrive, until interrupted, `duration` or `count` records."""
+    """Print records as they arrive (of `kinds` only, if given: record letters or
+    "errors"), until interrupted, `duration` or `count` of them; `out` None prints none
+    (`appmode record`)."""
     seen = 0
     with ExitStack() as stack:
         host = open_host(stack, url, record, stop_on_close=stop_on_exit)
-        print(f"monitoring {url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+        doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"
+        print(f"{doing} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         try:
             for event in host.events(duration):
-                show(host, event, out, as_json)
+                if kinds is not None and _kind(event) not in kinds:
+                    continue
+                if out is not None:
+                    show(host, event, out, as_json)
                 seen += isinstance(event, app.RECORDS)
                 if count is not None and seen >= count:
                     break
         finally:
             stats = host.state.stats
             print(
-                f"monitor: {stats.records} records, {stats.errors} errors, "
+                f"{name}: {stats.records} records, {stats.errors} errors, "
                 f"{stats.bytes_in} bytes in {host.now():.1f} s",
                 file=sys.stderr,
             )
     return 0
+
+
+def parse_kinds(text: str) -> frozenset[str]:
+    """`--filter A,B,errors`: record letters, and `errors` for what did not decode."""
+    kinds = frozenset(k.strip().upper() for k in text.split(",") if k.strip())
+    bad = [k for k in kinds if not (len(k) == 1 and k.isalpha() and k.isascii()) and k != "ERRORS"]
+    if bad or not kinds:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected record letters and 'errors', e.g. A,B or C,errors"
+        )
+    return kinds
+
+
+def _kind(event: Event) -> str:
+    if isinstance(event, app.RECORDS):
+        return app.record_fields(event)[0]
+    if isinstance(event, app.ERRORS):
+        return "ERRORS"
+    return "LINK"  # link changes always show

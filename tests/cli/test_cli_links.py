@@ -196,3 +196,24 @@ def test_monitor_count_counts_records_only() -> None:
     kinds = [json.loads(text)["kind"] for text in done.stdout.splitlines()]
     records = [k for k in kinds if k in ("velocity", "attitude", "params")]
     assert len(records) == 5 and len(kinds) > 5, kinds
+
+
+def test_monitor_filter_shows_and_counts_only_those_kinds() -> None:
+    done = run("monitor", "sim://", "--filter", "b", "--count", "3", "--json")
+    assert done.returncode == 0, done.stderr
+    assert [json.loads(text)["kind"] for text in done.stdout.splitlines()] == ["attitude"] * 3
+    refused = run("monitor", "sim://", "--filter", "A,x y")
+    assert refused.returncode == 2 and "expected record letters and 'errors'" in refused.stderr
+
+
+def test_record_logs_passively_to_a_transcript(tmp_path: Path) -> None:
+    seen_by_board = tmp_path / "board.transcript"
+    logged = tmp_path / "logged.transcript"
+    with board_process("--pty", "--quiet", "--record", str(seen_by_board)) as board:
+        done = run("record", board.url, str(logged), "--count", "4")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "" and "record: " in done.stderr
+    lines = logged.read_text().splitlines()
+    assert lines[0] == "# appmode transcript v1"
+    assert sum(" < {" in line for line in lines) >= 4
+    assert sent_lines(seen_by_board) == []  # nothing was written to the port

@@ -1,0 +1,36 @@
+"""`appmode record`: log a board's telemetry to a transcript, passively."""
+
+from __future__ import annotations
+
+import argparse
+
+from appmode.cli.monitor import add_limits, run_monitor
+from appmode.cli.options import Subparsers, add_url
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    rec = sub.add_parser(
+        "record",
+        help="log what a board sends to a transcript (passive)",
+        description="Write everything the board sends to a transcript, until Ctrl-C, "
+        "--duration or --count. It only listens: nothing is written to the port (for a "
+        "session that also sends, use --record on drive, send or tap). Read the result "
+        "with appmode dump or plot.",
+    )
+    add_url(rec)
+    rec.add_argument("file", metavar="FILE", help="the transcript to write")
+    add_limits(rec, "count only these (the transcript holds everything)")
+    return rec
+
+
+def run(args: argparse.Namespace) -> int:
+    return run_monitor(
+        args.url,
+        as_json=False,
+        duration=args.duration,
+        count=args.count,
+        record=args.file,
+        kinds=args.filter,
+        out=None,
+        name="record",
+    )
