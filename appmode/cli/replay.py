@@ -16,7 +16,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "ends with Z.",
     )
     replay.add_argument("file", metavar="FILE", help="the transcript")
-    replay.add_argument("--to", required=True, metavar="URL", help="where to play it")
+    replay.add_argument(
+        "--to",
+        required=True,
+        metavar="URL",
+        help="where to play it; with --side board, 'pty' makes a new pseudo-terminal for an "
+        "app to open (its path is printed; the replay starts when the app sends something)",
+    )
     replay.add_argument(
         "--side",
         choices=("host", "board"),

@@ -16,6 +16,7 @@ import serial
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.ports.link import open_link
+from appmode.ports.newpty import PtyPort
 from appmode.protocol.app import BoardDecoder, HostDecoder
 from appmode.protocol.render import describe, line
 from appmode.protocol.transcript import read_transcript
@@ -115,6 +116,11 @@ def run_replay(
 
         return write_and_print
 
+    if side == "host" and url == "pty":
+        raise AppmodeError(
+            "replay --to pty plays the board's side to an app: add --side board (to drive "
+            "a board on a pty, serve it with appmode board and replay to its port)"
+        )
     if side == "host":
         with Host(url) as host:
             late = play(
@@ -126,14 +132,14 @@ def run_replay(
                 progress=show,
             )
     else:
-        port = open_link(url)
+        port = _open_for_app(url)
         try:
             late = play(
                 items,
                 shown(port.write),
                 speed=speed,
                 loops=loops,
-                idle=lambda: _discard(lambda: port.read(port.in_waiting)),
+                idle=lambda: _drain(port),
                 progress=show,
             )
         except (serial.SerialException, OSError) as exc:
@@ -149,6 +155,31 @@ def run_replay(
         file=sys.stderr,
     )
     return 0
+
+
+def _open_for_app(url: str) -> serial.SerialBase | PtyPort:
+    """The port an app listens on: `pty` makes a new pseudo-terminal, prints its path and
+    waits until the app has opened it and sent something (an app asks first)."""
+    if url != "pty":
+        return open_link(url)
+    port = PtyPort()
+    print(f"port: {port.path}", flush=True)
+    print(
+        f"waiting for an app to open {port.path} and send something (Ctrl-C to give up)",
+        file=sys.stderr,
+        flush=True,
+    )
+    while not port.read(4096, timeout=0.5):
+        pass
+    return port
+
+
+def _drain(port: serial.SerialBase | PtyPort) -> None:
+    """Read and drop what the app sends meanwhile."""
+    if isinstance(port, PtyPort):
+        port.read(4096, timeout=0)
+    else:
+        port.read(port.in_waiting)
 
 
 def _discard(read: Callable[[], object]) -> None:

@@ -8,18 +8,15 @@ the way out the board gets `Z`: the app can no longer stop it.
 from __future__ import annotations
 
 import contextlib
-import os
-import pty
-import select
 import sys
 import threading
 import time
-import tty
 from typing import Protocol
 
 import serial
 
 from appmode.ports.link import open_link
+from appmode.ports.newpty import PtyPort
 from appmode.protocol.app import SessionEnd
 from appmode.protocol.transcript import Recorder
 
@@ -32,27 +29,6 @@ class Port(Protocol):
     def write(self, data: bytes) -> int | None: ...
 
     def close(self) -> None: ...
-
-
-class PtyPort:
-    """The master side of a new pseudo-terminal; the app opens `path`."""
-
-    def __init__(self) -> None:
-        self._master, self._slave = pty.openpty()
-        tty.setraw(self._slave)
-        self.path = os.ttyname(self._slave)
-
-    def read(self, size: int = 1) -> bytes:
-        if not select.select([self._master], [], [], READ_TIMEOUT)[0]:
-            return b""
-        return os.read(self._master, max(size, 4096))
-
-    def write(self, data: bytes) -> int:
-        return os.write(self._master, data)
-
-    def close(self) -> None:
-        os.close(self._master)
-        os.close(self._slave)
 
 
 def _read(port: Port) -> bytes:

@@ -257,3 +257,34 @@ def test_replay_verbose_prints_each_line_as_it_is_played(tmp_path: Path) -> None
     assert [line.split()[1:3] for line in lines] == [[">", "J"], [">", "A"], [">", "Z"]]
     assert "move A (direction 1)" in lines[1]
     assert 0.3 <= float(lines[2].split()[0]) < 1.0  # 30 s skipped down to 0.3
+
+
+def test_replay_to_a_new_pty_feeds_the_app_that_opens_it(tmp_path: Path) -> None:
+    path = tmp_path / "board.transcript"
+    path.write_text("# appmode transcript v1\n0.0 < {A0:1:0:0}$\n0.2 < {B0:0:0:99}$\n")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "replay", str(path), "--to", "pty", "--side", "board"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        cwd=ROOT,
+    )
+    try:
+        assert proc.stdout is not None
+        device = proc.stdout.readline().decode().split("port: ")[1].strip()
+        fd = os.open(device, os.O_RDWR | os.O_NOCTTY)
+        try:
+            tty.setraw(fd)
+            time.sleep(0.3)
+            assert not select.select([fd], [], [], 0)[0], "nothing before the app speaks"
+            os.write(fd, b"J")  # the app asks: the replay starts
+            got = b""
+            end = time.monotonic() + 5
+            while b"{B0:0:0:99}$" not in got and time.monotonic() < end:
+                if select.select([fd], [], [], 0.1)[0]:
+                    got += os.read(fd, 256)
+        finally:
+            os.close(fd)
+        assert proc.wait(10) == 0
+    finally:
+        proc.kill()
+    assert got == b"{A0:1:0:0}${B0:0:0:99}$"
