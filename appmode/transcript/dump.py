@@ -77,6 +77,26 @@ def run_dump(path: str, fmt: str, out: TextIO) -> int:
     return 0
 
 
+LABEL_GAP = 0.012
+"""Fraction of the time axis two command labels need between them (8 pt text, 11 in)."""
+
+
+def command_labels(commands: list[tuple[float, str]], gap: float) -> list[tuple[float, str]]:
+    """One label per group of commands closer than `gap` seconds: their texts joined,
+    at the first one's time, so that labels never overlap."""
+    groups: list[tuple[float, list[str]]] = []
+    for t, text in commands:
+        if groups and t - groups[-1][0] < gap:
+            groups[-1][1].append(text)
+        else:
+            groups.append((t, [text]))
+    labels = []
+    for t, texts in groups:
+        label = " ".join(texts)
+        labels.append((t, label if len(label) <= 16 else label[:15] + "…"))
+    return labels
+
+
 def run_plot(path: str, output: str) -> int:
     """Velocities, attitude and battery over time, with the commands marked."""
     check_writable(output, "plot")
@@ -85,6 +105,7 @@ def run_plot(path: str, output: str) -> int:
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        from matplotlib.ticker import MaxNLocator
     except ImportError:
         raise AppmodeError(
             "appmode plot needs matplotlib: pip install matplotlib (or, in a checkout of "
@@ -122,13 +143,18 @@ def run_plot(path: str, output: str) -> int:
     att.set_ylabel("degrees")
     bat.plot(series["tB"], series["battery"], color="tab:green", drawstyle="steps-post")
     bat.set_ylabel("battery %")
-    bat.set_ylim(0, 105)
+    if series["battery"]:  # the range it spans, so that a change shows
+        low, high = min(series["battery"]), max(series["battery"])
+        pad = max(2.0, (high - low) * 0.1)
+        bat.set_ylim(low - pad, high + pad)
+        bat.yaxis.set_major_locator(MaxNLocator(integer=True))
     bat.set_xlabel("time (s)")
     for ax in axes:
         ax.grid(True, alpha=0.3)
         for t, _ in commands:
             ax.axvline(t, color="grey", linestyle=":", linewidth=0.8)
-    for t, text in commands:
+    times = series["tA"] + series["tB"] + [t for t, _ in commands]
+    for t, text in command_labels(commands, (max(times) - min(times)) * LABEL_GAP):
         vel.annotate(
             text,
             (t, 1.0),

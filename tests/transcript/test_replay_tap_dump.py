@@ -288,3 +288,14 @@ def test_replay_to_a_new_pty_feeds_the_app_that_opens_it(tmp_path: Path) -> None
     finally:
         proc.kill()
     assert got == b"{A0:1:0:0}${B0:0:0:99}$"
+
+
+def test_command_labels_close_in_time_share_one_label() -> None:
+    from appmode.transcript.dump import command_labels
+
+    commands = [(0.0, "J"), (0.004, "{Q:P}"), (0.5, "B"), (0.502, "C"), (0.503, "D"), (1.0, "Z")]
+    assert command_labels(commands, 0.01) == [
+        (0.0, "J {Q:P}"), (0.5, "B C D"), (1.0, "Z")
+    ]
+    many = [(i * 0.001, "{0:12345}") for i in range(5)]
+    assert command_labels(many, 0.01) == [(0.0, "{0:12345} {0:12…")]
