@@ -13,6 +13,9 @@ import time
 import tty
 
 READ_TIMEOUT = 0.05
+SETTLE = 0.05
+"""Seconds for bytes written to the master to be counted as waiting on the slave (the
+kernel hands them over from a work queue)."""
 
 
 class PtyPort:
@@ -36,6 +39,7 @@ class PtyPort:
         """Close, once the program has read what was written (for at most `drain` s):
         closing the master would discard it."""
         end = time.monotonic() + drain
+        time.sleep(min(drain, SETTLE))  # the last bytes reach the count only after a while
         while time.monotonic() < end and _waiting(self._slave):
             time.sleep(0.01)
         os.close(self._master)
@@ -44,5 +48,5 @@ class PtyPort:
 
 def _waiting(fd: int) -> int:
     """Bytes written to the program and not read by it yet."""
-    (count,) = struct.unpack("i", fcntl.ioctl(fd, termios.TIOCINQ, b"\0\0\0\0"))
+    (count,) = struct.unpack("i", fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0"))
     return int(count)
