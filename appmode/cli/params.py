@@ -83,4 +83,13 @@ def run_params(
         )
     else:
         out.write(params_table(values) + "\n")
+    for index, value in enumerate(values):
+        error = params.value_error(index, value)
+        if error is not None:  # a board may hold it: say so, and how to repair it
+            name = params.PARAMS[index].name
+            print(
+                f"appmode: the board holds {name} = {value} ({error}): repair it with "
+                f"--set {name}=N",
+                file=sys.stderr,
+            )
     return 0

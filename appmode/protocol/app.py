@@ -163,6 +163,18 @@ class ParamsRecord:
     def as_dict(self) -> dict[str, int]:
         return {p.name: v for p, v in zip(params.PARAMS, self.values, strict=True)}
 
+    @property
+    def out_of_range(self) -> tuple[str, ...]:
+        """The names of the values outside the sheet's ranges: a real firmware takes any
+        value it is sent, so a board can hold them (they are shown, flagged)."""
+        if params.values_error(self.values) is None:
+            return ()
+        return tuple(
+            p.name
+            for p, v in zip(params.PARAMS, self.values, strict=True)
+            if params.value_error(p.index, v) is not None
+        )
+
 
 @dataclass(slots=True)
 class OtherRecord:
@@ -442,10 +454,7 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
         return Velocity(a, b, c, d, terminated, raw)
     if letter == 0x42:
         return Attitude(a, b, c, d, terminated, raw)
-    error = params.values_error(values)
-    if error is not None:
-        return Malformed(raw, f"C record: {error}")
-    return ParamsRecord(values, terminated, raw)
+    return ParamsRecord(values, terminated, raw)  # out-of-range values too: boards hold them
 
 
 _FAST = re.compile(

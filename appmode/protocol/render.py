@@ -9,7 +9,7 @@ from typing import Any
 from appmode.protocol import app as p
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape
-from appmode.protocol.params import PARAMS
+from appmode.protocol.params import PARAMS, value_error
 
 RECORD_FIELDS: dict[str, tuple[str, ...]] = {
     "A": ("x", "y", "z", "extra"),
@@ -31,6 +31,7 @@ JSON_KEYS: tuple[str, ...] = (
     "value",
     "warning",
     "reason",
+    "out_of_range",
     "terminated",
     "raw",
 )
@@ -44,6 +45,8 @@ def to_json(event: p.Event) -> dict[str, Any]:
         letter, values = p.record_fields(event)
         kind = {"A": "velocity", "B": "attitude", "C": "params"}[letter]
         body = {"kind": kind, **dict(zip(RECORD_FIELDS[letter], values, strict=True))}
+        if isinstance(event, p.ParamsRecord) and event.out_of_range:
+            body["out_of_range"] = list(event.out_of_range)
     elif isinstance(event, p.OtherRecord):
         body = {"kind": "record", "letter": event.letter, "values": list(event.values)}
     elif isinstance(event, p.Move):
@@ -118,7 +121,9 @@ def describe(event: p.Event) -> str:
             f"battery={event.battery}%"
         )
     if isinstance(event, p.ParamsRecord):
-        return "params " + " ".join(f"{k}={v}" for k, v in event.as_dict().items())
+        text = "params " + " ".join(f"{k}={v}" for k, v in event.as_dict().items())
+        odd = event.out_of_range
+        return text if not odd else f"{text} (out of range: {', '.join(odd)})"
     if isinstance(event, p.OtherRecord):
         return f"record {event.letter} {list(event.values)}"
     if isinstance(event, p.Move):
@@ -166,13 +171,13 @@ def line(time: float, direction: str, raw: bytes, text: str) -> str:
 
 
 def params_table(values: tuple[int, ...]) -> str:
-    """The nine parameters as an aligned table with their ranges and defaults."""
-    from appmode.protocol.params import PARAMS
-
+    """The nine parameters as an aligned table with their ranges and defaults; a value
+    outside its range (a real board may hold one) is flagged."""
     rows = [f"{'n':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
     for param, value in zip(PARAMS, values, strict=True):
+        flag = "" if value_error(param.index, value) is None else "  out of range"
         rows.append(
             f"{param.index:>2}  {param.name:<18} {value:>10}  "
-            f"{param.range_text:<14} {param.default:>7}"
+            f"{param.range_text:<14} {param.default:>7}{flag}"
         )
     return "\n".join(rows)

@@ -217,3 +217,18 @@ def test_record_logs_passively_to_a_transcript(tmp_path: Path) -> None:
     assert lines[0] == "# appmode transcript v1"
     assert sum(" < {" in line for line in lines) >= 4
     assert sent_lines(seen_by_board) == []  # nothing was written to the port
+
+
+def test_a_board_holding_a_value_out_of_range_is_read_shown_and_repaired() -> None:
+    from tests.support.lenient_board import lenient_board
+
+    held = [500, 10000, 20, -25, 10, 10, 10, 0, 0]  # a firmware that took -25
+    with lenient_board(held) as url:
+        shown = run("params", url, timeout=30)
+        assert shown.returncode == 0, shown.stderr
+        assert re.search(r"position_ki\s+-25\s+0–4294967295\s+0  out of range", shown.stdout)
+        assert "repair it with --set position_ki=N" in shown.stderr
+        repaired = run("params", url, "--set", "position_ki=0", timeout=30)
+    assert repaired.returncode == 0, repaired.stderr
+    assert "set position_ki = 0 (verified)" in repaired.stderr
+    assert "out of range" not in repaired.stdout and held[3] == 0

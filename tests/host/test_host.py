@@ -103,7 +103,16 @@ def test_params_record_is_not_reported_unless_intact() -> None:
         host.send(b"{C500:10000:20:0:10:10:10:0:0}$")  # echoed back: a C record
         events = host.poll(0.5) + host.poll(0.1)
         assert any(isinstance(e, ParamsRecord) for e in events)
-        host.send(b"{C500:10000:20:0:10:10:10:0:7}$")  # drive type 7: not a valid C
+        host.send(b"{C500:10000:20:0:10:10:10:0:x}$")  # garbled: not a C record
         events = host.poll(0.5) + host.poll(0.1)
         assert not any(isinstance(e, ParamsRecord) for e in events)
         assert host.state.stats.errors >= 1
+
+
+def test_a_board_holding_values_out_of_range_is_read_and_shown() -> None:
+    with Host("loop://") as host:  # a board that took drive type 7 and a negative gain
+        host.send(b"{C500:10000:20:-25:10:10:10:0:7}$")
+        events = host.poll(0.5) + host.poll(0.1)
+        [record] = [e for e in events if isinstance(e, ParamsRecord)]
+        assert record.out_of_range == ("position_ki", "system_mode")
+        assert host.state.params == record

@@ -39,10 +39,20 @@ def test_s3_3_c_record_nine_parameters() -> None:
     assert decoded == record and decoded.as_dict()["max_position"] == 10000
 
 
-def test_s3_3_c_record_with_wrong_count_or_range_is_malformed() -> None:
-    for raw in (b"{C1:2:3}$", b"{C70000:0:0:0:0:0:0:0:0}$", b"{C0:0:0:0:0:0:0:0:5}$"):
+def test_s3_3_c_record_with_wrong_count_is_malformed() -> None:
+    [event] = decode_whole(BoardDecoder, b"{C1:2:3}$")
+    assert isinstance(event, Malformed) and event.raw == b"{C1:2:3}$"
+
+
+def test_s3_3_c_record_out_of_range_is_read_and_flagged() -> None:
+    for raw, odd in (
+        (b"{C70000:0:0:0:0:0:0:0:0}$", ("max_speed",)),
+        (b"{C0:0:0:0:0:0:0:0:5}$", ("system_mode",)),
+        (b"{C500:10000:4000000000:-25:10:10:10:0:0}$", ("position_ki",)),
+    ):
         [event] = decode_whole(BoardDecoder, raw)
-        assert isinstance(event, Malformed) and event.raw == raw
+        assert isinstance(event, ParamsRecord) and event.raw == raw
+        assert event.out_of_range == odd
 
 
 def test_s3_missing_dollar_is_tolerated() -> None:

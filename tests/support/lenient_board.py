@@ -1,0 +1,48 @@
+"""A board as lenient as the reference firmware: on a pty, it stores whatever value a set
+frame carries and answers `{Q:P}` with a C record of what it holds."""
+
+from __future__ import annotations
+
+import os
+import pty
+import re
+import select
+import threading
+import tty
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+FRAME = re.compile(rb"\{(Q:P|\d:-?\d+)\}")
+
+
+@contextmanager
+def lenient_board(values: list[int]) -> Iterator[str]:
+    """Serve until the block ends; yields the pty path. `values` is updated in place."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    stop = threading.Event()
+
+    def serve() -> None:
+        pending = b""
+        while not stop.is_set():
+            if not select.select([master], [], [], 0.05)[0]:
+                continue
+            pending += os.read(master, 1024)
+            for match in FRAME.finditer(pending):
+                body = match.group(1)
+                if body == b"Q:P":
+                    os.write(master, b"{C" + b":".join(b"%d" % v for v in values) + b"}$")
+                else:
+                    index, value = body.split(b":")
+                    values[int(index)] = int(value)
+            pending = pending[pending.rfind(b"}") + 1 :] if b"}" in pending else pending[-64:]
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        yield os.ttyname(slave)
+    finally:
+        stop.set()
+        thread.join(2)
+        os.close(master)
+        os.close(slave)
