@@ -32,6 +32,11 @@ class QueryFailed:
 Outcome = QueryDone | QueryFailed
 
 
+MISMATCHES = 2
+"""Rounds of agreeing C records showing another value after which a set has failed: the
+set frame was sent again in between, so the board decided, not the link."""
+
+
 class ParamQuery:
     """Read the parameters, or set one and verify it by reading back."""
 
@@ -55,6 +60,9 @@ class ParamQuery:
         self._candidate: tuple[int, ...] | None = None
         self._seen = 0
         self._mismatch: int | None = None
+        self._mismatches = 0
+        self.known: tuple[int, ...] | None = None
+        """The parameters the host read last, before this query (set by HostState)."""
 
     @property
     def limit(self) -> int:
@@ -87,9 +95,24 @@ class ParamQuery:
         index, value = self.change
         if values[index] == value:
             return b"", QueryDone(values, f"{params.PARAMS[index].name} = {value} (verified)")
+        same = self._mismatch == values[index]
         self._mismatch = values[index]
+        self._mismatches = self._mismatches + 1 if same else 1
         self._candidate, self._seen = None, 0
+        if self._mismatches >= MISMATCHES:  # the board has decided, twice: say what it did
+            return b"", self._refused(index, value)
         return self._retry(now)
+
+    def _refused(self, index: int, value: int) -> QueryFailed:
+        name = params.PARAMS[index].name
+        held = self._mismatch
+        if self.known is None:
+            what = f"{name} reads {held}"
+        elif held == self.known[index]:
+            what = f"the board ignored it: {name} is still {held}"
+        else:
+            what = f"the board set {name} to {held} instead"
+        return QueryFailed(f"set {name} = {value} was not taken: {what}")
 
     def on_garbled(self, now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived garbled: ask again at once rather than wait for the timeout."""
@@ -105,11 +128,7 @@ class ParamQuery:
         if self.sent < self.limit:
             return self._request(now, with_change=True), None
         if self.change is not None and self._mismatch is not None:
-            index, value = self.change
-            return b"", QueryFailed(
-                f"{params.PARAMS[index].name} reads {self._mismatch} after setting it to "
-                f"{value}: the board did not take the value"
-            )
+            return b"", self._refused(*self.change)
         return b"", QueryFailed(
             f"no parameters from {self.where}: sent {{Q:P}} {self.sent} times and no "
             f"{self.agree} C records that agree came back ({self.timeout:g} s each); "

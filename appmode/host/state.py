@@ -121,6 +121,7 @@ class HostState:
     def start_query(self, query: ParamQuery, now: float) -> None:
         """Begin a parameter read or set; its bytes wait in the outbox."""
         self.query = query
+        query.known = None if self.params is None else self.params.values
         self._errors_at_start = self.stats.errors
         self._outbox += query.start(now)
 

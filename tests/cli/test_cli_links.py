@@ -232,3 +232,22 @@ def test_a_board_holding_a_value_out_of_range_is_read_shown_and_repaired() -> No
     assert repaired.returncode == 0, repaired.stderr
     assert "set position_ki = 0 (verified)" in repaired.stderr
     assert "out of range" not in repaired.stdout and held[3] == 0
+
+
+def test_a_set_the_board_changes_or_ignores_is_reported_as_what_it_did() -> None:
+    from tests.support.lenient_board import lenient_board
+
+    def firmware(index: int, value: int) -> int | None:
+        return None if index == 8 else value * 3 // 2 if index == 0 else value
+
+    held = [500, 10000, 20, 0, 10, 10, 10, 0, 0]
+    with lenient_board(held, firmware) as url:
+        changed = run("params", url, "--set", "max_speed=10", timeout=30)
+        ignored = run("params", url, "--set", "system_mode=1", timeout=30)
+    assert changed.returncode == 2 and ignored.returncode == 2
+    assert changed.stderr.endswith(
+        "set max_speed = 10 was not taken: the board set max_speed to 15 instead\n"
+    )
+    assert ignored.stderr.endswith(
+        "set system_mode = 1 was not taken: the board ignored it: system_mode is still 0\n"
+    )

@@ -84,7 +84,7 @@ def test_set_that_never_takes_is_retried_then_fails_naming_the_value_read() -> N
     state.feed(c_record(), 0.3)
     [failed] = outcomes(state.feed(c_record(), 0.4))
     assert isinstance(failed, QueryFailed)
-    assert failed.text.startswith("velocity_kp reads 10 after setting it to 42")
+    assert failed.text == "set velocity_kp = 42 was not taken: velocity_kp reads 10"
 
 
 def test_query_rejects_out_of_range_before_sending() -> None:

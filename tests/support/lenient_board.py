@@ -9,15 +9,18 @@ import re
 import select
 import threading
 import tty
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 FRAME = re.compile(rb"\{(Q:P|\d:-?\d+)\}")
 
 
 @contextmanager
-def lenient_board(values: list[int]) -> Iterator[str]:
-    """Serve until the block ends; yields the pty path. `values` is updated in place."""
+def lenient_board(
+    values: list[int], store: Callable[[int, int], int | None] = lambda index, value: value
+) -> Iterator[str]:
+    """Serve until the block ends; yields the pty path. `values` is updated in place with
+    what `store(index, value)` makes of each set (None: the set is ignored)."""
     master, slave = pty.openpty()
     tty.setraw(slave)
     stop = threading.Event()
@@ -33,8 +36,10 @@ def lenient_board(values: list[int]) -> Iterator[str]:
                 if body == b"Q:P":
                     os.write(master, b"{C" + b":".join(b"%d" % v for v in values) + b"}$")
                 else:
-                    index, value = body.split(b":")
-                    values[int(index)] = int(value)
+                    index, value = (int(x) for x in body.split(b":"))
+                    stored = store(index, value)
+                    if stored is not None:
+                        values[index] = stored
             pending = pending[pending.rfind(b"}") + 1 :] if b"}" in pending else pending[-64:]
 
     thread = threading.Thread(target=serve, daemon=True)
