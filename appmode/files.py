@@ -13,6 +13,7 @@ import os
 import re
 import secrets
 import stat
+import sys
 from pathlib import Path
 
 from appmode.errors import AppmodeError
@@ -43,6 +44,18 @@ def write_whole(path: str | os.PathLike[str], data: bytes, what: str) -> None:
                 f"cannot write {what} {shown}: there is no folder {folder}; create it first"
             ) from None
         raise AppmodeError(f"cannot write {what} {shown}: {exc.strerror}") from None
+
+
+def data_folder() -> Path:
+    """appmode's folder in the user's data folder (not created here): XDG_DATA_HOME or
+    ~/.local/share, ~/Library/Application Support on macOS, %LOCALAPPDATA% on Windows."""
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Application Support"
+    else:
+        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    return base / "appmode"
 
 
 def check_writable(path: str | os.PathLike[str], what: str) -> None:

@@ -11,6 +11,7 @@ from typing import TextIO
 from appmode.cli.hostio import open_host
 from appmode.cli.options import Subparsers, add_record, add_url
 from appmode.errors import AppmodeError
+from appmode.host import saves
 from appmode.protocol import params
 from appmode.protocol.render import params_table
 
@@ -32,7 +33,18 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         metavar="NAME=VALUE",
         help="set a parameter (repeatable), e.g. --set max_speed=800",
     )
-    prm.add_argument("--save", action="store_true", help="save to flash ({Q:W})")
+    saving = prm.add_mutually_exclusive_group()
+    saving.add_argument(
+        "--save",
+        action="store_true",
+        help="ask the board to save to flash ({Q:W}); it does not confirm, so appmode "
+        "remembers what was saved for --verify-saved",
+    )
+    saving.add_argument(
+        "--verify-saved",
+        action="store_true",
+        help="after the board restarted: check it holds what --save saved (exit 1 if not)",
+    )
     prm.add_argument("--json", action="store_true", help="print one JSON object")
     add_record(prm)
     return prm
@@ -40,7 +52,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     return run_params(
-        args.url, args.set, save=args.save, as_json=args.json, record=args.record, out=sys.stdout
+        args.url,
+        args.set,
+        save=args.save,
+        verify=args.verify_saved,
+        as_json=args.json,
+        record=args.record,
+        out=sys.stdout,
     )
 
 
@@ -60,10 +78,24 @@ def parse_assignment(text: str) -> tuple[int, int]:
 
 
 def run_params(
-    url: str, assignments: list[str], *, save: bool, as_json: bool, record: str | None, out: TextIO
+    url: str,
+    assignments: list[str],
+    *,
+    save: bool,
+    as_json: bool,
+    record: str | None,
+    out: TextIO,
+    verify: bool = False,
 ) -> int:
-    """Read the parameters; set each (verified by reading back), save, and print them."""
+    """Read the parameters; set each (verified by reading back), save, and print them;
+    or check them against what was saved (`verify`)."""
     changes = [parse_assignment(text) for text in assignments]  # all checked first
+    saved = saves.recall(url) if verify else None
+    if verify and saved is None:
+        raise AppmodeError(
+            f"no save of {url} to check: appmode remembers the saves made with "
+            f"'appmode params {url} --save' (in {saves.path()})"
+        )
     with ExitStack() as stack:
         host = open_host(stack, url, record)
         values = host.read_params()
@@ -73,10 +105,15 @@ def run_params(
         if save:
             host.save()
             values = host.read_params()
+            saves.remember(url, values)
             print(
-                "sent {Q:W}: the board saves its parameters to flash (it sends no reply)",
+                f"save requested ({{Q:W}}); the board does not confirm a save: restart it, "
+                f"then run appmode params {url} --verify-saved",
                 file=sys.stderr,
             )
+    status = 0
+    if saved is not None:
+        status = _verify(values, *saved)
     if as_json:
         out.write(
             json.dumps({p.name: v for p, v in zip(params.PARAMS, values, strict=True)}) + "\n"
@@ -92,4 +129,22 @@ def run_params(
                 f"--set {name}=N",
                 file=sys.stderr,
             )
-    return 0
+    return status
+
+
+def _verify(values: tuple[int, ...], saved: tuple[int, ...], at: str) -> int:
+    """Say whether the board holds what was saved; 1 if it does not."""
+    differ = [
+        f"{p.name} {old} → {new}"
+        for p, old, new in zip(params.PARAMS, saved, values, strict=True)
+        if old != new
+    ]
+    if not differ:
+        print(f"the board holds the parameters saved at {at}: the save held", file=sys.stderr)
+        return 0
+    print(
+        f"appmode: the board does not hold what was saved at {at}: {', '.join(differ)} "
+        "(not restarted since, or the save did not take)",
+        file=sys.stderr,
+    )
+    return 1

@@ -8,11 +8,9 @@ history): the status panel, the 3×3 key grid and arrows to drive, and a command
 from __future__ import annotations
 
 import asyncio
-import os
 import sys
 import time
 from collections.abc import Iterable
-from pathlib import Path
 from typing import TextIO
 
 from prompt_toolkit.application import Application
@@ -55,6 +53,7 @@ from appmode.console.session import (
     ShowStatus,
     help_lines,
 )
+from appmode.files import data_folder
 from appmode.host.signals import ENDING_SIGNALS
 from appmode.host.tokens import Wait
 from appmode.protocol import params
@@ -333,13 +332,7 @@ def is_quit(text: str) -> bool:
 def command_history() -> History:
     """The commands typed, kept across sessions in the user's data folder (in memory
     when that cannot be written)."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA", Path.home() / "AppData" / "Local"))
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    folder = base / "appmode"
+    folder = data_folder()
     try:
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / "history"

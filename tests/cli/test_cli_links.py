@@ -251,3 +251,21 @@ def test_a_set_the_board_changes_or_ignores_is_reported_as_what_it_did() -> None
     assert ignored.stderr.endswith(
         "set system_mode = 1 was not taken: the board ignored it: system_mode is still 0\n"
     )
+
+
+def test_a_save_is_requested_then_verified_after_a_restart(tmp_path: Path) -> None:
+    link, flash = str(tmp_path / "car"), str(tmp_path / "flash.json")
+    with board_process("--quiet", "--link", link, "--flash", flash):
+        nothing = run("params", link, "--verify-saved", timeout=30)
+        saved = run("params", link, "--set", "max_speed=900", "--save", timeout=30)
+    assert nothing.returncode == 2 and "no save of " in nothing.stderr
+    assert saved.returncode == 0 and "save requested ({Q:W}); the board does not confirm" in (
+        saved.stderr
+    )
+    with board_process("--quiet", "--link", link, "--flash", flash):  # restarted
+        held = run("params", link, "--verify-saved", timeout=30)
+    assert held.returncode == 0 and "the save held" in held.stderr
+    with board_process("--quiet", "--link", link):  # a board that forgot it
+        lost = run("params", link, "--verify-saved", timeout=30)
+    assert lost.returncode == 1
+    assert "does not hold what was saved" in lost.stderr and "max_speed 900 → 500" in lost.stderr
