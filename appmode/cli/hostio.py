@@ -10,7 +10,7 @@ from typing import TextIO
 
 from appmode.host.client import Event, Host
 from appmode.host.query import QueryDone, QueryFailed
-from appmode.host.state import LinkStatus
+from appmode.host.state import BoardWarning, LinkStatus
 from appmode.ports.sim import sim_directives
 from appmode.protocol.render import describe, line, to_json
 from appmode.protocol.transcript import Recorder
@@ -36,6 +36,9 @@ def open_host(
 def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:
     if isinstance(event, LinkStatus):
         print(f"appmode: {event.text}", file=sys.stderr, flush=True)
+        return
+    if isinstance(event, BoardWarning):
+        print(f"appmode: WARNING: {event.text}", file=sys.stderr, flush=True)
         return
     if isinstance(event, (QueryDone, QueryFailed)):
         return

@@ -17,7 +17,7 @@ from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host, LinkLost
 from appmode.host.query import ParamQuery, QueryDone, QueryFailed
-from appmode.host.state import LinkStatus
+from appmode.host.state import BoardWarning, LinkStatus
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.link import is_simulated
 from appmode.ports.sim import sim_directives
@@ -162,6 +162,8 @@ class Session:
                 if not event.up:
                     self.driving.stop()
                     self.in_force = STOP_LETTER
+            elif isinstance(event, BoardWarning):
+                self.say(f"WARNING: {event.text}")
             elif isinstance(event, QueryDone):
                 if self.baseline is None:
                     self.baseline = event.values

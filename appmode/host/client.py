@@ -17,7 +17,7 @@ import serial
 
 from appmode.errors import AppmodeError
 from appmode.host.query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, QueryFailed
-from appmode.host.state import HostState, LinkStatus
+from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.line.wire import Tap
 from appmode.ports.link import open_link
 from appmode.protocol import app, params
@@ -26,7 +26,7 @@ RETRY = 0.5
 STEP = 0.001
 """Seconds between looks at the port while waiting less than its read timeout."""
 
-Event = app.BoardEvent | LinkStatus | Outcome
+Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning
 
 
 class LinkLost(AppmodeError):
@@ -100,7 +100,7 @@ class Host:
         except (serial.SerialException, OSError) as exc:
             self._lost(exc)
             raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
-        self.state.sent(data)
+        self.state.sent(data, self.now())
         if self.tap is not None:
             self.tap(">", self.now(), data)
 

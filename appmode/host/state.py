@@ -43,6 +43,19 @@ class LinkStatus:
     text: str
 
 
+@dataclass(frozen=True, slots=True)
+class BoardWarning:
+    """The board does not do what it was told: the car still moves after a stop."""
+
+    text: str
+
+
+STILL_MOVING_AFTER = 1.0
+"""Seconds after a stop by which the board's A records must show the car (almost) still."""
+STILL = 20
+"""The largest velocity component of a car taken as stopped (a decaying ramp, §13)."""
+
+
 @dataclass(slots=True)
 class LinkStats:
     """Counters of one host session."""
@@ -102,21 +115,45 @@ class HostState:
         self._errors_at_start = 0
         self._outbox = bytearray()
         self.end = app.SessionEnd()
+        self.stopped_at: float | None = None
+        """When the host last told the car to stop (Z or a page letter), while it has not
+        told it to move since."""
+        self._warned = False
 
-    def feed(self, data: bytes, now: float) -> list[app.BoardEvent | Outcome]:
-        """Decode board bytes; returns the events, and the outcome of a query they end."""
+    def feed(self, data: bytes, now: float) -> list[app.BoardEvent | Outcome | BoardWarning]:
+        """Decode board bytes; returns the events, the outcome of a query they end, and a
+        warning if the car still moves well after a stop."""
         self.stats.bytes_in += len(data)
-        events: list[app.BoardEvent | Outcome] = []
+        events: list[app.BoardEvent | Outcome | BoardWarning] = []
         for event in self.decoder.feed(data):
             events.append(event)
             outcome = self._apply(event, now)
             if outcome is not None:
                 events.append(outcome)
+            if isinstance(event, app.Velocity) and (warning := self._disobeyed(event, now)):
+                events.append(warning)
         return events
 
-    def sent(self, data: bytes) -> None:
+    def sent(self, data: bytes, now: float) -> None:
         self.stats.bytes_out += len(data)
-        self.end.sent(data)
+        for event in self.end.sent(data):
+            if isinstance(event, app.Move):
+                self.stopped_at = None
+            elif isinstance(event, (app.Stop, app.SwitchPage)):
+                self.stopped_at, self._warned = now, False
+
+    def _disobeyed(self, velocity: app.Velocity, now: float) -> BoardWarning | None:
+        stopped = self.stopped_at
+        if stopped is None or self._warned or now - stopped < STILL_MOVING_AFTER:
+            return None
+        if max(abs(velocity.x), abs(velocity.y), abs(velocity.z)) <= STILL:
+            return None
+        self._warned = True
+        return BoardWarning(
+            f"the car still moves {now - stopped:.1f} s after it was told to stop "
+            f"(x={velocity.x} y={velocity.y} z={velocity.z}): another program or port may "
+            f"be driving it, or the board is not obeying"
+        )
 
     def start_query(self, query: ParamQuery, now: float) -> None:
         """Begin a parameter read or set; its bytes wait in the outbox."""

@@ -413,8 +413,9 @@ class SessionEnd:
     def __init__(self) -> None:
         self._decoder = HostDecoder()
 
-    def sent(self, data: bytes) -> None:
-        self._decoder.feed(data)
+    def sent(self, data: bytes) -> list[HostEvent]:
+        """Follow `data`; returns what it decodes to."""
+        return self._decoder.feed(data)
 
     @property
     def stop(self) -> bytes:

@@ -269,3 +269,17 @@ def test_a_save_is_requested_then_verified_after_a_restart(tmp_path: Path) -> No
         lost = run("params", link, "--verify-saved", timeout=30)
     assert lost.returncode == 1
     assert "does not hold what was saved" in lost.stderr and "max_speed 900 → 500" in lost.stderr
+
+
+def test_a_car_still_moving_after_a_stop_is_said_loudly() -> None:
+    from tests.support.lenient_board import runaway_board
+
+    with runaway_board() as url:
+        obeyed_too_soon = run("send", url, "J", "A", "Z", "wait:0.5", "--listen", "0")
+        ignored = run("send", url, "J", "A", "Z", "wait:1.5", "--listen", "0")
+    assert "WARNING" not in obeyed_too_soon.stderr  # a car needs time to stop
+    assert ignored.stderr.count("WARNING") == 1
+    assert "appmode: WARNING: the car still moves 1.0 s after it was told to stop" in (
+        ignored.stderr
+    )
+    assert "x=0 y=300 z=0" in ignored.stderr and "another program or port" in ignored.stderr

@@ -51,3 +51,28 @@ def lenient_board(
         thread.join(2)
         os.close(master)
         os.close(slave)
+
+
+@contextmanager
+def runaway_board(y: int = 300) -> Iterator[str]:
+    """A board that streams `{A0:<y>:0:0}$` every 50 ms whatever it is told (another
+    port in control, say); yields the pty path."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    stop = threading.Event()
+
+    def stream() -> None:
+        while not stop.wait(0.05):
+            os.write(master, b"{A0:%d:0:0}$" % y)
+            if select.select([master], [], [], 0)[0]:
+                os.read(master, 1024)  # what the host says changes nothing
+
+    thread = threading.Thread(target=stream, daemon=True)
+    thread.start()
+    try:
+        yield os.ttyname(slave)
+    finally:
+        stop.set()
+        thread.join(2)
+        os.close(master)
+        os.close(slave)
