@@ -134,11 +134,7 @@ def run_params(
 
 def _verify(values: tuple[int, ...], saved: tuple[int, ...], at: str) -> int:
     """Say whether the board holds what was saved; 1 if it does not."""
-    differ = [
-        f"{p.name} {old} → {new}"
-        for p, old, new in zip(params.PARAMS, saved, values, strict=True)
-        if old != new
-    ]
+    differ = params.changes(saved, values)
     if not differ:
         print(f"the board holds the parameters saved at {at}: the save held", file=sys.stderr)
         return 0

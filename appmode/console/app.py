@@ -50,6 +50,7 @@ from appmode.console.session import (
     QUIT_WORDS,
     Quit,
     Session,
+    ShowHelp,
     ShowStatus,
     help_lines,
 )
@@ -200,9 +201,6 @@ def build_app(
             command.append_to_history()
         command.reset()
         event.app.layout.focus(status)
-        if text.strip().lower() in ("help", "?"):
-            view.top = "help"
-            return
         try:
             step = session.run(text)
         except Quit:
@@ -210,7 +208,10 @@ def build_app(
             return
         if isinstance(step, Wait):
             session.say("wait is for script mode")
-        _show(session, step)
+        elif isinstance(step, ShowHelp):
+            view.top = "help"  # the whole of it, in place of the panel
+        else:
+            _show(session, step)
 
     keys.add("c-c")(lambda e: e.app.exit())  # at once: the session's close says what
     keys.add("c-q")(lambda e: leave(e.app))
@@ -359,10 +360,14 @@ def run_script(session: Session, lines: Iterable[str], out: TextIO) -> int:
     return 0
 
 
-def _show(session: Session, step: Wait | ShowStatus | None) -> None:
-    """What a command returned for the view: the panel for `status`."""
+def _show(session: Session, step: Wait | ShowStatus | ShowHelp | None) -> None:
+    """What a command returned for the view: the panel for `status`, the help for
+    `help`, as messages."""
     if isinstance(step, ShowStatus):
         session.say(status_text(session))
+    elif isinstance(step, ShowHelp):
+        for text in help_lines():
+            session.say(text)
 
 
 def _settle(session: Session, seconds: float) -> None:

@@ -85,6 +85,13 @@ class ShowStatus:
 SHOW_STATUS = ShowStatus()
 
 
+class ShowHelp:
+    """`help` was asked for: the view shows `help_lines()`."""
+
+
+SHOW_HELP = ShowHelp()
+
+
 class Session:
     """A host session with driving state, messages, recording and commands."""
 
@@ -266,14 +273,8 @@ class Session:
         current = self.host.state.params
         if current is None or self.baseline is None:
             return None
-        changed = [
-            f"{p.name} {old} → {new}"
-            for p, old, new in zip(params.PARAMS, self.baseline, current.values, strict=True)
-            if old != new
-        ]
-        if not changed:
-            return None
-        return f"not saved: {', '.join(changed)}"
+        changed = params.changes(self.baseline, current.values)
+        return f"not saved: {', '.join(changed)}" if changed else None
 
     # ------------------------------------------------------------ recording
 
@@ -297,8 +298,9 @@ class Session:
 
     # ------------------------------------------------------------ commands
 
-    def run(self, line: str) -> Wait | ShowStatus | None:
-        """Run one command line; returns a Wait for `wait`, SHOW_STATUS for `status`.
+    def run(self, line: str) -> Wait | ShowStatus | ShowHelp | None:
+        """Run one command line; returns a Wait for `wait`, SHOW_STATUS for `status`,
+        SHOW_HELP for `help`.
         Raises Quit to leave.
 
         Mistakes are reported as messages, never raised.
@@ -316,12 +318,11 @@ class Session:
             self.say(f"error: {exc}")
             return None
 
-    def _dispatch(self, name: str, args: list[str]) -> Wait | ShowStatus | None:
+    def _dispatch(self, name: str, args: list[str]) -> Wait | ShowStatus | ShowHelp | None:
         if name in QUIT_WORDS:
             raise Quit
         if name in ("help", "?"):
-            for text in help_lines():
-                self.say(text)
+            return SHOW_HELP
         elif name in ("params", "read"):
             self.read_params()
         elif name == "set":

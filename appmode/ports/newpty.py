@@ -19,18 +19,25 @@ kernel hands them over from a work queue)."""
 
 
 class PtyPort:
-    """The master side of a new pseudo-terminal; the app opens `path`."""
+    """The master side of a new pseudo-terminal; the app opens `path`. It reads and
+    writes as a pyserial port does, so the code that uses it takes either."""
 
     def __init__(self) -> None:
         self._master, self._slave = pty.openpty()
         tty.setraw(self._slave)
         self.path = os.ttyname(self._slave)
 
-    def read(self, size: int = 1, timeout: float = READ_TIMEOUT) -> bytes:
-        """What the program wrote, waiting at most `timeout` seconds for it."""
-        if not select.select([self._master], [], [], timeout)[0]:
+    @property
+    def in_waiting(self) -> int:
+        """Bytes the program wrote that were not read yet (as pyserial's ports say)."""
+        return _waiting(self._master)
+
+    def read(self, size: int = 1) -> bytes:
+        """At most `size` bytes the program wrote, waiting at most READ_TIMEOUT for the
+        first (as a pyserial port with that timeout; `read(0)` does not wait)."""
+        if size <= 0 or not select.select([self._master], [], [], READ_TIMEOUT)[0]:
             return b""
-        return os.read(self._master, max(size, 4096))
+        return os.read(self._master, size)
 
     def write(self, data: bytes) -> int:
         return os.write(self._master, data)
@@ -47,6 +54,7 @@ class PtyPort:
 
 
 def _waiting(fd: int) -> int:
-    """Bytes written to the program and not read by it yet."""
+    """Bytes that can be read from `fd` (on the slave: written to the program and not
+    read by it yet)."""
     (count,) = struct.unpack("i", fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0"))
     return int(count)

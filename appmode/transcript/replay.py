@@ -44,13 +44,13 @@ def retime(items: Sequence[Item], gap: float = 0.0, skip: float | None = None) -
 
 def play(
     items: Sequence[Item],
-    write: Callable[[bytes], None],
+    write: Callable[[bytes], object],
     *,
     speed: float = 1.0,
     loops: int = 1,
     clock: Callable[[], float] = time.monotonic,
     sleep: Callable[[float], None] = time.sleep,
-    idle: Callable[[], None] | None = None,
+    idle: Callable[[], object] | None = None,
     progress: Callable[[float, float], None] | None = None,
 ) -> list[float]:
     """Send each item at start + (loop offset + t) / speed; returns how late each was (s)."""
@@ -90,23 +90,24 @@ def run_replay(
     """The `appmode replay` command."""
     if not (0.001 <= speed <= 1000 and loops >= 1):
         raise AppmodeError("--speed must be > 0, in 0.001–1000, and --loop at least 1")
+    if side == "host" and url == "pty":
+        raise AppmodeError(
+            "replay --to pty plays the board's side to an app: add --side board (to drive "
+            "a board on a pty, serve it with appmode board and replay to its port)"
+        )
     transcript = read_transcript(path)
     entries = [(e.time, e.direction, e.data) for e in transcript.entries]
     items = retime(plan(entries, side), gap, skip)
+    mark = ">" if side == "host" else "<"
     if not items:
-        mark = ">" if side == "host" else "<"
         raise AppmodeError(f"{path} has no '{mark}' lines to play as the {side}")
     show = _progress(path) if sys.stderr.isatty() and not verbose else None
-    mark = ">" if side == "host" else "<"
     started = time.monotonic()
 
-    def shown(write: Callable[[bytes], object]) -> Callable[[bytes], None]:
+    def shown(write: Callable[[bytes], object]) -> Callable[[bytes], object]:
         """`write`, printing each unit as it goes (-v)."""
-        def write_only(data: bytes) -> None:
-            write(data)
-
         if not verbose:
-            return write_only
+            return write
         decoder = HostDecoder() if side == "host" else BoardDecoder()
 
         def write_and_print(data: bytes) -> None:
@@ -116,11 +117,6 @@ def run_replay(
 
         return write_and_print
 
-    if side == "host" and url == "pty":
-        raise AppmodeError(
-            "replay --to pty plays the board's side to an app: add --side board (to drive "
-            "a board on a pty, serve it with appmode board and replay to its port)"
-        )
     if side == "host":
         with Host(url) as host:
             late = play(
@@ -128,7 +124,7 @@ def run_replay(
                 shown(host.send),
                 speed=speed,
                 loops=loops,
-                idle=lambda: _discard(host.poll_nowait),
+                idle=host.poll_nowait,
                 progress=show,
             )
     else:
@@ -139,7 +135,7 @@ def run_replay(
                 shown(port.write),
                 speed=speed,
                 loops=loops,
-                idle=lambda: _drain(port),
+                idle=lambda: port.read(port.in_waiting),  # what the app says meanwhile
                 progress=show,
             )
         except (serial.SerialException, OSError) as exc:
@@ -169,21 +165,9 @@ def _open_for_app(url: str) -> serial.SerialBase | PtyPort:
         file=sys.stderr,
         flush=True,
     )
-    while not port.read(4096, timeout=0.5):
+    while not port.read():
         pass
     return port
-
-
-def _drain(port: serial.SerialBase | PtyPort) -> None:
-    """Read and drop what the app sends meanwhile."""
-    if isinstance(port, PtyPort):
-        port.read(4096, timeout=0)
-    else:
-        port.read(port.in_waiting)
-
-
-def _discard(read: Callable[[], object]) -> None:
-    read()
 
 
 def _progress(path: str) -> Callable[[float, float], None]:

@@ -24,6 +24,9 @@ READ_TIMEOUT = 0.05
 
 
 class Port(Protocol):
+    @property
+    def in_waiting(self) -> int: ...
+
     def read(self, size: int = 1) -> bytes: ...
 
     def write(self, data: bytes) -> int | None: ...
@@ -32,10 +35,7 @@ class Port(Protocol):
 
 
 def _read(port: Port) -> bytes:
-    if isinstance(port, serial.SerialBase):
-        data: bytes = port.read(max(1, port.in_waiting))
-        return data
-    return port.read(4096)
+    return port.read(max(1, port.in_waiting))
 
 
 def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
