@@ -7,8 +7,10 @@ Documented model (all constants here):
 - yaw turns at YAW_GAIN degrees a second per unit of z (z = 500 turns 90 °/s), clockwise +;
 - pitch and roll lean with acceleration: TILT_GAIN degrees per unit/s² (nose up while
   speeding up forward, right side down while speeding up to the right);
+- or, on a board whose profile ramps (§13), velocity is set by `ramp` each tick;
 - the battery starts full (12.60 V) and drains IDLE_DRAIN centivolts a second plus
-  LOAD_DRAIN per unit of speed; percent is (cV − 1110) × 2 / 3, capped to 0…100 (§3.2).
+  LOAD_DRAIN per unit of speed; percent is (cV − 1110) × 2 / 3, at most 100, and at least
+  0 on the sheet (§3.2).
 """
 
 from __future__ import annotations
@@ -26,14 +28,18 @@ IDLE_DRAIN = 0.02
 LOAD_DRAIN = 0.00017
 
 
-def battery_percent(centivolts: float) -> int:
-    """§3.2: (cV − 1110) × 2 / 3 in whole percent, capped at 100 and floored at 0."""
-    return max(0, min(100, (round(centivolts) - round(EMPTY_CV)) * 2 // 3))
+def battery_percent(centivolts: float, floor: bool = True) -> int:
+    """§3.2: (cV − 1110) × 2 / 3 in whole percent (truncated, as C divides), at most 100,
+    and at least 0 when `floor`."""
+    percent = min(100, int((round(centivolts) - round(EMPTY_CV)) * 2 / 3))
+    return max(0, percent) if floor else percent
 
 
-def wrap_degrees(angle: float) -> int:
-    """Whole degrees in −179…180."""
-    return (round(angle) + 179) % 360 - 179
+def wrap_degrees(angle: float, low: int = -179, truncate: bool = False) -> int:
+    """Whole degrees in low…low + 359, rounded (or truncated, as a C cast does)."""
+    if truncate:
+        return math.trunc((angle - low) % 360 + low)
+    return (round(angle) - low) % 360 + low
 
 
 @dataclass(slots=True)
@@ -57,6 +63,29 @@ class Vehicle:
         self.vx = _approach(self.vx, target[0], alpha)
         self.vy = _approach(self.vy, target[1], alpha)
         self.vz = _approach(self.vz, target[2], alpha)
+        self._move(old_x, old_y, dt)
+
+    def ramp(
+        self, pushes: tuple[int | None, ...], limit: float, step: float, coast: float, dt: float
+    ) -> None:
+        """One control tick of a ramping board (§13): an axis pushed by ±1 gains ±step up
+        to ±limit (checked as the firmware does, upper bound first), an axis pushed by 0
+        is set to 0, an axis pushed by None coasts (divided by `coast`)."""
+        old_x, old_y = self.vx, self.vy
+        axes = [self.vx, self.vy, self.vz]
+        for i, push in enumerate(pushes):
+            if push is None:
+                axes[i] /= coast
+            elif push == 0:
+                axes[i] = 0.0
+            else:
+                value = axes[i] + push * step
+                value = limit if value > limit else value
+                axes[i] = -limit if value < -limit else value
+        self.vx, self.vy, self.vz = axes
+        self._move(old_x, old_y, dt)
+
+    def _move(self, old_x: float, old_y: float, dt: float) -> None:
         self.pitch = (self.vy - old_y) / dt * TILT_GAIN
         self.roll = (self.vx - old_x) / dt * TILT_GAIN
         self.heading = (self.heading + self.vz * YAW_GAIN * dt) % 360.0

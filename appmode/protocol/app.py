@@ -115,6 +115,8 @@ class BadFrame:
 
 Command = Move | Stop | SwitchPage | ReadParams | SaveParams | SetParam
 HostEvent = Command | Noise | BadFrame
+ByteEvent = Move | Stop | SwitchPage | Noise
+"""What a byte outside a frame can be."""
 
 
 def _separator_warning(separator: int) -> str | None:
@@ -249,10 +251,9 @@ def encode(item: Event) -> bytes:
         return b"{A" + _ints([item.x, item.y, item.z, item.extra]) + b"}$"
     if isinstance(item, Attitude):
         return b"{B" + _ints([item.pitch, item.roll, item.yaw, item.battery]) + b"}$"
-    if isinstance(item, ParamsRecord):
-        error = params.values_error(item.values)
-        if error is not None:
-            raise ValueError(error)
+    if isinstance(item, ParamsRecord):  # any values: a real board sends what it holds (§3.3)
+        if len(item.values) != params.PARAM_COUNT:
+            raise ValueError(f"a C record has {params.PARAM_COUNT} values, not {len(item.values)}")
         return b"{C" + _ints(item.values) + b"}$"
     if isinstance(item, OtherRecord):
         if len(item.letter) != 1 or not item.letter.isalpha() or not item.letter.isascii():
@@ -264,12 +265,12 @@ def encode(item: Event) -> bytes:
 # ---------------------------------------------------------------- host stream decoder
 
 
-def _single_byte_events() -> tuple[HostEvent, ...]:
-    table: list[HostEvent] = []
+def _single_byte_events() -> tuple[ByteEvent, ...]:
+    table: list[ByteEvent] = []
     for value in range(256):
         raw = bytes([value])
         char = chr(value)
-        event: HostEvent
+        event: ByteEvent
         if char in LETTERS:
             event = Move(LETTERS.index(char) + 1, raw=raw)
         elif 1 <= value <= 8:
@@ -284,7 +285,8 @@ def _single_byte_events() -> tuple[HostEvent, ...]:
     return tuple(table)
 
 
-_SINGLE = _single_byte_events()
+SINGLE_BYTE = _single_byte_events()
+"""What each byte means outside a frame (§2.1), by value."""
 
 
 def _parse_frame(raw: bytes) -> HostEvent:
@@ -325,7 +327,7 @@ class HostDecoder:
         buf += data
         out: list[HostEvent] = []
         pos, n = 0, len(buf)
-        single = _SINGLE
+        single = SINGLE_BYTE
         while pos < n:
             if self._skip_len:
                 skipped = self._skip(buf, pos, n, out)

@@ -6,6 +6,7 @@ the grid. A motion is given as unit factors of S (parameter 0, max speed).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
 
@@ -99,19 +100,26 @@ def letter_name(page: Page, letter: str) -> str:
     return motion.name
 
 
-def motion_for(page: Page, direction: int) -> Motion | None:
-    """The motion of direction 1…8 on `page`; None for 0 (stop)."""
+def motion_for(
+    page: Page, direction: int, buttons: Mapping[str, Motion] = BUTTON_PAGE
+) -> Motion | None:
+    """The motion of direction 1…8 on `page`; None for 0 (stop) or a letter that is not
+    one of `buttons` (the button page's letters, which depend on the board)."""
     if direction == 0:
         return None
-    table = DIRECTION_PAGE if page is Page.DIRECTION else BUTTON_PAGE
-    return table[LETTERS[direction - 1]]
+    table = DIRECTION_PAGE if page is Page.DIRECTION else buttons
+    return table.get(LETTERS[direction - 1])
 
 
 def target_velocity(
-    page: Page, direction: int, speed: float, differential: bool
+    page: Page,
+    direction: int,
+    speed: float,
+    differential: bool,
+    buttons: Mapping[str, Motion] = BUTTON_PAGE,
 ) -> tuple[float, float, float]:
     """Target body velocity (x, y, z) for a direction at max speed `speed`."""
-    motion = motion_for(page, direction)
+    motion = motion_for(page, direction, buttons)
     if motion is None:
         return (0.0, 0.0, 0.0)
     if differential:

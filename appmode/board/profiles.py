@@ -1,0 +1,199 @@
+"""Board profiles (design.md "Board profiles"): every point where the simulated board can
+behave differently, as one named switch, and one row of values per profile.
+
+`sheet` is the vendor's sheet as docs/protocol.md §1–§12 reads it; `minibalance` is the
+reference firmware as measured (§13). A third board is a third row.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+
+from appmode.errors import AppmodeError
+from appmode.protocol import params
+from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
+from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
+
+
+@dataclass(frozen=True, slots=True)
+class Profile:
+    """One board's behaviour, switch by switch (the §13 table, row by row)."""
+
+    name: str
+    summary: str
+    # -- bytes in (§2)
+    firmware_frames: bool
+    """Frames as the reference loop reads them (§13): Q frames by position 3, set values
+    summed byte by byte in float32, nothing validated. Else the sheet's checked grammar."""
+    steer_in_frames: bool
+    """Every byte inside a frame also goes through the direction logic of §2.1."""
+    frame_restarts: bool
+    """A `{` inside a frame starts a new frame (else it is kept as a byte of the frame)."""
+    settable: frozenset[int]
+    """The parameters a set frame changes; the others are ignored."""
+    stall_speed: int
+    """A max_speed from 1 to stall_speed − 1 becomes stall_speed at the next tick (0: never)."""
+    # -- parameters (§5)
+    saves: bool
+    """`{Q:W}` writes the store, and power-up loads it."""
+    defaults: tuple[int, ...]
+    """The parameters at power-up when nothing is saved."""
+    drive_types: bool
+    """system_mode's drive type is kept and used (else the car is always omni/mecanum)."""
+    c_saturates: bool
+    """C record values printed as a 32-bit C `int` (saturating) rather than as held."""
+    # -- motion (§4)
+    buttons: Mapping[str, Motion]
+    """The button page's letters; a letter not here stops."""
+    numeric_buttons: bool
+    """The bytes 0x01–0x08 act as letters on the button page (else they stop)."""
+    sticky_rotation: bool
+    """A rotation begun on the button page ends only with a direction or another button."""
+    ramp: float | None
+    """Units a held direction adds per 10 ms tick, up to ±max_speed; None: a first-order
+    lag toward the target (vehicle.RESPONSE_TAU)."""
+    coast: float
+    """With no direction, x and y (and z with no rotation) are divided by this each tick."""
+    dead_time: float
+    """Seconds after power-up with the motors off and the battery voltage read as 0."""
+    # -- records (§3)
+    a_layout: ALayout
+    """What the A record's fields hold."""
+    truncate: bool
+    """Whole numbers in records by truncation, as C casts do (else rounded)."""
+    yaw_low: int
+    """The yaw field runs from yaw_low to yaw_low + 359 (whole degrees)."""
+    battery_floor: bool
+    """The battery percentage never goes below 0."""
+    # -- timing (§3.4)
+    period_ms: int | None
+    """Fixed milliseconds between records; None: the record's wire time rounded up to
+    pause_step_ms, plus pause_ms."""
+    pause_ms: int
+    pause_step_ms: int
+    byte_ms: float
+    """A byte's wire time as the firmware's pause counts it."""
+    first_record: str
+    """"A" or "B": the first record after power-up."""
+    read_lost_in_c: bool
+    """A `{Q:P}` that arrives while a C record is going out is lost."""
+    startup_text: bytes
+    """What the APP port carries at power-up, before the first record."""
+
+    def describe(self) -> str:
+        return f"{self.name} profile ({self.summary})"
+
+    def check(self, drive: bool, flash: bool) -> None:
+        """AppmodeError when a board of this profile is asked for what it does not have."""
+        if drive and not self.drive_types:
+            raise AppmodeError(
+                f"the {self.name} profile has no drive types (docs/protocol.md §13): "
+                "leave out the drive type"
+            )
+        if flash and not self.saves:
+            raise AppmodeError(
+                f"the {self.name} profile saves nothing and starts from its factory "
+                "defaults (docs/protocol.md §13): leave out the flash file"
+            )
+
+
+MPU_LINES = (
+    "mpu_set_sensor complete ......",
+    "mpu_configure_fifo complete ......",
+    "mpu_set_sample_rate complete ......",
+    "dmp_load_motion_driver_firmware complete ......",
+    "dmp_set_orientation complete ......",
+    "dmp_enable_feature complete ......",
+    "dmp_set_fifo_rate complete ......",
+    "setting bias succesfully ......",
+    "mpu_set_dmp_state complete ......",
+    "mpu_dmp_init complete ......",
+)
+"""The reference firmware's sensor start-up messages (§13), spelling as it prints them."""
+
+SHEET = Profile(
+    name="sheet",
+    summary="the vendor's sheet, docs/protocol.md §1–§12",
+    firmware_frames=False,
+    steer_in_frames=False,
+    frame_restarts=True,
+    settable=frozenset(range(params.PARAM_COUNT)),
+    stall_speed=0,
+    saves=True,
+    defaults=params.DEFAULTS,
+    drive_types=True,
+    c_saturates=False,
+    buttons=BUTTON_PAGE,
+    numeric_buttons=True,
+    sticky_rotation=False,
+    ramp=None,
+    coast=1.0,
+    dead_time=0.0,
+    a_layout=VELOCITY,
+    truncate=False,
+    yaw_low=-179,
+    battery_floor=True,
+    period_ms=50,
+    pause_ms=0,
+    pause_step_ms=5,
+    byte_ms=1.04,
+    first_record="A",
+    read_lost_in_c=False,
+    startup_text=b"",
+)
+
+MINIBALANCE = Profile(
+    name="minibalance",
+    summary="the reference firmware as measured, docs/protocol.md §13",
+    firmware_frames=True,
+    steer_in_frames=True,
+    frame_restarts=False,
+    settable=frozenset(range(7)),
+    stall_speed=15,
+    saves=False,
+    defaults=(30, 3000, 40, 0, 40, 10, 10, 0, 0),
+    drive_types=False,
+    c_saturates=True,
+    buttons=MappingProxyType(
+        {
+            k: MOTIONS[v]
+            for k, v in (
+                ("A", "forward"),
+                ("C", "rotate-cw"),
+                ("E", "backward"),
+                ("G", "rotate-ccw"),
+            )
+        }
+    ),
+    numeric_buttons=False,
+    sticky_rotation=True,
+    ramp=0.5,
+    coast=1.05,
+    dead_time=1.0,
+    a_layout=SCALED,
+    truncate=True,
+    yaw_low=-180,
+    battery_floor=False,
+    period_ms=None,
+    pause_ms=45,
+    pause_step_ms=5,
+    byte_ms=1.04,
+    first_record="B",
+    read_lost_in_c=True,
+    startup_text=b"".join(line.encode() + b"\r\n" for line in MPU_LINES),
+)
+
+PROFILES: dict[str, Profile] = {p.name: p for p in (SHEET, MINIBALANCE)}
+PROFILE_NAMES: tuple[str, ...] = tuple(PROFILES)
+
+
+def profile_named(name: str) -> Profile:
+    """The profile called `name`; AppmodeError lists the choices."""
+    try:
+        return PROFILES[name]
+    except KeyError:
+        raise AppmodeError(
+            f"unknown board profile {name!r}: choose one of {', '.join(PROFILE_NAMES)}"
+        ) from None
