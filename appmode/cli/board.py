@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import Subparsers, add_record, number_type
+from appmode.cli.options import Subparsers, add_profile, add_record, number_type
 from appmode.protocol.params import DRIVE_NAMES
 
 
@@ -44,6 +44,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="with --pty: keep a symlink PATH to the pty, so clients find a restarted board "
         "at the same path",
     )
+    add_profile(
+        board,
+        "the board's behaviour: sheet (the vendor's sheet, the default) or "
+        "minibalance (the reference firmware as measured, docs/protocol.md §13)",
+    )
     board.add_argument(
         "--drive", choices=DRIVE_NAMES, help="drive type (default: the saved one, else omni)"
     )
@@ -78,4 +83,5 @@ def run(args: argparse.Namespace) -> int:
         record=args.record,
         quiet=args.quiet,
         count=args.count,
+        profile=args.profile,
     )

@@ -3,9 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 from collections.abc import Callable
 from typing import TypeAlias
+
+from serial import SerialException
+
+from appmode.board.profiles import PROFILE_NAMES, PROFILES
+from appmode.ports.sim import parse_sim_url
+from appmode.protocol.layouts import VELOCITY, ALayout
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
@@ -25,6 +32,32 @@ def add_record(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--record", metavar="FILE", help="record the session as a transcript (flushed line by line)"
     )
+
+
+def add_profile(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument(
+        "--profile", choices=PROFILE_NAMES, default="sheet", help=f"{what} (default: sheet)"
+    )
+
+
+def add_record_layout(parser: argparse.ArgumentParser) -> None:
+    """`--profile` on a command that shows records: it names the A record's fields."""
+    parser.add_argument(
+        "--profile",
+        choices=PROFILE_NAMES,
+        help="the board's profile, for what its A record holds: sheet (x, y, z) or "
+        "minibalance (|0.7x|, |0.7y|, battery; docs/protocol.md §13) (default: a sim:// "
+        "URL's profile, else sheet)",
+    )
+
+
+def layout_for(url: str | None, name: str | None) -> ALayout:
+    """The A record layout of `--profile NAME`, else of a sim:// URL's profile, else the
+    sheet's."""
+    if name is None and url is not None and url.lower().startswith("sim://"):
+        with contextlib.suppress(SerialException):
+            name = parse_sim_url(url).get("profile")
+    return PROFILES[name].a_layout if name in PROFILES else VELOCITY
 
 
 Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"

@@ -23,6 +23,7 @@ from pathlib import Path
 import serial
 
 from appmode.board.firmware import Board
+from appmode.board.profiles import SHEET, profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
@@ -328,6 +329,7 @@ def serve(
     announce: Callable[[str], None],
     record: str | None = None,
     banner: str = "",
+    directives: tuple[str, ...] = (),
 ) -> None:
     """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line.
 
@@ -341,7 +343,7 @@ def serve(
     try:
         for make in make_endpoints:
             endpoints.append(make(sel, log))
-        recorder = Recorder.create(record) if record else None
+        recorder = Recorder.create(record, 0.0, directives) if record else None
         for endpoint, board in zip(endpoints, boards, strict=True):
             baud = getattr(endpoint, "baud", BAUD)
             one = Served(endpoint, Wire(board, baud if pace else None, recorder))
@@ -391,6 +393,7 @@ def run_board(
     record: str | None,
     quiet: bool,
     count: int = 1,
+    profile: str = "sheet",
 ) -> int:
     """The `appmode board` command: build the board(s) and serve until interrupted."""
 
@@ -417,11 +420,20 @@ def run_board(
     else:
         make = partial(_pty, link=link)
     kind = DriveType.from_cli_name(drive) if drive else None
-    boards = [Board(open_store(flash), drive=kind) for _ in range(count)]
-    banner = (
-        f"simulated board{'s' if count > 1 else ''}, {boards[0].drive_type.cli_name} drive, "
-        f"flash {flash or 'in memory'}, {'paced at the line rate' if pace else 'not paced'}"
+    rules = profile_named(profile)
+    rules.check(drive=kind is not None, flash=flash is not None)
+    boards = [Board(open_store(flash), drive=kind, profile=rules) for _ in range(count)]
+    body = (
+        f"{boards[0].drive_type.cli_name} drive, flash {flash or 'in memory'}"
+        if rules.drive_types
+        else "no drive types, saves nothing"
     )
+    banner = (
+        f"simulated board{'s' if count > 1 else ''}, {rules.name} profile, {body}, "
+        f"{'paced at the line rate' if pace else 'not paced'}"
+    )
+    needs = [f"profile={profile}"] if rules is not SHEET else []
+    needs += [f"drive={drive}"] if drive else []
     try:
         serve(
             [make] * count,
@@ -431,6 +443,7 @@ def run_board(
             announce=announce,
             record=record,
             banner=banner,
+            directives=(f"board {' '.join(needs)}",) if needs else (),
         )
     except KeyboardInterrupt:
         log("stopped")

@@ -1,10 +1,11 @@
 """`sim://`: the simulated board in-process, as a pyserial port.
 
-`sim://?drive=mecanum&flash=board.json&pace=0` — options: `drive` (omni, mecanum, diff,
-diff-gyro; default: what the flash holds, else omni), `flash` (a JSON parameter file;
-default: in memory), `pace` (1: bytes move at the real 9600-bps rate, the default; 0:
-instantly), `baud`, `faults` (a faulty link both ways, see appmode.faults). There is no
-thread: the board runs whenever the port is used.
+`sim://?drive=mecanum&flash=board.json&pace=0` — options: `profile` (sheet, the
+default, or minibalance: docs/protocol.md §13), `drive` (omni, mecanum, diff, diff-gyro;
+default: what the flash holds, else omni), `flash` (a JSON parameter file; default: in
+memory), `pace` (1: bytes move at the real 9600-bps rate, the default; 0: instantly),
+`baud`, `faults` (a faulty link both ways, see appmode.faults). There is no thread: the
+board runs whenever the port is used.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import serial
 from serial import SerialBase, SerialException
 
 from appmode.board.firmware import Board
+from appmode.board.profiles import profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec, FaultyLine
@@ -25,14 +27,15 @@ from appmode.line.wire import Wire
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
 
-OPTIONS = ("drive", "flash", "pace", "baud", "faults")
+OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults")
 WRITE_BUFFER = 4096
 MIN_BAUD, MAX_BAUD = 300, 4_000_000
 """Paced rates a simulated line takes: below 300 bps closing (which waits for what is
 queued to go out) could take minutes."""
 """Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
 USAGE = (
-    "sim://[?drive=omni|mecanum|diff|diff-gyro][&flash=FILE][&pace=1|0][&baud=9600]"
+    "sim://[?profile=sheet|minibalance][&drive=omni|mecanum|diff|diff-gyro][&flash=FILE]"
+    "[&pace=1|0][&baud=9600]"
     "[&faults=drop:0.01,corrupt:0.01,…]"
 )
 
@@ -54,8 +57,9 @@ def sim_directives(url: str) -> tuple[str, ...]:
     """Transcript directives that describe a sim:// board, for replaying its sessions."""
     if not url.lower().startswith("sim://"):
         return ()
-    drive = parse_sim_url(url).get("drive")
-    return (f"board drive={drive}",) if drive else ()
+    options = parse_sim_url(url)
+    needs = " ".join(f"{key}={options[key]}" for key in ("profile", "drive") if key in options)
+    return (f"board {needs}",) if needs else ()
 
 
 def _flag(name: str, text: str) -> bool:
@@ -89,6 +93,11 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             drive = DriveType.from_cli_name(options["drive"]) if "drive" in options else None
         except ValueError as exc:
             raise SerialException(f"sim:// option drive: {exc}") from None
+        try:
+            profile = profile_named(options.get("profile", "sheet"))
+            profile.check(drive=drive is not None, flash="flash" in options)
+        except AppmodeError as exc:
+            raise SerialException(f"sim:// option profile: {exc}") from None
         if "baud" in options:
             baud = params.whole(options["baud"])
             if baud is None or not MIN_BAUD <= baud <= MAX_BAUD:
@@ -107,7 +116,7 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             store = open_store(options.get("flash"))
         except AppmodeError as exc:
             raise SerialException(str(exc)) from None
-        self.board = Board(store, drive=drive)
+        self.board = Board(store, drive=drive, profile=profile)
         self._wire = Wire(self.board, self._baudrate if pace else None)
         self._rx.clear()
         self._origin = time.monotonic()
