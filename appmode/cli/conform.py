@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, add_profile
 from appmode.errors import AppmodeError
 
 
@@ -28,6 +28,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     conform.add_argument(
         "--board", metavar="URL", help="run in real time against this board instead"
+    )
+    add_profile(
+        conform,
+        "run the transcripts written for this board profile (@board profile=…); "
+        "without --board, on a simulated board of that profile",
     )
     conform.add_argument("--junit", metavar="FILE", help="also write a JUnit XML report")
     conform.add_argument(
@@ -58,4 +63,4 @@ def run(args: argparse.Namespace) -> int:
         if sys.stdin.readline().strip().lower() not in ("y", "yes"):
             print("not run", file=sys.stderr)
             return 1
-    return run_conform(args.paths, args.board, args.junit, sys.stdout)
+    return run_conform(args.paths, args.board, args.junit, sys.stdout, args.profile)

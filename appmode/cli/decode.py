@@ -7,9 +7,10 @@ import sys
 from collections.abc import Iterable, Iterator
 from typing import BinaryIO, TextIO
 
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, add_record_layout, layout_for
 from appmode.errors import AppmodeError
 from appmode.protocol import app
+from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import coalesce, json_line
 
 CHUNK = 65536
@@ -38,13 +39,19 @@ def read_chunks(stream: BinaryIO, name: str, out: TextIO) -> Iterator[bytes]:
         yield chunk
 
 
-def run_decode(stream: BinaryIO, out: TextIO, source: str, name: str = "standard input") -> int:
+def run_decode(
+    stream: BinaryIO,
+    out: TextIO,
+    source: str,
+    name: str = "standard input",
+    layout: ALayout = VELOCITY,
+) -> int:
     """Write one JSON object a line; returns the number of undecodable runs."""
     errors = 0
     write = out.write
     for event in coalesce(decode_chunks(read_chunks(stream, name, out), source)):
         errors += isinstance(event, app.ERRORS)
-        write(json_line(event) + "\n")
+        write(json_line(event, layout) + "\n")
     out.flush()
     return errors
 
@@ -64,17 +71,19 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         default="board",
         help="who sent the bytes (default: board, i.e. board→host records)",
     )
+    add_record_layout(decode)
     return decode
 
 
 def run(args: argparse.Namespace) -> int:
+    layout = layout_for(None, args.profile)
     if args.file in (None, "-"):
-        run_decode(sys.stdin.buffer, sys.stdout, args.source)
+        run_decode(sys.stdin.buffer, sys.stdout, args.source, layout=layout)
         return 0
     try:
         stream = open(args.file, "rb")  # noqa: SIM115 - closed below
     except OSError as exc:
         raise AppmodeError(f"cannot read {args.file}: {exc.strerror}") from None
     with stream:
-        run_decode(stream, sys.stdout, args.source, args.file)
+        run_decode(stream, sys.stdout, args.source, args.file, layout)
     return 0

@@ -9,7 +9,8 @@ from collections.abc import Callable
 from typing import TextIO
 
 from appmode.board.firmware import Board
-from appmode.cli.options import Subparsers
+from appmode.board.profiles import SHEET, Profile, profile_named
+from appmode.cli.options import Subparsers, add_profile
 from appmode.protocol import app
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 from appmode.protocol.render import describe, line
@@ -30,28 +31,36 @@ END = 3.0
 
 def run_demo(
     out: TextIO,
-    drive: DriveType = DriveType.MECANUM,
+    drive: DriveType | None = DriveType.MECANUM,
     sleep: Callable[[float], None] | None = time.sleep,
+    profile: Profile = SHEET,
 ) -> int:
     """Print each command sent and each record decoded, at its time; returns records seen.
 
-    With `sleep=None` the route runs on virtual time, as fast as it can.
+    With `sleep=None` the route runs on virtual time, as fast as it can. On a profile whose
+    motors are off after power-up the route starts once they are on.
     """
-    board = Board(drive=drive)
+    board = Board(drive=drive if profile.drive_types else None, profile=profile)
+    layout = profile.a_layout
     decoder = app.BoardDecoder()
     started = time.monotonic()
-    out.write(f"SIMULATED board ({drive.cli_name} drive), scripted route of {END:.1f} s\n")
+    start = profile.dead_time + 0.2 if profile.dead_time else 0.0
+    end = start + END
+    kind = f"{drive.cli_name} drive" if drive and profile.drive_types else "no drive types"
+    if profile is not SHEET:
+        kind = f"{profile.name} profile, {kind}"
+    out.write(f"SIMULATED board ({kind}), scripted route of {end:.1f} s\n")
     records = 0
-    schedule = list(ROUTE)
+    schedule = [(round(start + t, 3), command) for t, command in ROUTE]
     now = 0.0
-    while now <= END + 1e-9:
+    while now <= end + 1e-9:
         if sleep is not None:
             sleep(max(0.0, started + now - time.monotonic()))
         for event in decoder.feed(board.poll(now)):
             records += isinstance(
                 event, app.Velocity | app.Attitude | app.ParamsRecord
             )
-            out.write(line(now, "<", event.raw, describe(event)) + "\n")
+            out.write(line(now, "<", event.raw, describe(event, layout)) + "\n")
         while schedule and schedule[0][0] <= now + 1e-9:
             _, command = schedule.pop(0)
             data = app.encode(command)
@@ -75,6 +84,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         default="mecanum",
         help="drive type of the simulated board (default: mecanum)",
     )
+    add_profile(
+        demo,
+        "the simulated board's behaviour: sheet or minibalance (the reference firmware, "
+        "docs/protocol.md §13; it has no drive types)",
+    )
     demo.add_argument(
         "--fast", action="store_true", help="run on virtual time instead of real time"
     )
@@ -82,5 +96,10 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    run_demo(sys.stdout, DriveType.from_cli_name(args.drive), None if args.fast else time.sleep)
+    run_demo(
+        sys.stdout,
+        DriveType.from_cli_name(args.drive),
+        None if args.fast else time.sleep,
+        profile_named(args.profile),
+    )
     return 0

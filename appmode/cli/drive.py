@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.cli.options import Subparsers, add_record, number_type
+from appmode.board.profiles import PROFILE_NAMES
+from appmode.cli.options import Subparsers, add_record, layout_for, number_type
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 
@@ -45,6 +46,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     drive.add_argument(
         "--latched", action="store_true", help="a direction stays until stop (key l toggles it)"
     )
+    drive.add_argument(
+        "--profile",
+        choices=PROFILE_NAMES,
+        help="the board's profile: with no URL, the simulated board's (sheet, the default, "
+        "or minibalance: the reference firmware, docs/protocol.md §13); with a URL, what "
+        "its A record holds (default: a sim:// URL's profile, else sheet)",
+    )
     add_record(drive)
     return drive
 
@@ -56,8 +64,15 @@ def run(args: argparse.Namespace) -> int:
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
+    url = args.url
+    if args.profile and url.lower().startswith("sim://") and "profile=" not in url:
+        url += f"{'&' if '?' in url else '?'}profile={args.profile}"
     session = Session(
-        args.url, driving, args.record, on_message=None if interactive else _print_message
+        url,
+        driving,
+        args.record,
+        on_message=None if interactive else _print_message,
+        layout=layout_for(url, args.profile),
     )
     return run_drive(session, interactive, sys.stdin, sys.stdout)
 

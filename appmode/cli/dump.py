@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from appmode.board.profiles import PROFILE_NAMES
 from appmode.cli.options import Subparsers
 
 
@@ -18,10 +19,17 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     fmt = dump.add_mutually_exclusive_group()
     fmt.add_argument("--json", action="store_true", help="JSON Lines")
     fmt.add_argument("--csv", action="store_true", help="CSV with a header row")
+    dump.add_argument(
+        "--profile",
+        choices=PROFILE_NAMES,
+        help="read A records as this board profile lays them out (default: the "
+        "transcript's @board profile=…, else sheet)",
+    )
     return dump
 
 
 def run(args: argparse.Namespace) -> int:
     from appmode.transcript.dump import run_dump
 
-    return run_dump(args.file, "json" if args.json else "csv" if args.csv else "text", sys.stdout)
+    fmt = "json" if args.json else "csv" if args.csv else "text"
+    return run_dump(args.file, fmt, sys.stdout, args.profile)

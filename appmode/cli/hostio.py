@@ -12,16 +12,21 @@ from appmode.host.client import Event, Host
 from appmode.host.query import QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
 from appmode.ports.sim import sim_directives
+from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import describe, line, to_json
 from appmode.protocol.transcript import Recorder
 
 
 def open_host(
-    stack: ExitStack, url: str, record: str | None, stop_on_close: bool = True
+    stack: ExitStack,
+    url: str,
+    record: str | None,
+    stop_on_close: bool = True,
+    layout: ALayout = VELOCITY,
 ) -> Host:
     """The host, then its recording: a URL that does not open leaves the file untouched.
     The recording is closed after the host, so it holds the final stop."""
-    host = Host(url, stop_on_close=stop_on_close)
+    host = Host(url, stop_on_close=stop_on_close, layout=layout)
     try:
         recorder = Recorder.create(record, 0.0, sim_directives(url)) if record else None
     except BaseException:
@@ -43,7 +48,8 @@ def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:
     if isinstance(event, (QueryDone, QueryFailed)):
         return
     if as_json:
-        out.write(json.dumps({"t": round(host.now(), 3), **to_json(event)}) + "\n")
+        body = to_json(event, host.state.layout)
+        out.write(json.dumps({"t": round(host.now(), 3), **body}) + "\n")
     else:
-        out.write(line(host.now(), "<", event.raw, describe(event)) + "\n")
+        out.write(line(host.now(), "<", event.raw, describe(event, host.state.layout)) + "\n")
     out.flush()

@@ -8,9 +8,18 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.cli.hostio import open_host, show
-from appmode.cli.options import DAY, Subparsers, add_record, add_url, number_type
+from appmode.cli.options import (
+    DAY,
+    Subparsers,
+    add_record,
+    add_record_layout,
+    add_url,
+    layout_for,
+    number_type,
+)
 from appmode.host.client import Event
 from appmode.protocol import app
+from appmode.protocol.layouts import VELOCITY, ALayout
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -23,6 +32,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_url(mon)
     mon.add_argument("--json", action="store_true", help="print JSON Lines")
+    add_record_layout(mon)
     add_limits(mon, "show and count only these")
     mon.add_argument(
         "--stop-on-exit",
@@ -65,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
         stop_on_exit=args.stop_on_exit,
         kinds=args.filter,
         out=sys.stdout,
+        layout=layout_for(args.url, args.profile),
     )
 
 
@@ -79,13 +90,14 @@ def run_monitor(
     stop_on_exit: bool = False,
     kinds: frozenset[str] | None = None,
     name: str = "monitor",
+    layout: ALayout = VELOCITY,
 ) -> int:
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none
     (`appmode record`)."""
     seen = 0
     with ExitStack() as stack:
-        host = open_host(stack, url, record, stop_on_close=stop_on_exit)
+        host = open_host(stack, url, record, stop_on_close=stop_on_exit, layout=layout)
         doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"
         print(f"{doing} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         try:

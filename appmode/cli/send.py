@@ -8,9 +8,18 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.cli.hostio import open_host, show
-from appmode.cli.options import DAY, Subparsers, add_record, add_url, number_type
+from appmode.cli.options import (
+    DAY,
+    Subparsers,
+    add_record,
+    add_record_layout,
+    add_url,
+    layout_for,
+    number_type,
+)
 from appmode.host.tokens import Wait, parse_token
 from appmode.protocol.app import HostDecoder
+from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import describe, line
 
 
@@ -36,6 +45,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--raw", action="store_true", help="send frames even if the board would reject them"
     )
     send.add_argument("--json", action="store_true", help="print JSON Lines")
+    add_record_layout(send)
     add_record(send)
     return send
 
@@ -49,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
         as_json=args.json,
         record=args.record,
         out=sys.stdout,
+        layout=layout_for(args.url, args.profile),
     )
 
 
@@ -61,11 +72,12 @@ def run_send(
     as_json: bool,
     record: str | None,
     out: TextIO,
+    layout: ALayout = VELOCITY,
 ) -> int:
     """Send the tokens in order, printing what comes back; `Z` is always sent last."""
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:
-        host = open_host(stack, url, record)
+        host = open_host(stack, url, record, layout=layout)
         for step in steps:
             if isinstance(step, Wait):
                 for event in host.events(step.seconds):

@@ -9,7 +9,7 @@ from prompt_toolkit.formatted_text import StyleAndTextTuples
 from appmode.console.session import KEYS_HELP
 from appmode.console.waves import waveform_lines
 from appmode.host.state import TRACE_SECONDS
-from appmode.protocol import params
+from appmode.protocol import app, params
 from appmode.protocol.directions import grid_for, letter_name
 
 if TYPE_CHECKING:
@@ -82,7 +82,11 @@ def status_fragments(session: Session, waveforms: bool = False) -> Fragments:
 
     state = host.state
     v, a = state.velocity, state.attitude
-    velocity = "  —" if v is None else f"x {v.x:6d}   y {v.y:6d}   z {v.z:6d}"
+    if v is None:
+        velocity = "  —"
+    else:
+        values, labels = app.record_fields(v)[1], state.layout.labels
+        velocity = "   ".join(f"{labels[i]} {values[i]:6d}" for i in state.layout.motion)
     attitude = "  —" if a is None else f"pitch {a.pitch:4d}   roll {a.roll:4d}   yaw {a.yaw:4d}"
     out += _reading(" velocity ", velocity, state.velocities.age(now))
     out += _reading(" attitude ", attitude, state.attitudes.age(now))

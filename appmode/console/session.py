@@ -24,6 +24,7 @@ from appmode.ports.sim import sim_directives
 from appmode.protocol import params
 from appmode.protocol.app import HostDecoder, Move, Noise, Stop, SwitchPage
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES, STOP_LETTER, Page, letter_name
+from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
 from appmode.protocol.transcript import Recorder
 
 SPEED_STEP = 100
@@ -101,6 +102,7 @@ class Session:
         driving: HoldToDrive | None = None,
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
+        layout: ALayout = VELOCITY,
     ) -> None:
         self.url = url
         self.simulated = is_simulated(url)
@@ -108,7 +110,7 @@ class Session:
         self.messages: deque[str] = deque(maxlen=LOG)
         self.on_message = on_message
         self.recorder: Recorder | None = None
-        self.host = Host(url, tap=self._tap)
+        self.host = Host(url, tap=self._tap, layout=layout)
         self.page = Page.DIRECTION
         self.page_letter = "J"
         self.in_force = STOP_LETTER
@@ -238,7 +240,24 @@ class Session:
         if self.host.state.query is not None:
             self.say("busy: a parameter read or set is in progress")
             return
+        if self.in_force != STOP_LETTER:
+            self._frame_while_driving()
         self.host.start_query(query)
+
+    def _frame_while_driving(self) -> None:
+        """A parameter frame is about to go out while a direction is in force: on the
+        reference firmware every frame stops the car (§13), so say so, never silently."""
+        if self.host.state.layout is SCALED:
+            self.stop()
+            self.say(
+                "stopped: on this board (minibalance) every frame stops the car, so a "
+                "parameter read or set cannot happen while driving; drive again after it"
+            )
+        else:
+            self.say(
+                f"note: reading parameters while driving ({self.in_force_text}); on boards "
+                "with the reference firmware (--profile minibalance) this stops the car"
+            )
 
     def read_params(self) -> None:
         self._query(ParamQuery(where=self.url))

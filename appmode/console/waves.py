@@ -4,18 +4,11 @@ line of block characters, scaled to its own range."""
 from __future__ import annotations
 
 from appmode.host.state import TRACE_SECONDS, HostState, Trace
+from appmode.protocol import app
 
 LEVELS = "▁▂▃▄▅▆▇█"
-SERIES: tuple[tuple[str, str, str], ...] = (
-    ("vx", "velocities", "x"),
-    ("vy", "velocities", "y"),
-    ("vz", "velocities", "z"),
-    ("pitch", "attitudes", "pitch"),
-    ("roll", "attitudes", "roll"),
-    ("yaw", "attitudes", "yaw"),
-    ("battery", "attitudes", "battery"),
-)
-"""(label, HostState trace, record field) for each line."""
+ATTITUDE: tuple[tuple[str, int], ...] = (("pitch", 0), ("roll", 1), ("yaw", 2), ("battery", 3))
+"""(label, field) of each B record line; the A record's lines follow the board's layout."""
 
 
 def sparkline(points: list[tuple[float, int]], now: float, width: int) -> str:
@@ -49,10 +42,15 @@ def sparkline(points: list[tuple[float, int]], now: float, width: int) -> str:
 
 def waveform_lines(state: HostState, now: float, width: int) -> list[str]:
     """One line per SERIES: label, waveform, and the range it spans."""
+    layout = state.layout
+    series: list[tuple[str, Trace, int]] = [
+        (f"v{layout.labels[i]}" if layout.signed else layout.labels[i], state.velocities, i)
+        for i in layout.motion
+    ]
+    series += [(label, state.attitudes, i) for label, i in ATTITUDE]
     lines = []
-    for label, trace_name, field in SERIES:
-        trace: Trace = getattr(state, trace_name)
-        points = [(t, int(getattr(event, field))) for t, event in trace.points]
+    for label, trace, field in series:
+        points = [(t, app.record_fields(event)[1][field]) for t, event in trace.points]
         values = [v for _, v in points]
         span = f"{min(values)}…{max(values)}" if values else "—"
         lines.append(f" {label:<8}{sparkline(points, now, width - 24)}  {span:>13}")

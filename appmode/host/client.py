@@ -21,6 +21,7 @@ from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.line.wire import Tap
 from appmode.ports.link import open_link
 from appmode.protocol import app, params
+from appmode.protocol.layouts import VELOCITY, ALayout
 
 RETRY = 0.5
 STEP = 0.001
@@ -43,11 +44,12 @@ class Host:
         clock: Callable[[], float] = time.monotonic,
         opener: Callable[[str], serial.SerialBase] = open_link,
         stop_on_close: bool = True,
+        layout: ALayout = VELOCITY,
     ) -> None:
         self.url = url
         self.tap = tap
         self.stop_on_close = stop_on_close
-        self.state = HostState()
+        self.state = HostState(layout)
         self._clock = clock
         self._opener = opener
         self._port: serial.SerialBase | None = opener(url)

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 from appmode.host.query import Outcome, ParamQuery, QueryFailed
 from appmode.protocol import app
+from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.render import motion_text
 
 RATE_WINDOW = 2.0
 DEGRADED_WINDOW = 5.0
@@ -103,7 +105,9 @@ class LinkStats:
 class HostState:
     """Last records seen and link counters, fed with the board's bytes."""
 
-    def __init__(self) -> None:
+    def __init__(self, layout: ALayout = VELOCITY) -> None:
+        self.layout = layout
+        """How the board's A records are laid out (§3.1, §13)."""
         self.decoder = app.BoardDecoder()
         self.stats = LinkStats()
         self.velocity: app.Velocity | None = None
@@ -146,12 +150,12 @@ class HostState:
         stopped = self.stopped_at
         if stopped is None or self._warned or now - stopped < STILL_MOVING_AFTER:
             return None
-        if max(abs(velocity.x), abs(velocity.y), abs(velocity.z)) <= STILL:
+        if self.layout.speed(app.record_fields(velocity)[1]) <= STILL:
             return None
         self._warned = True
         return BoardWarning(
             f"the car still moves {now - stopped:.1f} s after it was told to stop "
-            f"(x={velocity.x} y={velocity.y} z={velocity.z}): another program or port may "
+            f"({motion_text(velocity, self.layout)}): another program or port may "
             f"be driving it, or the board is not obeying"
         )
 

@@ -9,17 +9,22 @@ from typing import Any
 from appmode.protocol import app as p
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape
+from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, ALayout
 from appmode.protocol.params import PARAMS, value_error
 
 RECORD_FIELDS: dict[str, tuple[str, ...]] = {
-    "A": ("x", "y", "z", "extra"),
+    "A": VELOCITY.fields,
     "B": ("pitch", "roll", "yaw", "battery"),
     "C": tuple(param.name for param in PARAMS),
 }
-"""The names of each record's fields, in order."""
+"""The names of each record's fields, in order (the A record as the sheet lays it out)."""
 JSON_KEYS: tuple[str, ...] = (
     "kind",
-    *dict.fromkeys(name for names in RECORD_FIELDS.values() for name in names),
+    *dict.fromkeys(
+        name
+        for names in (*RECORD_FIELDS.values(), *(a.fields for a in A_LAYOUTS.values()))
+        for name in names
+    ),
     "letter",
     "values",
     "direction",
@@ -38,13 +43,15 @@ JSON_KEYS: tuple[str, ...] = (
 """Every key `to_json` may write, in the order a table (CSV) shows them."""
 
 
-def to_json(event: p.Event) -> dict[str, Any]:
-    """One JSON-ready object: `kind`, the integer values, and `raw` (escaped bytes)."""
+def to_json(event: p.Event, layout: ALayout = VELOCITY) -> dict[str, Any]:
+    """One JSON-ready object: `kind`, the integer values (an A record's named as `layout`
+    reads them), and `raw` (escaped bytes)."""
     body: dict[str, Any]
     if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord)):
         letter, values = p.record_fields(event)
         kind = {"A": "velocity", "B": "attitude", "C": "params"}[letter]
-        body = {"kind": kind, **dict(zip(RECORD_FIELDS[letter], values, strict=True))}
+        names = layout.fields if letter == "A" else RECORD_FIELDS[letter]
+        body = {"kind": kind, **dict(zip(names, values, strict=True))}
         if isinstance(event, p.ParamsRecord) and event.out_of_range:
             body["out_of_range"] = list(event.out_of_range)
     elif isinstance(event, p.OtherRecord):
@@ -92,10 +99,12 @@ def to_json(event: p.Event) -> dict[str, Any]:
 _JSON = json.JSONEncoder(ensure_ascii=False).encode
 
 
-def json_line(event: p.Event) -> str:
-    """`to_json(event)` as `json.dumps(…, ensure_ascii=False)` writes it. Whole A and B
-    records whose text needs no JSON escaping are formatted directly: `appmode decode`
-    spends its time here."""
+def json_line(event: p.Event, layout: ALayout = VELOCITY) -> str:
+    """`to_json(event, layout)` as `json.dumps(…, ensure_ascii=False)` writes it. Whole A
+    and B records whose text needs no JSON escaping are formatted directly: `appmode
+    decode` spends its time here."""
+    if layout is not VELOCITY and isinstance(event, p.Velocity):
+        return _JSON(to_json(event, layout))
     if isinstance(event, (p.Velocity, p.Attitude)) and event.terminated:
         raw = escape(event.raw)
         if '"' not in raw and "\\" not in raw:
@@ -111,10 +120,19 @@ def json_line(event: p.Event) -> str:
     return _JSON(to_json(event))
 
 
-def describe(event: p.Event) -> str:
-    """A short human description of an event."""
+def motion_text(record: p.Velocity, layout: ALayout = VELOCITY) -> str:
+    """An A record's fields by name, as `layout` reads them: `x=0 y=500 z=0`."""
+    values = (record.x, record.y, record.z, record.extra)
+    shown = [f"{layout.fields[i]}={values[i]}" for i in layout.motion]
+    if layout.battery is not None:
+        shown.append(f"battery={values[layout.battery]}%")
+    return " ".join(shown)
+
+
+def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
+    """A short human description of an event (an A record's fields as `layout` reads them)."""
     if isinstance(event, p.Velocity):
-        return f"velocity x={event.x} y={event.y} z={event.z}"
+        return f"velocity {motion_text(event, layout)}"
     if isinstance(event, p.Attitude):
         return (
             f"attitude pitch={event.pitch} roll={event.roll} yaw={event.yaw} "

@@ -1,0 +1,45 @@
+"""What the four fields of an A record mean (§3.1, §13): the sheet's signed velocity, or
+the reference firmware's |0.7·x|, |0.7·y| and battery. The grammar is the same; a host
+that shows or checks the fields picks a layout (`--profile`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True, slots=True)
+class ALayout:
+    """One reading of `{A<f0>:<f1>:<f2>:<f3>}$`."""
+
+    name: str
+    fields: tuple[str, str, str, str]
+    """The fields' names (JSON keys), in order."""
+    motion: tuple[int, ...]
+    """The fields that grow with the car's speed."""
+    scale: float
+    """field = scale × velocity for the motion fields."""
+    signed: bool
+    """Whether the motion fields carry a sign (else they are magnitudes)."""
+    labels: tuple[str, str, str, str]
+    """The fields' names for people."""
+    battery: int | None = None
+    """The field holding the battery percentage, if any."""
+
+    def speed(self, values: tuple[int, ...]) -> float:
+        """The largest speed the motion fields show, in the board's velocity unit."""
+        return max(abs(values[i]) for i in self.motion) / self.scale
+
+
+VELOCITY = ALayout(
+    "velocity", ("x", "y", "z", "extra"), (0, 1, 2), 1.0, True, ("x", "y", "z", "extra")
+)
+SCALED = ALayout(
+    "scaled",
+    ("abs_x", "abs_y", "battery", "extra"),
+    (0, 1),
+    0.7,
+    False,
+    ("|0.7x|", "|0.7y|", "battery", "extra"),
+    battery=2,
+)
+A_LAYOUTS: dict[str, ALayout] = {layout.name: layout for layout in (VELOCITY, SCALED)}
