@@ -9,19 +9,21 @@ from io import BytesIO
 from pathlib import Path
 from typing import Any, TextIO
 
+from appmode.board.profiles import PROFILES
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.protocol import app
+from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, describe, line, to_json
 from appmode.protocol.transcript import Transcript, read_transcript
-from appmode.transcript.matcher import Pattern, parse_pattern
+from appmode.transcript.matcher import Check, Pattern, parse_pattern
 
 CSV_FIELDS = ("t", "dir", *JSON_KEYS)
 
 
 def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event | Pattern]]:
     """(time, direction, event) for every command and record of the transcript; a `<`
-    line with `*` fields is an expectation (a Pattern), not bytes."""
+    line with `*` or `LO..HI` fields is an expectation (a Pattern), not bytes."""
     decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
         ">": app.HostDecoder(),
         "<": app.BoardDecoder(),
@@ -30,7 +32,7 @@ def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event | Pa
     for entry in transcript.entries:
         last[entry.direction] = entry.time
         pattern = parse_pattern(entry.text) if entry.direction == "<" else None
-        if pattern is not None and None in pattern.fields:
+        if pattern is not None and any(f is None or f[0] != f[1] for f in pattern.fields):
             yield entry.time, "<", pattern
             continue
         for event in decoders[entry.direction].feed(entry.data):
@@ -40,10 +42,13 @@ def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event | Pa
             yield last[direction], direction, event
 
 
-def expectation_json(pattern: Pattern) -> dict[str, Any]:
-    """An expectation as `to_json` shows records, `"*"` for a field that matches any."""
-    names = RECORD_FIELDS.get(pattern.letter, ())
-    values: list[int | str] = ["*" if v is None else v for v in pattern.fields]
+def expectation_json(pattern: Pattern, layout: ALayout = VELOCITY) -> dict[str, Any]:
+    """An expectation as `to_json` shows records, `"*"` for a field that matches any and
+    `"LO..HI"` for a range."""
+    names = layout.fields if pattern.letter == "A" else RECORD_FIELDS.get(pattern.letter, ())
+    values: list[int | str] = [
+        "*" if f is None else f[0] if f[0] == f[1] else f"{f[0]}..{f[1]}" for f in pattern.fields
+    ]
     body: dict[str, Any] = {"kind": "expectation", "letter": pattern.letter}
     if len(names) == len(values):
         body.update(zip(names, values, strict=True))
@@ -52,21 +57,24 @@ def expectation_json(pattern: Pattern) -> dict[str, Any]:
     return {**body, "raw": pattern.text}
 
 
-def run_dump(path: str, fmt: str, out: TextIO) -> int:
+def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> int:
+    """Print every event; A records named as `profile` lays them out (default: the
+    transcript's `@board profile=…`, else the sheet's)."""
     transcript = read_transcript(path)
+    layout = (PROFILES[profile] if profile else Check(transcript).needs.profile).a_layout
     if fmt == "csv":
         writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
         writer.writeheader()
     for t, direction, event in decoded(transcript):
         if isinstance(event, Pattern):
-            body = expectation_json(event)
+            body = expectation_json(event, layout)
             raw = event.text.encode()
             text = "expectation " + " ".join(
                 f"{k}={v}" for k, v in body.items() if k not in ("kind", "letter", "raw")
             )
         else:
-            body = to_json(event)
-            raw, text = event.raw, describe(event)
+            body = to_json(event, layout)
+            raw, text = event.raw, describe(event, layout)
         if fmt == "json":
             out.write(json.dumps({"t": t, "dir": direction, **body}) + "\n")
         elif fmt == "csv":

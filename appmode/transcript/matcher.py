@@ -2,14 +2,16 @@
 
 `>` lines are sent at their times. Each `<` line that is a record is an expectation, to
 be matched in file order by a record the board sends; `*` in place of a field matches
-any integer. A record matches an expectation only once every `>` line before it in the
-file has been sent, and within `tolerance` seconds of its time (default TOLERANCE). Other
-records are ignored — unless `@strict on`, when each record must match the next
-expectation. `<` lines that are not records (bytes that decoded to nothing) expect
-nothing. `@board drive=…` names the drive type the transcript needs. `@align` makes the
-next expectation match whenever it comes (after its sends, by its time + tolerance), and
-shifts the times of the expectations after it by how early or late it came: timing is
-then checked against the board's own rhythm.
+any integer, `LO..HI` any integer from LO to HI (`{A0:4..16:*:0}$`). A record matches an
+expectation only once every `>` line before it in the file has been sent, and within
+`tolerance` seconds of its time (default TOLERANCE). Other records are ignored — unless
+`@strict on`, when each record must match the next expectation. `<` lines that are not
+records (bytes that decoded to nothing) expect nothing. `@board profile=… drive=…
+start=power-up` names the board the transcript needs: its profile (default sheet), drive
+type, and whether time 0 is the board's power-up. `@align` makes the next expectation
+match whenever it comes (after its sends, by its time + tolerance), and shifts the times
+of the expectations after it by how early or late it came: timing is then checked
+against the board's own rhythm.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.errors import AppmodeError
 from appmode.protocol import app
 from appmode.protocol.escaping import escape
@@ -24,7 +27,10 @@ from appmode.protocol.params import DriveType
 from appmode.protocol.transcript import MAX_TIME, Directive, Entry, Transcript
 
 TOLERANCE = 0.5
-_PATTERN = re.compile(r"\{([A-Za-z])((?:-?\d+|\*)(?::(?:-?\d+|\*))*)?\}\$?")
+_FIELD = r"(?:-?\d+(?:\.\.-?\d+)?|\*)"
+_PATTERN = re.compile(rf"\{{([A-Za-z])({_FIELD}(?::{_FIELD})*)?\}}\$?")
+Span = tuple[int, int] | None
+"""A field of a pattern: the integers it matches, from–to, or None for any."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,7 +38,7 @@ class Pattern:
     """A record with `*` wildcards: `{A*:500:*:0}$`."""
 
     letter: str
-    fields: tuple[int | None, ...]
+    fields: tuple[Span, ...]
     text: str
 
     def matches(self, record: app.Record) -> bool:
@@ -40,7 +46,9 @@ class Pattern:
         return (
             letter == self.letter
             and len(values) == len(self.fields)
-            and all(f is None or f == v for f, v in zip(self.fields, values, strict=True))
+            and all(
+                f is None or f[0] <= v <= f[1] for f, v in zip(self.fields, values, strict=True)
+            )
         )
 
 
@@ -50,8 +58,15 @@ def parse_pattern(text: str) -> Pattern | None:
     if match is None:
         return None
     body = match.group(2) or ""
-    fields = tuple(None if f == "*" else int(f) for f in body.split(":")) if body else ()
+    fields = tuple(_span(f) for f in body.split(":")) if body else ()
     return Pattern(match.group(1), fields, text)
+
+
+def _span(text: str) -> Span:
+    if text == "*":
+        return None
+    low, _, high = text.partition("..")
+    return (int(low), int(high or low))
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,7 +83,10 @@ class Expectation:
 
 @dataclass(frozen=True, slots=True)
 class BoardNeeds:
+    profile: Profile = SHEET
     drive: DriveType | None = None
+    power_up: bool = False
+    """Time 0 is the board's power-up: only a board started for the run can pass it."""
 
 
 @dataclass
@@ -121,19 +139,11 @@ class Check:
                 raise AppmodeError(f"{where}: @strict takes on or off")
             strict = item.args[0] == "on"
         else:
-            drive = None
-            for arg in item.args:
-                key, _, value = arg.partition("=")
-                if key != "drive":
-                    raise AppmodeError(f"{where}: @board knows drive=…, not {arg!r}")
-                try:
-                    drive = DriveType.from_cli_name(value)
-                except ValueError as exc:
-                    raise AppmodeError(f"{where}: @board {exc}") from None
-            self.needs = BoardNeeds(drive)
+            self.needs = _board_needs(item.args, where)
         return tolerance, strict
 
     # ------------------------------------------------------------ driving it
+
 
     @property
     def done(self) -> bool:
@@ -217,3 +227,25 @@ class Check:
             f"{self.transcript.path}:{exp.entry.lineno}: expected {exp.pattern.text} at "
             f"{self._time(exp):.3f} s (±{exp.tolerance:g} s); {what}"
         )
+
+
+def _board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:
+    """`@board profile=minibalance drive=omni start=power-up` (each part optional)."""
+    found: dict[str, str] = {}
+    for arg in args:
+        key, _, value = arg.partition("=")
+        if key not in ("profile", "drive", "start") or key in found:
+            raise AppmodeError(
+                f"{where}: @board takes profile=…, drive=… and start=power-up, once each, "
+                f"not {arg!r}"
+            )
+        found[key] = value
+    try:
+        profile = profile_named(found.get("profile", "sheet"))
+        drive = DriveType.from_cli_name(found["drive"]) if "drive" in found else None
+        profile.check(drive=drive is not None, flash=False)
+    except (AppmodeError, ValueError) as exc:
+        raise AppmodeError(f"{where}: @board {exc}") from None
+    if found.get("start", "power-up") != "power-up":
+        raise AppmodeError(f"{where}: @board start= takes power-up, not {found['start']!r}")
+    return BoardNeeds(profile, drive, "start" in found)

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TextIO
 
 from appmode.board.firmware import Board
+from appmode.board.profiles import Profile, profile_named
 from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
@@ -34,13 +35,16 @@ class Result:
     """Transcript time covered (virtual or real)."""
     wall: float
     failure: str | None = None
+    skipped: str | None = None
+    """Why the transcript was not run against this board."""
 
 
 def run_virtual(transcript: Transcript) -> Result:
     """Run against a fresh embedded board on virtual time: no sleeping."""
     started = time.perf_counter()
     check = Check(transcript)
-    wire = Wire(Board(MemoryStore(), drive=check.needs.drive), 9600)
+    needs = check.needs
+    wire = Wire(Board(MemoryStore(), drive=needs.drive, profile=needs.profile), 9600)
     decoder = app.BoardDecoder()
     now = 0.0
     while not check.done and now <= check.end:
@@ -147,6 +151,7 @@ def write_junit(path: str, results: list[Result]) -> None:
         name="appmode conform",
         tests=str(len(results)),
         failures=str(sum(not r.passed for r in results)),
+        skipped=str(sum(r.skipped is not None for r in results)),
         time=f"{sum(r.wall for r in results):.3f}",
     )
     for result in results:
@@ -160,13 +165,17 @@ def write_junit(path: str, results: list[Result]) -> None:
         if result.failure is not None:
             failure = ET.SubElement(case, "failure", message=result.failure.splitlines()[0])
             failure.text = result.failure
+        elif result.skipped is not None:
+            ET.SubElement(case, "skipped", message=result.skipped)
     data = BytesIO()
     ET.ElementTree(suite).write(data, encoding="utf-8", xml_declaration=True)
     write_whole(path, data.getvalue(), "JUnit report")
 
 
-def run_conform(paths: list[str], board: str | None, junit: str | None, out: TextIO) -> int:
-    """Run every transcript; one line each; exit status 1 on any failure."""
+def run_conform(
+    paths: list[str], board: str | None, junit: str | None, out: TextIO, profile: str = "sheet"
+) -> int:
+    """Run every transcript for `profile`; one line each; exit status 1 on any failure."""
     if junit:
         check_writable(junit, "JUnit report")
     if paths:
@@ -180,6 +189,7 @@ def run_conform(paths: list[str], board: str | None, junit: str | None, out: Tex
     for transcript in transcripts:
         if not transcript.entries:
             raise AppmodeError(f"{transcript.path} has no '>' or '<' lines: nothing to check")
+    transcripts = _for_profile(transcripts, profile_named(profile), out)
     interactive = sys.stderr.isatty()
 
     def progress(text: str) -> None:
@@ -195,8 +205,11 @@ def run_conform(paths: list[str], board: str | None, junit: str | None, out: Tex
         if board is not None and found is not None:
             out.write(restore_params(board, found) + "\n")
     failed = sum(not r.passed for r in results)
-    target = "the embedded simulated board" if board is None else board
-    out.write(f"{len(results) - failed} passed, {failed} failed against {target}\n")
+    skipped = sum(r.skipped is not None for r in results)
+    target = f"the embedded simulated board ({profile} profile)" if board is None else board
+    counts = f"{len(results) - failed - skipped} passed, {failed} failed"
+    counts += f", {skipped} skipped" if skipped else ""
+    out.write(f"{counts} against {target}\n")
     if junit:
         write_junit(junit, results)
     return 1 if failed else 0
@@ -211,22 +224,46 @@ def _run_all(
     out: TextIO,
 ) -> None:
     for transcript in transcripts:
+        needs = Check(transcript).needs
         if board is None:
             result = run_virtual(transcript)
+        elif needs.power_up and not is_simulated(board):
+            why = "starts at the board's power-up: run it on virtual time (no --board)"
+            result = Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
         else:
             result = run_live(transcript, board, progress)
             if interactive:
                 print("\r\033[K", end="", file=sys.stderr, flush=True)
         results.append(result)
-        verdict = "PASS" if result.passed else "FAIL"
+        verdict = "SKIP" if result.skipped else "PASS" if result.passed else "FAIL"
         if board is None:
             timing = f"{result.seconds:.2f} s of virtual time in {result.wall:.3f} s"
         else:
             timing = f"{result.wall:.2f} s"
-        out.write(f"{verdict}  {result.path}  ({timing})\n")
+        if result.skipped is not None:
+            out.write(f"{verdict}  {result.path}  ({result.skipped})\n")
+        else:
+            out.write(f"{verdict}  {result.path}  ({timing})\n")
         if result.failure is not None:
             out.write(f"      {result.failure}\n")
         out.flush()
+
+
+def _for_profile(
+    transcripts: list[Transcript], profile: Profile, out: TextIO
+) -> list[Transcript]:
+    """The transcripts written for `profile` (`@board profile=…`, default sheet); says how
+    many others there were."""
+    chosen = [t for t in transcripts if Check(t).needs.profile is profile]
+    others = len(transcripts) - len(chosen)
+    if others:
+        out.write(
+            f"{len(chosen)} transcript(s) for the {profile.name} profile; {others} for other "
+            "profiles not run (--profile NAME runs those)\n"
+        )
+    if not chosen:
+        raise AppmodeError(f"none of these transcripts is for the {profile.name} profile")
+    return chosen
 
 
 def _read_params(url: str) -> tuple[int, ...]:

@@ -98,7 +98,9 @@ def test_align_times_the_rest_from_the_first_match() -> None:
     [
         ("@tolerance soon", "@tolerance takes seconds"),
         ("@strict maybe", "@strict takes on"),
-        ("@board wheels=3", "@board knows drive="),
+        ("@board wheels=3", "@board takes profile=…, drive=…"),
+        ("@board profile=tiny", "unknown board profile 'tiny'"),
+        ("@board profile=minibalance drive=omni", "has no drive types"),
         ("@board drive=tank", "unknown drive type"),
     ],
 )
