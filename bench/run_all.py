@@ -31,6 +31,7 @@ import decode_command
 import decoder
 import link_pacing
 import link_roundtrip
+import minibalance
 import replay_timing
 import serial
 from common import board, percentile
@@ -466,6 +467,7 @@ def main() -> None:
         ),
         ("replay", lambda: bench_replay(1000 if quick else 10_000)),
         ("conform timing", lambda: bench_conform_timing(200 if quick else 600)),
+        ("minibalance", lambda: minibalance.rows(30 if quick else 100)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

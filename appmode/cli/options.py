@@ -10,9 +10,9 @@ from typing import TypeAlias
 
 from serial import SerialException
 
-from appmode.board.profiles import PROFILE_NAMES, PROFILES
+from appmode.board.profiles import PROFILE_NAMES, PROFILES, SHEET, Profile
 from appmode.ports.sim import parse_sim_url
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import ALayout
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
@@ -51,13 +51,17 @@ def add_record_layout(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def layout_for(url: str | None, name: str | None) -> ALayout:
-    """The A record layout of `--profile NAME`, else of a sim:// URL's profile, else the
-    sheet's."""
+def profile_for(url: str | None, name: str | None) -> Profile:
+    """The profile `--profile NAME` names, else a sim:// URL's, else the sheet."""
     if name is None and url is not None and url.lower().startswith("sim://"):
         with contextlib.suppress(SerialException):
             name = parse_sim_url(url).get("profile")
-    return PROFILES[name].a_layout if name in PROFILES else VELOCITY
+    return PROFILES.get(name or "sheet", SHEET)
+
+
+def layout_for(url: str | None, name: str | None) -> ALayout:
+    """The A record layout of `profile_for(url, name)`."""
+    return profile_for(url, name).a_layout
 
 
 Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"

@@ -8,8 +8,9 @@ import sys
 from contextlib import ExitStack
 from typing import TextIO
 
+from appmode.board.profiles import PROFILE_NAMES, SHEET, Profile
 from appmode.cli.hostio import open_host
-from appmode.cli.options import Subparsers, add_record, add_url
+from appmode.cli.options import Subparsers, add_record, add_url, profile_for
 from appmode.errors import AppmodeError
 from appmode.host import saves
 from appmode.protocol import params
@@ -46,6 +47,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="after the board restarted: check it holds what --save saved (exit 1 if not)",
     )
     prm.add_argument("--json", action="store_true", help="print one JSON object")
+    prm.add_argument(
+        "--profile",
+        choices=PROFILE_NAMES,
+        help="the board's profile, for the defaults shown: sheet or minibalance (the "
+        "reference firmware, docs/protocol.md §13) (default: a sim:// URL's, else sheet)",
+    )
     add_record(prm)
     return prm
 
@@ -59,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
         as_json=args.json,
         record=args.record,
         out=sys.stdout,
+        profile=profile_for(args.url, args.profile),
     )
 
 
@@ -86,6 +94,7 @@ def run_params(
     record: str | None,
     out: TextIO,
     verify: bool = False,
+    profile: Profile = SHEET,
 ) -> int:
     """Read the parameters; set each (verified by reading back), save, and print them;
     or check them against what was saved (`verify`)."""
@@ -97,7 +106,7 @@ def run_params(
             f"'appmode params {url} --save' (in {saves.path()})"
         )
     with ExitStack() as stack:
-        host = open_host(stack, url, record)
+        host = open_host(stack, url, record, layout=profile.a_layout)
         values = host.read_params()
         for index, value in changes:
             values = host.set_param(index, value)
@@ -119,7 +128,7 @@ def run_params(
             json.dumps({p.name: v for p, v in zip(params.PARAMS, values, strict=True)}) + "\n"
         )
     else:
-        out.write(params_table(values) + "\n")
+        out.write(params_table(values, profile.defaults) + "\n")
     for index, value in enumerate(values):
         error = params.value_error(index, value)
         if error is not None:  # a board may hold it: say so, and how to repair it

@@ -10,7 +10,7 @@ from appmode.protocol import app as p
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, ALayout
-from appmode.protocol.params import PARAMS, value_error
+from appmode.protocol.params import DEFAULTS, PARAMS, value_error
 
 RECORD_FIELDS: dict[str, tuple[str, ...]] = {
     "A": VELOCITY.fields,
@@ -188,14 +188,14 @@ def line(time: float, direction: str, raw: bytes, text: str) -> str:
     return f"{time:7.3f} {direction} {escape(raw):<34} {text}"
 
 
-def params_table(values: tuple[int, ...]) -> str:
-    """The nine parameters as an aligned table with their ranges and defaults; a value
-    outside its range (a real board may hold one) is flagged."""
+def params_table(values: tuple[int, ...], defaults: tuple[int, ...] = DEFAULTS) -> str:
+    """The nine parameters as an aligned table with their ranges and the board's defaults;
+    a value outside its range (a real board may hold one) is flagged."""
     rows = [f"{'n':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
-    for param, value in zip(PARAMS, values, strict=True):
+    for param, value, default in zip(PARAMS, values, defaults, strict=True):
         flag = "" if value_error(param.index, value) is None else "  out of range"
         rows.append(
             f"{param.index:>2}  {param.name:<18} {value:>10}  "
-            f"{param.range_text:<14} {param.default:>7}{flag}"
+            f"{param.range_text:<14} {default:>7}{flag}"
         )
     return "\n".join(rows)
