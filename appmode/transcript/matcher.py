@@ -116,6 +116,11 @@ class Check:
                 self.sends.append(item)
                 last_send = max(last_send, item.time)
             elif (pattern := parse_pattern(item.text)) is not None:
+                if any(f is not None and f[0] > f[1] for f in pattern.fields):
+                    raise AppmodeError(
+                        f"{self.transcript.path}:{item.lineno}: {item.text}: a field LO..HI "
+                        "needs LO <= HI"
+                    )
                 self.expectations.append(
                     Expectation(item, pattern, tolerance, strict, last_send, align)
                 )

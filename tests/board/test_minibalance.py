@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import pytest
 
@@ -22,7 +23,9 @@ def board(**kwargs: object) -> Board:
     return Board(profile=MINIBALANCE, **kwargs)  # type: ignore[arg-type]
 
 
-def records(b: Board, start: float, end: float, step: float = 0.001) -> list[tuple[float, app.Record]]:
+def records(
+    b: Board, start: float, end: float, step: float = 0.001
+) -> list[tuple[float, app.Record]]:
     """Each record with the time the board sent it (to the ms)."""
     out = []
     decoder = app.BoardDecoder()
@@ -191,7 +194,7 @@ def test_s13_telemetry_periods_and_b_first() -> None:
     assert isinstance(first, app.Attitude), "B first"
     text = b"".join(line.encode() + b"\r\n" for line in MPU_LINES)
     assert first_time == pytest.approx(0.005 * -(-len(text) * 1.04 // 5) + 0.045)
-    gaps = {round(b2 - a2, 3) for (a2, _), (b2, _) in zip(timeline, timeline[1:])}
+    gaps = {round(b2 - a2, 3) for (a2, _), (b2, _) in itertools.pairwise(timeline)}
     assert gaps == {0.06}, "records up to 14 bytes: 60 ms"
     b.receive(b"{Q:P}", 2.0)
     timeline = records(b, 2.0, 2.5)
@@ -200,7 +203,7 @@ def test_s13_telemetry_periods_and_b_first() -> None:
     assert round(after - c_at, 3) == 0.08, "a pass with a C record: 80 ms"
     b.vehicle.heading = 181.0  # {B0:0:-179:100}$, 16 bytes: 65 ms
     timeline = records(b, 2.5, 3.0)
-    lengths = {len(r.raw): round(t2 - t1, 3) for (t1, r), (t2, _) in zip(timeline, timeline[1:])}
+    lengths = {len(r.raw): round(t2 - t1, 3) for (t1, r), (t2, _) in itertools.pairwise(timeline)}
     assert lengths.get(16) == 0.065
 
 

@@ -93,6 +93,19 @@ def test_align_times_the_rest_from_the_first_match() -> None:
     assert virtual(text)[0]
 
 
+def test_a_reversed_range_is_an_error(tmp_path: Path) -> None:
+    path = tmp_path / "r.transcript"
+    path.write_text("# appmode transcript v1\n0.1 > Z\n0.2 < {A0:9..1:*:0}$\n")
+    done = run("conform", str(path))
+    assert done.returncode == 2 and f"{path}:3: " in done.stderr and "LO <= HI" in done.stderr
+
+
+def test_ranges_match_from_low_to_high() -> None:
+    assert virtual("@tolerance 0.3\n0.5 > {0:600}JA\n1.5 < {A0:590..610:0:0}$\n") == (True, None)
+    ok, failure = virtual("@tolerance 0.3\n0.5 > {0:600}JA\n1.5 < {A0:400..500:0:0}$\n")
+    assert not ok and failure is not None and "400..500" in failure
+
+
 @pytest.mark.parametrize(
     ("directive", "message"),
     [
