@@ -249,15 +249,9 @@ class Session:
         reference firmware every frame stops the car (§13), so say so, never silently."""
         if self.host.state.layout is SCALED:
             self.stop()
-            self.say(
-                "stopped: on this board (minibalance) every frame stops the car, so a "
-                "parameter read or set cannot happen while driving; drive again after it"
-            )
+            self.say("stopped: a minibalance car stops at every frame; drive again after it")
         else:
-            self.say(
-                f"note: reading parameters while driving ({self.in_force_text}); on boards "
-                "with the reference firmware (--profile minibalance) this stops the car"
-            )
+            self.say("note: on a minibalance car (--profile) this frame would stop it")
 
     def read_params(self) -> None:
         self._query(ParamQuery(where=self.url))

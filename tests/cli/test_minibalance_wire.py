@@ -86,6 +86,13 @@ def test_s13_reading_params_while_driving_stops_first_and_says_so(board: BoardPr
     done = run("drive", board.url, "--profile", "minibalance", stdin=script)
     assert done.returncode == 0, done.stderr
     out = done.stdout
-    assert "stopped: on this board (minibalance) every frame stops the car" in out
+    assert "stopped: a minibalance car stops at every frame; drive again after it" in out
     assert "in force  Z stop" in out
     assert "|0.7x|" in out and "|0.7y|" in out
+
+
+def test_reading_params_while_driving_a_sheet_board_says_what_a_real_car_would_do() -> None:
+    done = run("drive", stdin=b"drive A\nwait 0.3\nparams\nwait 0.3\nstatus\nquit\n")
+    assert done.returncode == 0, done.stderr
+    assert "note: on a minibalance car (--profile) this frame would stop it" in done.stdout
+    assert "in force  A forward" in done.stdout, "the sheet board keeps driving"
