@@ -105,6 +105,9 @@ def command_labels(commands: list[tuple[float, str]], gap: float) -> list[tuple[
     return labels
 
 
+VELOCITY_LABELS = ("x (lateral, right +)", "y (forward +)", "z (rotation, cw +)", "extra")
+
+
 def run_plot(path: str, output: str) -> int:
     """Velocities, attitude and battery over time, with the commands marked."""
     check_writable(output, "plot")
@@ -120,15 +123,18 @@ def run_plot(path: str, output: str) -> int:
             "appmode, pip install '.[plot]')"
         ) from None
     transcript = read_transcript(path)
+    layout = Check(transcript).needs.profile.a_layout
+    motion: dict[int, list[int]] = {i: [] for i in layout.motion}
     series: dict[str, list[Any]] = {
-        k: [] for k in ("tA", "x", "y", "z", "tB", "pitch", "roll", "yaw", "battery")
+        k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")
     }
     commands: list[tuple[float, str]] = []
     for t, direction, event in decoded(transcript):
         if isinstance(event, app.Velocity):
             series["tA"].append(t)
-            for k in ("x", "y", "z"):
-                series[k].append(getattr(event, k))
+            values = app.record_fields(event)[1]
+            for i, column in motion.items():
+                column.append(values[i])
         elif isinstance(event, app.Attitude):
             series["tB"].append(t)
             for k in ("pitch", "roll", "yaw", "battery"):
@@ -139,13 +145,12 @@ def run_plot(path: str, output: str) -> int:
         raise AppmodeError(f"{path} has no A or B records to plot")
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(11, 8), constrained_layout=True)
     vel, att, bat = axes
-    for k, label in (
-        ("x", "x (lateral, right +)"),
-        ("y", "y (forward +)"),
-        ("z", "z (rotation, cw +)"),
-    ):
-        vel.plot(series["tA"], series[k], label=label, drawstyle="steps-post")
-    vel.set_ylabel("velocity (board unit)")
+    names = VELOCITY_LABELS if layout is VELOCITY else layout.labels
+    for i, column in motion.items():
+        vel.plot(series["tA"], column, label=names[i], drawstyle="steps-post")
+    vel.set_ylabel(
+        "velocity (board unit)" if layout.signed else f"|{layout.scale:g}·v| (wraps at 256)"
+    )
     for k in ("pitch", "roll", "yaw"):
         att.plot(series["tB"], series[k], label=k, drawstyle="steps-post")
     att.set_ylabel("degrees")

@@ -193,6 +193,19 @@ def test_plot_writes_a_png(tmp_path: Path) -> None:
     assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and image.stat().st_size > 20_000
 
 
+def test_plot_and_dump_read_a_minibalance_transcript_by_its_profile(tmp_path: Path) -> None:
+    record = tmp_path / "mb.transcript"
+    done = run("send", "sim://?profile=minibalance", "--record", str(record), "wait:1.1", "J", "A")
+    assert done.returncode == 0, done.stderr
+    assert "@board profile=minibalance" in record.read_text()
+    dumped = run("dump", str(record), "--json")
+    rows = [json.loads(line) for line in dumped.stdout.splitlines()]
+    assert any(r.get("kind") == "velocity" and "abs_y" in r for r in rows)
+    image = tmp_path / "mb.png"
+    assert run("plot", str(record), "-o", str(image)).returncode == 0
+    assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_plot_without_records_is_a_clear_error(tmp_path: Path) -> None:
     path = tmp_path / "empty.transcript"
     path.write_text("0.0 > J\n")
