@@ -95,10 +95,6 @@ class FirmwareIntake:
         self._frame: bytearray | None = None
         self._length = 0  # bytes of the open frame, including any not kept
 
-    @property
-    def in_frame(self) -> bool:
-        return self._frame is not None
-
     def feed(self, data: bytes) -> list[Steer | Frame]:
         out: list[Steer | Frame] = []
         loose, framed = _STEER

@@ -22,7 +22,6 @@ class Profile:
     """One board's behaviour, switch by switch (the §13 table, row by row)."""
 
     name: str
-    summary: str
     # -- bytes in (§2)
     firmware_frames: bool
     """Frames as the reference loop reads them (§13): Q frames by position 3, set values
@@ -82,9 +81,6 @@ class Profile:
     startup_text: bytes
     """What the APP port carries at power-up, before the first record."""
 
-    def describe(self) -> str:
-        return f"{self.name} profile ({self.summary})"
-
     def check(self, drive: bool, flash: bool) -> None:
         """AppmodeError when a board of this profile is asked for what it does not have."""
         if drive and not self.drive_types:
@@ -115,7 +111,6 @@ MPU_LINES = (
 
 SHEET = Profile(
     name="sheet",
-    summary="the vendor's sheet, docs/protocol.md §1–§12",
     firmware_frames=False,
     steer_in_frames=False,
     frame_restarts=True,
@@ -146,7 +141,6 @@ SHEET = Profile(
 
 MINIBALANCE = Profile(
     name="minibalance",
-    summary="the reference firmware as measured, docs/protocol.md §13",
     firmware_frames=True,
     steer_in_frames=True,
     frame_restarts=False,
