@@ -91,11 +91,11 @@ def run_send(
                 show(host, event, out, as_json)
         for event in host.events(listen):
             show(host, event, out, as_json)
+        stop_text = host.state.end.stop_text  # what the stop below will do
         stop = host.close()
         if stop is None:
             print("appmode: the link is down: the final Z was not sent", file=sys.stderr)
             return 1
         if not as_json:
-            text = "stop" if stop == b"Z" else "closes the open frame, then stop"
-            out.write(line(host.now(), ">", stop, text) + "\n")
+            out.write(line(host.now(), ">", stop, stop_text) + "\n")
     return 0

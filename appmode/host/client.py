@@ -202,7 +202,8 @@ class Host:
     # ------------------------------------------------------------ end
 
     def close(self) -> bytes | None:
-        """Stop the car (`Z` is the last byte sent, after `{}` if a frame is open), then
+        """Stop the car (`Z` is the last byte sent, after `{}` if a frame is open and `K`
+        and the page letter if a button-page rotation may go on: SessionEnd), then
         close the port. Returns the bytes of that stop, or None if the link was down.
         A passive host (`stop_on_close=False`, a monitor) sends nothing."""
         if self._port is None:

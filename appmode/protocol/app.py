@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass, field
 
 from appmode.protocol import params
-from appmode.protocol.directions import LETTERS, PAGE_LETTERS
+from appmode.protocol.directions import BUTTON_PAGE, LETTERS, PAGE_LETTERS
 
 LBRACE, RBRACE, DOLLAR, COLON = 0x7B, 0x7D, 0x24, 0x3A
 MAX_FRAME = 50
@@ -409,20 +409,49 @@ an empty frame, which changes nothing."""
 class SessionEnd:
     """Follows what a host sends, so that its last bytes stop the car (§2.1).
 
-    A `Z` sent while a frame is open is swallowed by the frame: then `{}` goes first.
+    A `Z` sent while a frame is open is swallowed by the frame: then `{}` goes first. A
+    rotation begun on the button page and left by `I`/`J` goes on after `Z` on the
+    reference firmware (§13): then `K` ends it, and the page letter goes back, first.
     """
 
     def __init__(self) -> None:
         self._decoder = HostDecoder()
+        self._page = "J"  # the page letter last sent (the board boots on the direction page)
+        self._turning = False  # a button-page rotation that a direction-page Z leaves on
 
     def sent(self, data: bytes) -> list[HostEvent]:
         """Follow `data`; returns what it decodes to."""
-        return self._decoder.feed(data)
+        events = self._decoder.feed(data)
+        for event in events:
+            if isinstance(event, SwitchPage):
+                self._turning = self._turning and event.letter != "K"
+                self._page = event.letter
+            elif self._page == "K" and isinstance(event, (Move, Stop, Noise)):
+                self._turning = isinstance(event, Move) and _rotates(event)
+            elif isinstance(event, Move):
+                self._turning = False
+        return events
 
     @property
     def stop(self) -> bytes:
         """The bytes that end the session with the car stopped."""
-        return (ABANDON_FRAME if self._decoder.in_frame else b"") + encode(Stop())
+        frame = ABANDON_FRAME if self._decoder.in_frame else b""
+        rotation = f"K{self._page}".encode() if self._turning and self._page != "K" else b""
+        return frame + rotation + encode(Stop())
+
+    @property
+    def stop_text(self) -> str:
+        """What `stop` does, for people."""
+        steps = ["closes the open frame"] if self._decoder.in_frame else []
+        if self._turning and self._page != "K":
+            steps.append(f"ends a button-page rotation (K), back to {self._page}")
+        return ", ".join([*steps, "then stop"]) if steps else "stop"
+
+
+def _rotates(move: Move) -> bool:
+    """A button-page letter that rotates the car on the spot (C, G)."""
+    motion = BUTTON_PAGE.get(move.letter)
+    return not move.numeric and motion is not None and motion.holonomic[:2] == (0, 0)
 
 
 def _overlong(length: int, done: bool = False) -> str:

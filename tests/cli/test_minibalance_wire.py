@@ -4,6 +4,7 @@ commands, in real time: what docs/protocol.md §13 says a host meets on a real b
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -96,3 +97,30 @@ def test_reading_params_while_driving_a_sheet_board_says_what_a_real_car_would_d
     assert done.returncode == 0, done.stderr
     assert "note: on a minibalance car (--profile) this frame would stop it" in done.stdout
     assert "in force  A forward" in done.stdout, "the sheet board keeps driving"
+
+
+def test_s13_a_session_left_on_the_direction_page_mid_rotation_stops_the_car(
+    tmp_path: Path,
+) -> None:
+    """A button-page rotation goes on after J and Z (§13): the session's end must end it,
+    judged by the board's own B records (the yaw stops changing)."""
+    log_file = tmp_path / "board.transcript"
+    served = BoardProcess("--pty", "--profile", "minibalance", "--quiet", "--record", str(log_file))
+    try:
+        script = b"page button\ndrive C\nwait 1\npage joystick\nwait 0.2\nquit\n"
+        done = run("drive", served.url, "--profile", "minibalance", stdin=script)
+        assert done.returncode == 0, done.stderr
+        time.sleep(2.6)
+    finally:
+        served.stop()
+    entries = read_transcript(log_file).entries
+    sent = [e for e in entries if e.direction == ">"]
+    assert sent[-1].text == "Z" and [e.text for e in sent[-3:-1]] == ["K", "J"], sent[-4:]
+    end = sent[-1].time
+    yaws = [
+        (e.time, int(e.text[2:-2].split(":")[2]))
+        for e in entries
+        if e.direction == "<" and e.text.startswith("{B")
+    ]
+    settled = [yaw for t, yaw in yaws if t > end + 1.2]
+    assert len(settled) >= 5 and len(set(settled)) == 1, yaws[-12:]
