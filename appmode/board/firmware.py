@@ -295,16 +295,11 @@ class Board:
         elif isinstance(event, app.SetParam):
             self.params[event.index] = event.value
             self._note(now, "applied", f"{shown}: {event.name} = {event.value}")
-        elif isinstance(event, app.ReadParams):
-            if event.warning is not None:
-                self.warnings += 1
-                self._note(now, "warning", f"{shown}: {event.warning}")
-            self._read(now, shown)
         else:
             if event.warning is not None:
                 self.warnings += 1
                 self._note(now, "warning", f"{shown}: {event.warning}")
-            self._save(now, shown)
+            (self._read if isinstance(event, app.ReadParams) else self._save)(now, shown)
 
     def _apply_frame(self, frame: Frame, now: float) -> None:
         shown = escape(frame.raw)

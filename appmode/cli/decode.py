@@ -7,7 +7,7 @@ import sys
 from collections.abc import Iterable, Iterator
 from typing import BinaryIO, TextIO
 
-from appmode.cli.options import Subparsers, add_record_layout, layout_for
+from appmode.cli.options import Subparsers, add_profile, layout_for
 from appmode.errors import AppmodeError
 from appmode.protocol import app
 from appmode.protocol.layouts import VELOCITY, ALayout
@@ -71,7 +71,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         default="board",
         help="who sent the bytes (default: board, i.e. board→host records)",
     )
-    add_record_layout(decode)
+    add_profile(decode, default=None, unset="sheet")
     return decode
 
 

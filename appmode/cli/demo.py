@@ -57,9 +57,7 @@ def run_demo(
         if sleep is not None:
             sleep(max(0.0, started + now - time.monotonic()))
         for event in decoder.feed(board.poll(now)):
-            records += isinstance(
-                event, app.Velocity | app.Attitude | app.ParamsRecord
-            )
+            records += isinstance(event, app.Velocity | app.Attitude | app.ParamsRecord)
             out.write(line(now, "<", event.raw, describe(event, layout)) + "\n")
         while schedule and schedule[0][0] <= now + 1e-9:
             _, command = schedule.pop(0)

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.board.profiles import PROFILE_NAMES
-from appmode.cli.options import Subparsers, add_record, layout_for, number_type
+from appmode.cli.options import Subparsers, add_profile, add_record, layout_for, number_type
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 
@@ -46,12 +45,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     drive.add_argument(
         "--latched", action="store_true", help="a direction stays until stop (key l toggles it)"
     )
-    drive.add_argument(
-        "--profile",
-        choices=PROFILE_NAMES,
-        help="the board's profile: with no URL, the simulated board's (sheet, the default, "
-        "or minibalance: the reference firmware, docs/protocol.md §13); with a URL, what "
-        "its A record holds (default: a sim:// URL's profile, else sheet)",
+    add_profile(
+        drive,
+        "the board's profile: with no URL, the simulated board's (sheet or minibalance: the "
+        "reference firmware, docs/protocol.md §13); with a URL, what its A record holds",
+        default=None,
     )
     add_record(drive)
     return drive

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.board.profiles import PROFILE_NAMES
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, add_profile
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -19,12 +18,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     fmt = dump.add_mutually_exclusive_group()
     fmt.add_argument("--json", action="store_true", help="JSON Lines")
     fmt.add_argument("--csv", action="store_true", help="CSV with a header row")
-    dump.add_argument(
-        "--profile",
-        choices=PROFILE_NAMES,
-        help="read A records as this board profile lays them out (default: the "
-        "transcript's @board profile=…, else sheet)",
-    )
+    add_profile(dump, default=None, unset="the transcript's @board profile=…, else sheet")
     return dump
 
 

@@ -11,8 +11,8 @@ from appmode.cli.hostio import open_host, show
 from appmode.cli.options import (
     DAY,
     Subparsers,
+    add_profile,
     add_record,
-    add_record_layout,
     add_url,
     layout_for,
     number_type,
@@ -32,7 +32,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_url(mon)
     mon.add_argument("--json", action="store_true", help="print JSON Lines")
-    add_record_layout(mon)
+    add_profile(mon, default=None)
     add_limits(mon, "show and count only these")
     mon.add_argument(
         "--stop-on-exit",

@@ -34,20 +34,26 @@ def add_record(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_profile(parser: argparse.ArgumentParser, what: str) -> None:
-    parser.add_argument(
-        "--profile", choices=PROFILE_NAMES, default="sheet", help=f"{what} (default: sheet)"
-    )
+A_RECORD = (
+    "the board's profile, for what its A record holds: sheet (x, y, z) or minibalance "
+    "(|0.7x|, |0.7y|, battery; docs/protocol.md §13)"
+)
+FROM_URL = "a sim:// URL's profile, else sheet"
 
 
-def add_record_layout(parser: argparse.ArgumentParser) -> None:
-    """`--profile` on a command that shows records: it names the A record's fields."""
+def add_profile(
+    parser: argparse.ArgumentParser,
+    what: str = A_RECORD,
+    default: str | None = "sheet",
+    unset: str = FROM_URL,
+) -> None:
+    """`--profile NAME`; with `default` None it is None when not given (`unset` says what
+    then applies)."""
     parser.add_argument(
         "--profile",
         choices=PROFILE_NAMES,
-        help="the board's profile, for what its A record holds: sheet (x, y, z) or "
-        "minibalance (|0.7x|, |0.7y|, battery; docs/protocol.md §13) (default: a sim:// "
-        "URL's profile, else sheet)",
+        default=default,
+        help=f"{what} (default: {default or unset})",
     )
 
 

@@ -8,9 +8,9 @@ import sys
 from contextlib import ExitStack
 from typing import TextIO
 
-from appmode.board.profiles import PROFILE_NAMES, SHEET, Profile
+from appmode.board.profiles import SHEET, Profile
 from appmode.cli.hostio import open_host
-from appmode.cli.options import Subparsers, add_record, add_url, profile_for
+from appmode.cli.options import Subparsers, add_profile, add_record, add_url, profile_for
 from appmode.errors import AppmodeError
 from appmode.host import saves
 from appmode.protocol import params
@@ -47,11 +47,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="after the board restarted: check it holds what --save saved (exit 1 if not)",
     )
     prm.add_argument("--json", action="store_true", help="print one JSON object")
-    prm.add_argument(
-        "--profile",
-        choices=PROFILE_NAMES,
-        help="the board's profile, for the defaults shown: sheet or minibalance (the "
-        "reference firmware, docs/protocol.md §13) (default: a sim:// URL's, else sheet)",
+    add_profile(
+        prm,
+        "the board's profile, for the defaults shown: sheet or minibalance (the reference "
+        "firmware, docs/protocol.md §13)",
+        default=None,
     )
     add_record(prm)
     return prm

@@ -11,8 +11,8 @@ from appmode.cli.hostio import open_host, show
 from appmode.cli.options import (
     DAY,
     Subparsers,
+    add_profile,
     add_record,
-    add_record_layout,
     add_url,
     layout_for,
     number_type,
@@ -45,7 +45,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--raw", action="store_true", help="send frames even if the board would reject them"
     )
     send.add_argument("--json", action="store_true", help="print JSON Lines")
-    add_record_layout(send)
+    add_profile(send, default=None)
     add_record(send)
     return send
 
