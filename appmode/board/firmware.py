@@ -1,11 +1,13 @@
 """The board's firmware as a deterministic state machine with an injected clock.
 
 `Board.receive(data, now)` applies host bytes at time `now`; `Board.poll(now)` returns
-the telemetry due by `now`. Time only moves forward (an earlier `now` counts as the
-board's current time). The control loop runs in fixed ticks of TICK seconds from boot;
-records go out on the profile's schedule (§3.4, §13), on a millisecond grid. The same
-inputs at the same times give the same bytes, whatever the pattern of `poll` calls.
-Every way a profile differs is a switch of `profiles.Profile`.
+the telemetry due by `now`. The control port has its own pair, `receive_uart2` and
+`poll_uart2` (docs/protocol.md §8–§12), with the same clock and the same state. Time
+only moves forward (an earlier `now` counts as the board's current time). The control
+loop runs in fixed ticks of TICK seconds from boot; records go out on the profile's
+schedule (§3.4, §13), on a millisecond grid. The same inputs at the same times give the
+same bytes, whatever the pattern of `poll` calls. Every way a profile differs is a
+switch of `profiles.Profile`.
 """
 
 from __future__ import annotations
@@ -14,14 +16,16 @@ import math
 from collections import deque
 from dataclasses import dataclass
 
+from appmode.board import kinematics
 from appmode.board.intake import INT_PARAMS, FirmwareIntake, Frame, c_int
 from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
-from appmode.board.vehicle import Vehicle, battery_percent, wrap_degrees
+from appmode.board.vehicle import YAW_GAIN, Vehicle, battery_percent, wrap_degrees
 from appmode.errors import AppmodeError
-from appmode.protocol import app, params
+from appmode.protocol import app, control, params, settings
 from appmode.protocol.directions import PAGE_LETTERS, Page, motion_for, target_velocity
 from appmode.protocol.escaping import escape
+from appmode.protocol.params import DriveType
 
 TICK = 0.01
 TICK_MS = 10
@@ -35,6 +39,15 @@ MAX_RAMP = 2000
 """Ticks of a ramp run when the board skips ahead (20 s: any ramp has settled)."""
 MAX_NOTES = 1000
 """Log lines kept until taken: an edge that never reads them costs bounded memory."""
+REPORT_MS = 50
+"""The encoder report's period on UART2 (§12)."""
+POSITION_GAIN = 2.0
+"""Position mode drives each axis at this many times its remaining distance a second
+(at most max_speed): the car slows as it nears the target and holds it (§9.3)."""
+ANGLE_SPEED = 0.5
+"""Angle mode turns at this fraction of max_speed (§9.1)."""
+UART3, UART2 = "uart3", "uart2"
+"""The ports, as the board's log names them."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,6 +57,7 @@ class Note:
     time: float
     level: str  # "applied", "rejected", "warning" or "info"
     text: str
+    port: str = UART3
 
 
 class Board:
@@ -66,7 +80,11 @@ class Board:
             saved, warning = self.store.load()
             if warning is not None:
                 self._note(now, "warning", warning)
-        self.params: list[float] = list(saved if saved is not None else profile.defaults)
+        values = saved if saved is not None else profile.defaults
+        self.params: list[float] = list(values[: params.PARAM_COUNT])
+        self.gyro_calibration = (
+            values[params.PARAM_COUNT] if len(values) > params.PARAM_COUNT else 0
+        )
         profile.check(drive=drive is not None, flash=False)
         if drive is not None:
             mode = int(self.params[params.SYSTEM_MODE]) & ~params.DRIVE_MASK
@@ -89,12 +107,30 @@ class Board:
         self._outbox = bytearray()
         self._decoder = app.HostDecoder()
         self._intake = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
+        # the control port (§8–§12)
+        self.uart2_control = False
+        self.uart2_received = 0
+        self.uart2_errors = 0
+        self.pending_angle = 0.0  # 0.1°, signed (§9.1)
+        self._command: control.HostFrame | None = None  # the last motion frame obeyed
+        self._position_goal: tuple[float, float, float] | None = None
+        self._wheel_targets: tuple[float, ...] = ()
+        self._reads: list[settings.Read] = []
+        self._out2 = bytearray()
+        self._frames = control.HostDecoder(self.drive_type, profile.motor_width)
+        self._app2 = app.HostDecoder()
+        self._intake2 = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
 
     # ------------------------------------------------------------ clock
 
     def next_slot(self) -> float:
-        """When the next record is due."""
-        return self._boot + self._record_ms / 1000
+        """When the board next sends something: a record, a reply, an encoder report."""
+        due = self._record_ms
+        if self._reads:
+            due = min(due, self._tick_ms)
+        elif self._mode("encoder_report") and not self._mode("app_mode"):
+            due = min(due, -(-self._tick_ms // REPORT_MS) * REPORT_MS)
+        return self._boot + due / 1000
 
     def advance(self, now: float) -> None:
         """Run every tick and record due by `now`."""
@@ -112,6 +148,7 @@ class Board:
             if self._tick_ms <= self._record_ms:
                 if self._tick_ms:
                     self._control(1)
+                self._uart2_tick()
                 self._tick_ms += TICK_MS
             else:
                 self._send_record()
@@ -121,21 +158,56 @@ class Board:
     def receive(self, data: bytes, now: float) -> None:
         """Apply host bytes that arrived at `now`."""
         self.advance(now)
+        self._receive_app(data, now, UART3)
+
+    def _receive_app(self, data: bytes, now: float, port: str) -> None:
         if self.profile.firmware_frames:
-            for item in self._intake.feed(data):
+            intake = self._intake if port == UART3 else self._intake2
+            for item in intake.feed(data):
                 if isinstance(item, Frame):
-                    self._apply_frame(item, now)
+                    self._apply_frame(item, now, port)
                 else:
-                    self._apply(item.event, now, framed=item.framed)
+                    self._apply(item.event, now, port, framed=item.framed)
         else:
-            for event in self._decoder.feed(data):
-                self._apply(event, now)
+            decoder = self._decoder if port == UART3 else self._app2
+            for event in decoder.feed(data):
+                self._apply(event, now, port)
 
     def poll(self, now: float) -> bytes:
         """The telemetry bytes due by `now`."""
         self.advance(now)
         out = bytes(self._outbox)
         self._outbox.clear()
+        return out
+
+    def receive_uart2(self, data: bytes, now: float) -> None:
+        """Apply bytes that arrived on the control port at `now` (§8)."""
+        self.advance(now)
+        before = self.uart2_received
+        self.uart2_received += len(data)
+        if self._mode("app_mode"):
+            self._receive_app(data, now, UART2)
+        else:
+            for event in self._frames.feed(data):
+                self._apply_control(event, now)
+        at = self.profile.takeover_byte
+        if not self.uart2_control and before < at <= self.uart2_received:
+            self.uart2_control = True
+            self.direction, self.turn = 0, 0
+            self._note(
+                now,
+                "info",
+                f"UART2 takes over the motion at its byte {at}; the APP port's direction "
+                "is dropped and its drive letters are ignored from now on (§8.3)",
+                UART2,
+            )
+
+    def poll_uart2(self, now: float) -> bytes:
+        """The control port's bytes due by `now`: replies, encoder reports, and records
+        while APP mode is on."""
+        self.advance(now)
+        out = bytes(self._out2)
+        self._out2.clear()
         return out
 
     def take_notes(self) -> list[Note]:
@@ -167,12 +239,111 @@ class Board:
         speed = self.params[params.MAX_SPEED]
         if 0 < speed < profile.stall_speed:
             self.params[params.MAX_SPEED] = speed = profile.stall_speed
-        if profile.ramp is None:
-            self.vehicle.step(self._target(speed), ticks * TICK)
+        vehicle = self.vehicle
+        if self.uart2_control and not self._mode("app_mode"):
+            for _ in range(min(ticks, MAX_RAMP)):  # beyond that the car has long settled
+                self._drive_uart2(speed)
             return
-        pushes = self._pushes() if self._powered(self._tick_ms) else (0, 0, 0)
-        for _ in range(min(ticks, MAX_RAMP)):  # beyond that a ramp has long settled
-            self.vehicle.ramp(pushes, speed, profile.ramp, profile.coast, TICK)
+        if profile.ramp is None:
+            target = self._target(speed)
+            vehicle.step(target, ticks * TICK)
+        else:
+            pushes = self._pushes() if self._powered(self._tick_ms) else (0, 0, 0)
+            for _ in range(min(ticks, MAX_RAMP)):  # beyond that a ramp has long settled
+                vehicle.ramp(pushes, speed, profile.ramp, profile.coast, TICK)
+            target = (vehicle.vx, vehicle.vy, vehicle.vz)
+        self._wheel_targets = kinematics.wheels(self.drive_type, *target)
+
+    def _drive_uart2(self, speed: float) -> None:
+        """One control tick with UART2 in control: its last motion frame, angle mode's
+        pending rotation, position mode's goal (§9)."""
+        command, drive, vehicle = self._command, self.drive_type, self.vehicle
+        x = y = z = 0.0
+        if isinstance(command, control.VelocityFrame):
+            x, y, z = self._velocity_target(command, speed)
+        elif isinstance(command, control.MotorFrame):
+            x, y, z = kinematics.body(drive, tuple(map(float, command.speeds)))
+        elif self._position_goal is not None:
+            travel = (vehicle.travel_x, vehicle.travel_y, vehicle.travel_z)
+            x, y, z = (
+                _clamp((goal - done) * POSITION_GAIN, speed)
+                for goal, done in zip(self._position_goal, travel, strict=True)
+            )
+        if self.pending_angle:
+            z = math.copysign(speed * ANGLE_SPEED, self.pending_angle)
+        vehicle.step((x, y, z), TICK)
+        if self.pending_angle:
+            left = self.pending_angle - vehicle.vz * YAW_GAIN * TICK * 10
+            self.pending_angle = left if left * self.pending_angle > 0 else 0.0
+        if isinstance(command, control.MotorFrame):
+            self._wheel_targets = tuple(map(float, command.speeds))
+        else:
+            self._wheel_targets = kinematics.wheels(drive, x, y, z)
+
+    def _angle_mode(self, frame: control.VelocityFrame) -> bool:
+        return (
+            frame.angle and self.profile.angle_mode and self.drive_type is not DriveType.DIFF_GYRO
+        )
+
+    def _velocity_target(
+        self, frame: control.VelocityFrame, speed: float
+    ) -> tuple[float, float, float]:
+        """A velocity frame's body velocity on this drive type (§9.1)."""
+        a, b, c = frame.values
+        if self._angle_mode(frame):
+            c = 0
+        drive = self.drive_type
+        if drive is DriveType.DIFF_GYRO:
+            left, right = _duty(a, speed), _duty(b, speed)
+            return (0.0, (left + right) / 2, (left - right) / 2)
+        if drive.differential:
+            return (0.0, _duty(b, speed), _duty(c, speed))
+        return (_clamp(a, speed), _clamp(b, speed), _clamp(c, speed))
+
+    def _uart2_tick(self) -> None:
+        """What UART2 sends in a control tick: the replies to reads received since the
+        last tick (§11), and the encoder report every REPORT_MS while bit 6 is set (§12)."""
+        for read in self._reads:
+            value = self._read_value(read)
+            self._out2 += control.encode(control.Reply(read.reply_id, value))
+        self._reads.clear()
+        if (
+            self._mode("encoder_report")
+            and not self._mode("app_mode")
+            and self._tick_ms % REPORT_MS == 0
+            and 0x80 in self.profile.control_modes
+        ):
+            targets, actuals = self._encoders(self._wheel_targets), self._encoders(self._wheels())
+            self._out2 += control.encode(control.EncoderReport(targets, actuals))
+
+    def _wheels(self) -> tuple[float, ...]:
+        v = self.vehicle
+        return kinematics.wheels(self.drive_type, v.vx, v.vy, v.vz)
+
+    def _encoders(self, values: tuple[float, ...]) -> tuple[int, ...]:
+        """Wheel values as the encoders give them: whole, signed by encoder_reverse."""
+        sign = -1 if self._mode("encoder_reverse") else 1
+        count = control.motor_count(self.drive_type)
+        values = (values + (0.0,) * count)[:count]
+        return tuple(_int32(sign * value) for value in values)
+
+    def _read_value(self, read: settings.Read) -> int:
+        """The value a read's reply carries (§11)."""
+        setting = settings.BY_NAME.get(read.name)
+        if setting is not None:
+            held = self.gyro_calibration if setting.param is None else self.params[setting.param]
+            return int(held) & params.U32
+        if read.ss == settings.PENDING_ANGLE:
+            return _int32(self.pending_angle)
+        v = self.vehicle
+        if read.ss >= settings.POSITION_BASE:
+            wheels = kinematics.wheels(self.drive_type, v.travel_x, v.travel_y, v.travel_z)
+            index = read.ss - settings.POSITION_BASE
+        else:
+            wheels = self._wheels()
+            index = read.ss - settings.SPEED_BASE
+        encoders = self._encoders(wheels)
+        return encoders[index] if index < len(encoders) else 0  # no wheel D on an omni
 
     def _target(self, speed: float) -> tuple[float, float, float]:
         if self._mode("motor_reverse"):
@@ -205,7 +376,10 @@ class Board:
         else:
             data = app.encode(self._a_record(at) if self._show_a else self._b_record(at))
             self._show_a = not self._show_a
-        self._outbox += data
+        if self._mode("app_mode"):
+            self._out2 += data  # §12: records go out on UART2, UART3's transmitter is idle
+        else:
+            self._outbox += data
         if profile.period_ms is not None:
             self._record_ms = at + profile.period_ms
         else:
@@ -242,8 +416,8 @@ class Board:
             self._battery(ms),
         )
 
-    def _note(self, now: float, level: str, text: str) -> None:
-        self.notes.append(Note(now, level, text))
+    def _note(self, now: float, level: str, text: str, port: str = UART3) -> None:
+        self.notes.append(Note(now, level, text, port))
 
     def _steer(self, event: app.ByteEvent) -> str:
         """Apply one byte's direction logic (§2.1, §4; §13's rotation rule); what it did."""
@@ -273,66 +447,177 @@ class Board:
             self.turn = 0
         return "stop" if not self.turn else "stop; the rotation goes on (§13)"
 
-    def _apply(self, event: app.HostEvent, now: float, framed: bool = False) -> None:
+    def _apply(self, event: app.HostEvent, now: float, port: str, framed: bool = False) -> None:
         shown = escape(event.raw)
         if isinstance(event, (app.Move, app.Stop, app.SwitchPage, app.Noise)):
+            if isinstance(event, app.Noise):
+                self.errors += not framed
+            if port == UART3 and self.uart2_control:
+                if not framed:
+                    self._note(now, "rejected", f"{shown}: ignored: UART2 drives (§8.3)", port)
+                return
             before = (self.direction, self.turn, self.page)
             did = self._steer(event)
             if isinstance(event, app.Noise):
-                self.errors += not framed
                 did = f"unrecognised byte, {did}"
             if not framed:
-                self._note(
-                    now,
-                    "rejected" if isinstance(event, app.Noise) else "applied",
-                    f"{shown}: {did}",
-                )
+                level = "rejected" if isinstance(event, app.Noise) else "applied"
+                self._note(now, level, f"{shown}: {did}", port)
             elif before != (self.direction, self.turn, self.page):
-                self._note(now, "applied", f"{shown} in a frame: {did} (§13)")
+                self._note(now, "applied", f"{shown} in a frame: {did} (§13)", port)
         elif isinstance(event, app.BadFrame):
             self.errors += 1
-            self._note(now, "rejected", f"{shown}: {event.reason}")
+            self._note(now, "rejected", f"{shown}: {event.reason}", port)
         elif isinstance(event, app.SetParam):
-            self.params[event.index] = event.value
-            self._note(now, "applied", f"{shown}: {event.name} = {event.value}")
+            self._set_param(event.index, event.value)
+            self._note(now, "applied", f"{shown}: {event.name} = {event.value}", port)
         else:
             if event.warning is not None:
                 self.warnings += 1
-                self._note(now, "warning", f"{shown}: {event.warning}")
-            (self._read if isinstance(event, app.ReadParams) else self._save)(now, shown)
+                self._note(now, "warning", f"{shown}: {event.warning}", port)
+            (self._read if isinstance(event, app.ReadParams) else self._save)(now, shown, port)
 
-    def _apply_frame(self, frame: Frame, now: float) -> None:
+    def _apply_frame(self, frame: Frame, now: float, port: str) -> None:
         shown = escape(frame.raw)
         if frame.action == "read":
-            self._read(now, shown)
+            self._read(now, shown, port)
         elif frame.action == "save":
-            self._save(now, shown)
+            self._save(now, shown, port)
         elif frame.action == "ignored" or frame.index not in self.profile.settable:
             reason = frame.reason or f"parameter {frame.index} is not settable on this board"
-            self._note(now, "rejected", f"{shown}: ignored: {reason}")
+            self._note(now, "rejected", f"{shown}: ignored: {reason}", port)
         else:
             index = frame.index
             kept = c_int(frame.value) if index in INT_PARAMS else frame.value
             self.params[index] = kept
             name = params.PARAMS[index].name
-            self._note(now, "applied", f"{shown}: {name} = {kept:.10g}")
+            self._note(now, "applied", f"{shown}: {name} = {kept:.10g}", port)
 
-    def _read(self, now: float, shown: str) -> None:
+    def _set_param(self, index: int, value: int) -> None:
+        """Set a parameter from either port; a new drive type changes how UART2's
+        mode-02 frames are read."""
+        self.params[index] = value
+        if index == params.SYSTEM_MODE:
+            self._frames.drive = self.drive_type
+
+    def _read(self, now: float, shown: str, port: str) -> None:
         if self.profile.read_lost_in_c and now < self._c_on_wire_until:
-            self._note(now, "rejected", f"{shown}: lost: a C record is going out (§13)")
+            self._note(now, "rejected", f"{shown}: lost: a C record is going out (§13)", port)
             return
         self._c_pending = True
-        self._note(now, "applied", f"{shown}: read parameters, C record in next slot")
+        self._note(now, "applied", f"{shown}: read parameters, C record in next slot", port)
 
-    def _save(self, now: float, shown: str) -> None:
+    def _save(self, now: float, shown: str, port: str) -> None:
         if not self.profile.saves:
-            self._note(now, "rejected", f"{shown}: this board saves nothing (§13)")
+            self._note(now, "rejected", f"{shown}: this board saves nothing (§13)", port)
             return
-        saved = params.saved_form([int(v) for v in self.params])
+        saved = (*params.saved_form([int(v) for v in self.params]), self.gyro_calibration)
         try:
             self.store.save(saved)
         except AppmodeError as exc:
             self.errors += 1
-            self._note(now, "rejected", f"{shown}: save failed: {exc}")
+            self._note(now, "rejected", f"{shown}: save failed: {exc}", port)
             return
-        self._note(now, "applied", f"{shown}: saved {list(saved)}")
+        self._note(now, "applied", f"{shown}: saved {list(saved)}", port)
+
+    def _load(self, values: tuple[int, ...] | tuple[float, ...]) -> None:
+        """Load settings into the running copy; system_mode's unsaved bits stay (§10)."""
+        mode = int(self.params[params.SYSTEM_MODE]) & params.UNSAVED_MASK
+        self.params = [float(v) for v in values[: params.PARAM_COUNT]]
+        self.params[params.SYSTEM_MODE] = int(self.params[params.SYSTEM_MODE]) | mode
+        self.gyro_calibration = int(values[params.PARAM_COUNT]) if len(values) > 9 else 0
+        self._frames.drive = self.drive_type
+
+    def _apply_control(self, event: control.HostEvent, now: float) -> None:
+        """One event of UART2's binary stream (§9–§11)."""
+        shown = event.raw.hex(" ").upper()
+        if isinstance(event, (control.Garbage, control.BadFrame)):
+            self.uart2_errors += 1
+            self._note(now, "rejected", f"{shown}: {event.reason}", UART2)
+            return
+        mode = event.raw[2]
+        if mode not in self.profile.control_modes:
+            self.uart2_errors += 1
+            self._note(
+                now,
+                "rejected",
+                f"{shown}: ignored: the {self.profile.name} board has no "
+                f"{control.MODES[mode]} frames on UART2 (§13)",
+                UART2,
+            )
+            return
+        if isinstance(event, (control.VelocityFrame, control.MotorFrame)):
+            self._command, self._position_goal = event, None
+            did = f"{control.MODES[mode]} {event.values}"
+            if isinstance(event, control.VelocityFrame) and self._angle_mode(event):
+                self.pending_angle += event.c
+                did += f", angle mode: {self.pending_angle / 10:g}° pending"
+            self._note(now, "applied", f"{shown}: {did}", UART2)
+        elif isinstance(event, control.PositionFrame):
+            self._position(event, now, shown)
+        elif isinstance(event, control.SetSetting):
+            self._set_setting(event, now, shown)
+        elif isinstance(event, control.StoreFrame):
+            self._store_op(event.op, now, shown)
+        else:
+            self._reads.append(event.read)
+            self._note(
+                now, "applied", f"{shown}: read {event.read.name}, reply in the next tick", UART2
+            )
+
+    def _position(self, frame: control.PositionFrame, now: float, shown: str) -> None:
+        if self.drive_type.differential:
+            self.uart2_errors += 1
+            self._note(
+                now, "rejected", f"{shown}: no position mode on a differential drive (§9.3)", UART2
+            )
+            return
+        limit = self.params[params.BY_NAME["max_position"].index]
+        move = tuple(_clamp(v, limit) for v in (frame.x, frame.y, frame.z))
+        v = self.vehicle
+        self._position_goal = (v.travel_x + move[0], v.travel_y + move[1], v.travel_z + move[2])
+        self._command = frame
+        self._note(now, "applied", f"{shown}: position, move by {move}", UART2)
+
+    def _set_setting(self, frame: control.SetSetting, now: float, shown: str) -> None:
+        setting = frame.setting
+        if setting.param is None:
+            self.gyro_calibration = frame.value
+        elif setting.param in self.profile.settable:
+            self._set_param(setting.param, frame.value)
+        else:
+            self._note(
+                now,
+                "rejected",
+                f"{shown}: ignored: {setting.name} is not settable on this board",
+                UART2,
+            )
+            return
+        self._note(now, "applied", f"{shown}: {setting.name} = {frame.value}", UART2)
+
+    def _store_op(self, op: settings.StoreOp, now: float, shown: str) -> None:
+        if op.name == "save":
+            self._save(now, shown, UART2)
+            return
+        if op.name == "load" and self.profile.saves:
+            saved, warning = self.store.load()
+            values = saved if saved is not None else self.profile.defaults
+            did = "loaded the saved settings" if saved is not None else f"{warning}"
+        else:
+            values, did = self.profile.defaults, "loaded the factory defaults"
+        self._load(values)
+        self._note(now, "applied", f"{shown}: {did}", UART2)
+
+
+def _clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))
+
+
+def _duty(value: int, speed: float) -> float:
+    """A differential drive's duty in 0.1 % as a speed: above 1000 counts as 1000 (§9.1)."""
+    return math.copysign(min(abs(value), control.MAX_DUTY) / control.MAX_DUTY * speed, value)
+
+
+def _int32(value: float) -> int:
+    """A whole 32-bit signed value, saturating."""
+    return max(-(2**31), min(2**31 - 1, round(value)))

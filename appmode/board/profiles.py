@@ -80,6 +80,16 @@ class Profile:
     """A `{Q:P}` that arrives while a C record is going out is lost."""
     startup_text: bytes
     """What the APP port carries at power-up, before the first record."""
+    # -- the control port (§8–§12)
+    takeover_byte: int
+    """The byte received on UART2 at which UART2 takes over the motion (§8.3)."""
+    control_modes: frozenset[int]
+    """The frame modes UART2 obeys (01 velocity, 02 motors, 03 position, 80 settings and
+    reads); frames of other modes are ignored and counted."""
+    angle_mode: bool
+    """Bit 4 of a velocity frame's direction byte turns the third field into an angle."""
+    motor_width: int
+    """Bytes per motor speed in a mode-02 frame: 2, or 1 (always a 10-byte frame)."""
 
     def check(self, drive: bool, flash: bool) -> None:
         """AppmodeError when a board of this profile is asked for what it does not have."""
@@ -137,6 +147,10 @@ SHEET = Profile(
     first_record="A",
     read_lost_in_c=False,
     startup_text=b"",
+    takeover_byte=10,
+    control_modes=frozenset({0x01, 0x02, 0x03, 0x80}),
+    angle_mode=True,
+    motor_width=2,
 )
 
 MINIBALANCE = Profile(
@@ -177,6 +191,10 @@ MINIBALANCE = Profile(
     first_record="B",
     read_lost_in_c=True,
     startup_text=b"".join(line.encode() + b"\r\n" for line in MPU_LINES),
+    takeover_byte=11,
+    control_modes=frozenset({0x01, 0x02}),
+    angle_mode=False,
+    motor_width=1,
 )
 
 PROFILES: dict[str, Profile] = {p.name: p for p in (SHEET, MINIBALANCE)}

@@ -1,7 +1,9 @@
 """The board's non-volatile parameter store ("flash"), behind a small interface (§5).
 
-`load()` gives the saved parameters, or None with a warning when there are none or they
-cannot be read; it never raises. `save()` replaces them whole.
+`load()` gives the saved values, or None with a warning when there are none or they
+cannot be read; it never raises. `save()` replaces them whole. The values are the nine
+parameters, then gyro_calibration (the control port's tenth setting, §10) when it was
+saved: a file written before it existed holds nine.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from appmode.protocol import params
 
 FORMAT = "appmode-flash"
 VERSION = 1
+GYRO_CALIBRATION = "gyro_calibration"
+"""The key of the tenth setting, beside `params`."""
 MAX_SIZE = 64 * 1024
 """Bytes read at most: a flash file is a few hundred."""
 
@@ -128,11 +132,13 @@ class JsonFileStore:
         return values, None
 
     def save(self, values: Sequence[int]) -> None:
-        document = {
+        document: dict[str, object] = {
             "format": FORMAT,
             "version": VERSION,
-            "params": {p.name: v for p, v in zip(params.PARAMS, values, strict=True)},
+            "params": {p.name: v for p, v in zip(params.PARAMS, values, strict=False)},
         }
+        if len(values) > params.PARAM_COUNT:
+            document[GYRO_CALIBRATION] = values[params.PARAM_COUNT]
         text = json.dumps(document, indent=2) + "\n"
         write_whole(self.path, text.encode(), "flash file")
 
@@ -175,6 +181,11 @@ def _parse(data: bytes) -> tuple[int, ...]:
     error = params.values_error(values)
     if error is not None:
         raise ValueError(error)
+    if GYRO_CALIBRATION in document:
+        value = document[GYRO_CALIBRATION]
+        if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= params.U16:
+            raise ValueError(f"{GYRO_CALIBRATION} must be an integer in 0–{params.U16}")
+        values.append(value)
     return tuple(values)
 
 

@@ -55,6 +55,10 @@ class Vehicle:
     pitch: float = 0.0
     roll: float = 0.0
     centivolts: float = FULL_CV
+    travel_x: float = 0.0
+    travel_y: float = 0.0
+    travel_z: float = 0.0
+    """The body's own x, y, z integrated over time: what the wheel encoders count."""
 
     def step(self, target: tuple[float, float, float], dt: float) -> None:
         """Advance by `dt` seconds toward the target velocity (x, y, z)."""
@@ -89,6 +93,9 @@ class Vehicle:
         self.pitch = (self.vy - old_y) / dt * TILT_GAIN
         self.roll = (self.vx - old_x) / dt * TILT_GAIN
         self.heading = (self.heading + self.vz * YAW_GAIN * dt) % 360.0
+        self.travel_x += self.vx * dt
+        self.travel_y += self.vy * dt
+        self.travel_z += self.vz * dt
         rad = math.radians(self.heading)
         self.east += (self.vx * math.cos(rad) + self.vy * math.sin(rad)) * dt
         self.north += (self.vy * math.cos(rad) - self.vx * math.sin(rad)) * dt
