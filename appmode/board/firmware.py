@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
+from typing import cast
 
 from appmode.board import kinematics
 from appmode.board.intake import INT_PARAMS, FirmwareIntake, Frame, c_int
@@ -188,8 +189,8 @@ class Board:
         if self._mode("app_mode"):
             self._receive_app(data, now, UART2)
         else:
-            for event in self._frames.feed(data):
-                self._apply_control(event, now)
+            for event in self._frames.feed(data):  # never in APP mode: _app2 has that
+                self._apply_control(cast(control.HostEvent, event), now)
         at = self.profile.takeover_byte
         if not self.uart2_control and before < at <= self.uart2_received:
             self.uart2_control = True

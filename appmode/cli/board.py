@@ -14,7 +14,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="serve the simulated board on a pseudo-terminal, TCP or a serial port",
         description="Serve the simulated board so that any serial program (the phone app "
         "through a Bluetooth module, miniterm, appmode itself) can talk to it. Prints "
-        "'port: URL' for clients to open, then logs what it receives until Ctrl-C.",
+        "'port: URL' (the APP port, UART3 at 9600 bps) and 'uart2: URL' (the control "
+        "port, UART2 at 115200 bps, docs/protocol.md §8) for clients to open, then logs "
+        "what it receives, port by port, until Ctrl-C.",
     )
     where = board.add_mutually_exclusive_group()
     where.add_argument(
@@ -30,6 +32,17 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--port",
         metavar="DEV",
         help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
+    )
+    where2 = board.add_mutually_exclusive_group()
+    where2.add_argument(
+        "--listen2",
+        metavar="HOST:PORT",
+        help="serve UART2, the control port, on TCP (default: a second pseudo-terminal)",
+    )
+    where2.add_argument(
+        "--port2",
+        metavar="DEV",
+        help="serve UART2 on a real serial port (?baud=N to change 115200)",
     )
     board.add_argument(
         "--count",
@@ -60,7 +73,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     board.add_argument(
         "--no-pace",
         action="store_true",
-        help="send as fast as the link takes, not at the 9600-bps line rate",
+        help="send as fast as the link takes, not at the line rates (9600 bps on the APP "
+        "port, 115200 on UART2)",
     )
     add_record(board)
     board.add_argument(
@@ -84,4 +98,6 @@ def run(args: argparse.Namespace) -> int:
         quiet=args.quiet,
         count=args.count,
         profile=args.profile,
+        listen2=args.listen2,
+        device2=args.port2,
     )

@@ -1,76 +1,130 @@
-"""The simulated board on a serial wire, with no I/O: the board and a line each way.
+"""The simulated board on its serial wires, with no I/O: the board and a line each way
+on each of its two ports (the APP port, UART3, and the control port, UART2).
 
-`write(data, now)` puts host bytes on the line to the board; `pump(now)` runs the board
-up to `now` and returns the bytes that have reached the host. The board acts on each
-byte when it would have arrived, and its telemetry leaves at slot time, paced. An
-optional `tap(direction, time, data)` sees both directions as they are sent.
+`write(data, now, port)` puts host bytes on the line to the board; `pump(now, port)`
+runs the board up to `now` and returns the bytes that have reached the host on that
+port. The board acts on each byte when it would have arrived (the two ports' bytes in
+time order), and what it sends leaves at slot time, paced. An optional `tap(direction,
+time, data)` sees every direction as it is sent: `>` and `<` on the APP port, `2>` and
+`2<` on UART2.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 from appmode.board.firmware import Board
 from appmode.line.pacing import Line
 
 Tap = Callable[[str, float, bytes], None]
+APP, UART2 = "app", "uart2"
+PORTS = (APP, UART2)
+APP_BAUD = 9600
+UART2_BAUD = 115200
 MAX_LAG = 1.0
 """Seconds behind after which the board catches up in one step instead of slot by slot."""
-MAX_BACKLOG = 960
-"""Bytes queued to the host (1 s at 9600 bps) beyond which new records are dropped."""
+MAX_BACKLOG = {APP: APP_BAUD // 10, UART2: UART2_BAUD // 10}
+"""Bytes queued to the host (1 s of the line) beyond which new bytes are dropped."""
+
+
+@dataclass
+class Port:
+    """One port's two lines and its tap directions."""
+
+    to_board: Line
+    to_host: Line
+    sent: str
+    received: str
+    dropped: int = field(default=0)
 
 
 class Wire:
-    """A Board behind a UART at `baud` (None: no pacing)."""
+    """A Board behind its two UARTs at `baud` and `baud2` (None: no pacing)."""
 
-    def __init__(self, board: Board, baud: int | None = 9600, tap: Tap | None = None) -> None:
+    def __init__(
+        self,
+        board: Board,
+        baud: int | None = APP_BAUD,
+        tap: Tap | None = None,
+        baud2: int | None = UART2_BAUD,
+    ) -> None:
         self.board = board
-        self.to_board = Line(baud)
-        self.to_host = Line(baud)
+        self.ports = {
+            APP: Port(Line(baud), Line(baud), ">", "<"),
+            UART2: Port(Line(baud2), Line(baud2), "2>", "2<"),
+        }
+        self.to_board = self.ports[APP].to_board
+        self.to_host = self.ports[APP].to_host
         self.tap = tap
-        self.dropped = 0
 
-    def write(self, data: bytes, now: float) -> None:
+    @property
+    def dropped(self) -> int:
+        return sum(p.dropped for p in self.ports.values())
+
+    def write(self, data: bytes, now: float, port: str = APP) -> None:
         """Host bytes sent at `now`."""
         if data:
+            line = self.ports[port]
             if self.tap is not None:
-                self.tap(">", now, data)
-            self.to_board.push(data, now)
+                self.tap(line.sent, now, data)
+            line.to_board.push(data, now)
 
-    def pump(self, now: float) -> bytes:
+    def pump(self, now: float, port: str = APP) -> bytes:
         """Run the board to `now`; the bytes delivered to the host by then."""
         self.run(now)
-        return self.to_host.take(now)
+        return self.ports[port].to_host.take(now)
 
-    def pump_timed(self, now: float) -> list[tuple[float, bytes]]:
+    def pump_timed(self, now: float, port: str = APP) -> list[tuple[float, bytes]]:
         """Like pump, with each run of bytes' delivery time."""
         self.run(now)
-        return self.to_host.take_timed(now)
+        return self.ports[port].to_host.take_timed(now)
 
     def run(self, now: float) -> None:
-        """Run the board to `now`: its input delivered, its records on the line."""
+        """Run the board to `now`: its input delivered, what it sends on the lines."""
         board = self.board
         if now - board.next_slot() > MAX_LAG:  # stalled (suspend, debugger): catch up at once
             self._deliver(now)
-            self._send(board.poll(now), now)
+            self._send(now)
         while (slot := board.next_slot()) <= now:
             self._deliver(slot)
-            self._send(board.poll(slot), slot)
+            self._send(slot)
         self._deliver(now)
 
-    def _send(self, data: bytes, when: float) -> None:
-        if data and len(self.to_host) > MAX_BACKLOG:
-            self.dropped += len(data)  # the line cannot carry it: bounded, like a UART FIFO
-        elif data:
+    def _send(self, when: float) -> None:
+        for name, data in ((APP, self.board.poll(when)), (UART2, self.board.poll_uart2(when))):
+            if not data:
+                continue
+            port = self.ports[name]
+            line = port.to_host
+            if len(line) > MAX_BACKLOG[name]:
+                port.dropped += len(data)  # the line cannot carry it: bounded, like a FIFO
+                continue
             if self.tap is not None:
-                self.tap("<", when, data)
-            self.to_host.push(data, when)
+                self.tap(port.received, when, data)
+            line.push(data, when)
 
     def _deliver(self, now: float) -> None:
-        for when, data in self.to_board.take_timed(now):
-            self.board.receive(data, when)
+        app = self.ports[APP].to_board.take_timed(now)
+        uart2 = self.ports[UART2].to_board.take_timed(now)
+        if not uart2:
+            for when, data in app:
+                self.board.receive(data, when)
+            return
+        merged = sorted(
+            [(when, 0, data) for when, data in app] + [(when, 1, data) for when, data in uart2],
+            key=lambda item: (item[0], item[1]),
+        )
+        for when, which, data in merged:
+            if which:
+                self.board.receive_uart2(data, when)
+            else:
+                self.board.receive(data, when)
 
     def next_wakeup(self) -> float:
         """The next time `pump` has something to do."""
-        times = [self.board.next_slot(), self.to_board.next_due(), self.to_host.next_due()]
-        return min(t for t in times if t is not None)
+        times = [self.board.next_slot()]
+        for port in self.ports.values():
+            due = (port.to_board.next_due(), port.to_host.next_due())
+            times += [t for t in due if t is not None]
+        return min(times)

@@ -69,11 +69,11 @@ def _check_address(url: str, scheme: str) -> None:
         )
 
 
-def parse_device(url: str) -> tuple[str, int]:
+def parse_device(url: str, baud: int = BAUD) -> tuple[str, int]:
+    """A device's path and baud rate (`?baud=N`, else `baud`)."""
     path, _, query = url.partition("?")
     if not path:
         raise AppmodeError(f"empty port name in {url!r}: {URL_HELP}")
-    baud = BAUD
     for name, values in parse_qs(query, keep_blank_values=True).items():
         if name != "baud":
             raise AppmodeError(f"unknown option {name!r} in {url!r}: only ?baud=N is known")

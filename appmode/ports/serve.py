@@ -1,4 +1,5 @@
-"""`appmode board`: serve the simulated board on a pseudo-terminal, TCP, or a real port.
+"""`appmode board`: serve the simulated board on a pseudo-terminal, TCP, or a real port,
+and its control port (UART2) on a second one.
 
 One thread, one selector. The board keeps running (and keeps its state) whatever the
 client does: a pty's other end closing, a TCP client leaving, nobody listening.
@@ -27,19 +28,20 @@ from appmode.board.profiles import SHEET, profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
-from appmode.line.wire import Wire
+from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
 from appmode.ports.link import BAUD, explain_open_error, parse_device
 from appmode.protocol import params
-from appmode.protocol.params import DriveType
+from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder
 
 Log = Callable[[str], None]
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
-RUN = 0.004
+RUN = {APP: 0.004, UART2: 0.001}
 """Seconds of wire time written at most at once to a paced client: bytes trickle in as
-from a real UART (a C record over 32 ms at 9600 bps), not a record at a time."""
+from a real UART (a C record over 32 ms at 9600 bps), not a record at a time. UART2's
+runs are shorter: a read's reply is due within its 10 ms tick (§11)."""
 INPUT_BACKLOG = 256
 """Bytes received but not yet on the simulated line beyond which the server stops reading:
 the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
@@ -231,8 +233,10 @@ class TcpEndpoint:
 class SerialEndpoint:
     """A real serial port (a USB-UART, with a Bluetooth module for the phone app)."""
 
-    def __init__(self, sel: selectors.BaseSelector, log: Log, device: str) -> None:
-        path, baud = parse_device(device)
+    def __init__(
+        self, sel: selectors.BaseSelector, log: Log, device: str, baud: int = BAUD
+    ) -> None:
+        path, baud = parse_device(device, baud)
         try:
             self._port = serial.Serial(path, baudrate=baud, timeout=0, exclusive=True)
         except (serial.SerialException, OSError, ValueError) as exc:
@@ -266,22 +270,22 @@ class SerialEndpoint:
 Endpoint = PtyEndpoint | TcpEndpoint | SerialEndpoint
 
 
-def parse_listen(text: str) -> tuple[str, int]:
+def parse_listen(text: str, option: str = "--listen") -> tuple[str, int]:
     """`PORT` or `HOST:PORT` (host 127.0.0.1 by default)."""
     host, _, port = text.rpartition(":")
     number = params.whole(port)
     if number is None or number > 65535:
-        raise AppmodeError(f"--listen {text!r}: expected HOST:PORT or PORT, e.g. 127.0.0.1:5000")
+        raise AppmodeError(f"{option} {text!r}: expected HOST:PORT or PORT, e.g. 127.0.0.1:5000")
     return host.strip("[]") or "127.0.0.1", number
 
 
 @dataclass
 class Served:
-    """One board being served: its endpoint and its wire."""
+    """One board being served: an endpoint for each port it serves, and its wire."""
 
-    endpoint: Endpoint
+    endpoints: dict[str, Endpoint]
     wire: Wire
-    paused: bool = False
+    paused: dict[str, bool]
     last_write: float = float("-inf")
 
     def wakeup(self) -> float:
@@ -290,38 +294,48 @@ class Served:
         time) and the bytes whose stop bit is done are written, never early, never more
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
-        step = wire.to_host.byte_time
-        due = wire.board.next_slot() + step  # the next slot's record: its first byte
-        if (line := wire.to_board.next_due()) is not None:
-            due = min(due, line)
-        if (line := wire.to_host.next_due()) is not None:
-            due = min(due, line)
-        if step:
-            due = math.ceil(due / RUN - 1e-9) * RUN
-        if self.endpoint.backlog:
+        slot = wire.board.next_slot()
+        due = math.inf
+        for name in self.endpoints:
+            port = wire.ports[name]
+            step = port.to_host.byte_time
+            mine = slot + step  # the next slot's output: its first byte
+            for line in (port.to_board.next_due(), port.to_host.next_due()):
+                if line is not None:
+                    mine = min(mine, line)
+            if step:
+                mine = math.ceil(mine / RUN[name] - 1e-9) * RUN[name]
+            due = min(due, mine)
+        if any(e.backlog for e in self.endpoints.values()):
             due = min(due, self.last_write + RETRY_WRITE)
         return due
 
     def pump(self, now: float) -> None:
-        out = self.wire.pump(now)
-        if out or self.endpoint.backlog:
-            self.endpoint.write(out)
-            self.last_write = now
+        self.wire.run(now)
+        for name, endpoint in self.endpoints.items():
+            out = self.wire.ports[name].to_host.take(now)
+            if out or endpoint.backlog:
+                endpoint.write(out)
+                self.last_write = now
 
-    def receive(self, data: bytes, now: float) -> None:
+    def receive(self, data: bytes, now: float, port: str) -> None:
         self.pump(now)  # what was due before these bytes came
-        self.wire.write(data, now)
+        self.wire.write(data, now, port)
 
     def throttle(self) -> None:
         """Read no more while INPUT_BACKLOG bytes wait for the simulated line."""
-        full = len(self.wire.to_board) >= INPUT_BACKLOG
-        if full != self.paused:
-            self.endpoint.pause(full)
-            self.paused = full
+        for name, endpoint in self.endpoints.items():
+            full = len(self.wire.ports[name].to_board) >= INPUT_BACKLOG
+            if full != self.paused[name]:
+                endpoint.pause(full)
+                self.paused[name] = full
+
+
+MakeEndpoint = Callable[[selectors.BaseSelector, Log], Endpoint]
 
 
 def serve(
-    make_endpoints: list[Callable[[selectors.BaseSelector, Log], Endpoint]],
+    make_endpoints: list[MakeEndpoint],
     boards: list[Board],
     *,
     pace: bool,
@@ -330,26 +344,47 @@ def serve(
     record: str | None = None,
     banner: str = "",
     directives: tuple[str, ...] = (),
+    make_uart2: list[MakeEndpoint] | None = None,
 ) -> None:
-    """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line.
+    """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line
+    (`port: …`, then `uart2: …` when `make_uart2` serves the board's control port).
 
     The recording (`record`) is created once every port is open: a port that cannot be
     opened leaves an existing file untouched."""
     sel = selectors.DefaultSelector()
     endpoints: list[Endpoint] = []
     served: list[Served] = []
-    by_endpoint: dict[int, Served] = {}
+    by_endpoint: dict[int, tuple[Served, str]] = {}
     recorder: Recorder | None = None
     try:
-        for make in make_endpoints:
-            endpoints.append(make(sel, log))
+        pairs: list[dict[str, Endpoint]] = []
+        for i, make in enumerate(make_endpoints):
+            pair = {APP: make(sel, log)}
+            if make_uart2 is not None:
+                pair[UART2] = make_uart2[i](sel, log)
+            endpoints += pair.values()
+            pairs.append(pair)
         recorder = Recorder.create(record, 0.0, directives) if record else None
-        for endpoint, board in zip(endpoints, boards, strict=True):
-            baud = getattr(endpoint, "baud", BAUD)
-            one = Served(endpoint, Wire(board, baud if pace else None, recorder))
+        for pair, board in zip(pairs, boards, strict=True):
+            if recorder is not None:
+                recorder.follow(int(board.params[SYSTEM_MODE]), 0.0)
+            bauds = {
+                name: getattr(endpoint, "baud", BAUD if name == APP else UART2_BAUD)
+                for name, endpoint in pair.items()
+            }
+            wire = Wire(
+                board,
+                bauds[APP] if pace else None,
+                recorder,
+                bauds.get(UART2, UART2_BAUD) if pace else None,
+            )
+            one = Served(pair, wire, dict.fromkeys(pair, False))
             served.append(one)
-            by_endpoint[id(endpoint)] = one
-            announce(f"port: {endpoint.url}")
+            for name, endpoint in pair.items():
+                by_endpoint[id(endpoint)] = (one, name)
+            announce(f"port: {pair[APP].url}")
+            if UART2 in pair:
+                announce(f"uart2: {pair[UART2].url}")
         if banner:
             log(banner)
         origin = time.monotonic()
@@ -361,17 +396,17 @@ def serve(
                 if due <= now:
                     one.pump(now)
                     for note in one.wire.board.take_notes():
-                        log(f"{note.time:10.3f}  {note.level:<8} {note.text}")
+                        log(f"{note.time:10.3f}  {note.port} {note.level:<8} {note.text}")
                     one.throttle()
                     due = one.wakeup()
                 wake = min(wake, due)
             timeout = max(0.0, wake - (time.monotonic() - origin))
             for key, _ in sel.select(timeout):
                 reader = key.data
-                one = by_endpoint[id(reader.__self__)]
-                data = reader(max(1, INPUT_BACKLOG - len(one.wire.to_board)))
+                one, name = by_endpoint[id(reader.__self__)]
+                data = reader(max(1, INPUT_BACKLOG - len(one.wire.ports[name].to_board)))
                 if data:
-                    one.receive(data, time.monotonic() - origin)
+                    one.receive(data, time.monotonic() - origin, name)
                     one.throttle()
     finally:
         for endpoint in endpoints:
@@ -394,6 +429,8 @@ def run_board(
     quiet: bool,
     count: int = 1,
     profile: str = "sheet",
+    listen2: str | None = None,
+    device2: str | None = None,
 ) -> int:
     """The `appmode board` command: build the board(s) and serve until interrupted."""
 
@@ -406,19 +443,29 @@ def run_board(
 
     if count < 1:
         raise AppmodeError("--count must be at least 1")
-    if count > 1 and (listen or device or link or flash or record):
+    if count > 1 and (listen or device or link or flash or record or listen2 or device2):
         raise AppmodeError(
             "--count serves several boards on ptys: it cannot be combined "
-            "with --listen, --port, --link, --flash or --record"
+            "with --listen, --port, --listen2, --port2, --link, --flash or --record"
         )
-    make: Callable[[selectors.BaseSelector, Log], Endpoint]
+    if listen2 is not None and device2 is not None:
+        raise AppmodeError("UART2 is served on one endpoint: give --listen2 or --port2, not both")
+    make: MakeEndpoint
     if listen is not None:
         host, port = parse_listen(listen)
         make = partial(_tcp, host=host, port=port)
     elif device is not None:
-        make = partial(_serial, device=device)
+        make = partial(_serial, device=device, baud=BAUD)
     else:
         make = partial(_pty, link=link)
+    make2: MakeEndpoint
+    if listen2 is not None:
+        host, port = parse_listen(listen2, "--listen2")
+        make2 = partial(_tcp, host=host, port=port)
+    elif device2 is not None:
+        make2 = partial(_serial, device=device2, baud=UART2_BAUD)
+    else:
+        make2 = partial(_pty, link=None)
     kind = DriveType.from_cli_name(drive) if drive else None
     rules = profile_named(profile)
     rules.check(drive=kind is not None, flash=flash is not None)
@@ -444,6 +491,7 @@ def run_board(
             record=record,
             banner=banner,
             directives=(f"board {' '.join(needs)}",) if needs else (),
+            make_uart2=[make2] * count,
         )
     except KeyboardInterrupt:
         log("stopped")
@@ -461,5 +509,5 @@ def _tcp(sel: selectors.BaseSelector, log: Log, *, host: str, port: int) -> Endp
     return TcpEndpoint(sel, log, host, port)
 
 
-def _serial(sel: selectors.BaseSelector, log: Log, *, device: str) -> Endpoint:
-    return SerialEndpoint(sel, log, device)
+def _serial(sel: selectors.BaseSelector, log: Log, *, device: str, baud: int) -> Endpoint:
+    return SerialEndpoint(sel, log, device, baud)

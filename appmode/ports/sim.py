@@ -4,14 +4,19 @@
 default, or minibalance: docs/protocol.md §13), `drive` (omni, mecanum, diff, diff-gyro;
 default: what the flash holds, else omni), `flash` (a JSON parameter file; default: in
 memory), `pace` (1: bytes move at the real 9600-bps rate, the default; 0: instantly),
-`baud`, `faults` (a faulty link both ways, see appmode.faults). There is no thread: the
-board runs whenever the port is used.
+`baud`, `faults` (a faulty link both ways, see appmode.faults), `port` (app, the
+default: the APP port, UART3 at 9600 bps; uart2: the control port at 115200 bps,
+docs/protocol.md §8) and `share` (a name: every port opened with the same name in one
+process is a port of one board, so `sim://?share=car` and `sim://?share=car&port=uart2`
+are its two ports). There is no thread: the board runs whenever a port is used.
 """
 
 from __future__ import annotations
 
 import random
+import threading
 import time
+from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
@@ -23,11 +28,14 @@ from appmode.board.profiles import profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec, FaultyLine
-from appmode.line.wire import Wire
+from appmode.line.pacing import Line
+from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
 
-OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults")
+OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults", "port", "share")
+BOARD_OPTIONS = ("profile", "drive", "flash", "pace")
+"""The options that make the board: ports that share one must agree on them."""
 WRITE_BUFFER = 4096
 MIN_BAUD, MAX_BAUD = 300, 4_000_000
 """Paced rates a simulated line takes: below 300 bps closing (which waits for what is
@@ -36,8 +44,23 @@ queued to go out) could take minutes."""
 USAGE = (
     "sim://[?profile=sheet|minibalance][&drive=omni|mecanum|diff|diff-gyro][&flash=FILE]"
     "[&pace=1|0][&baud=9600]"
-    "[&faults=drop:0.01,corrupt:0.01,…]"
+    "[&faults=drop:0.01,corrupt:0.01,…][&port=app|uart2][&share=NAME]"
 )
+
+
+@dataclass
+class Shared:
+    """A board and its wire, used by every port opened on it."""
+
+    wire: Wire
+    origin: float
+    options: tuple[tuple[str, str], ...]
+    lock: threading.RLock = field(default_factory=threading.RLock)
+    open_ports: set[str] = field(default_factory=set)
+
+
+_SHARED: dict[str, Shared] = {}
+_SHARED_LOCK = threading.Lock()
 
 
 def parse_sim_url(url: str) -> dict[str, str]:
@@ -77,6 +100,9 @@ class SimSerial(SerialBase):  # type: ignore[misc]
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         self._wire: Wire | None = None
+        self._shared: Shared | None = None
+        self._share_name: str | None = None
+        self._side = APP
         self._faults: tuple[FaultyLine, FaultyLine] | None = None
         self._rx = bytearray()
         self._origin = 0.0
@@ -89,6 +115,9 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         if self._port is None:
             raise SerialException("port must be configured before it can be used")
         options = parse_sim_url(self._port)
+        side = options.get("port", APP).lower()
+        if side not in PORTS:
+            raise SerialException(f"sim:// option port={side!r}: use {' or '.join(PORTS)}")
         try:
             drive = DriveType.from_cli_name(options["drive"]) if "drive" in options else None
         except ValueError as exc:
@@ -105,6 +134,8 @@ class SimSerial(SerialBase):  # type: ignore[misc]
                     f"sim:// option baud={options['baud']!r}: use a number in {MIN_BAUD}–{MAX_BAUD}"
                 )
             self._baudrate = baud
+        elif side == UART2:
+            self._baudrate = UART2_BAUD
         pace = _flag("pace", options.get("pace", "1"))
         try:
             spec = FaultSpec.parse(options.get("faults", ""))
@@ -112,21 +143,53 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             raise SerialException(f"sim:// option faults: {exc}") from None
         rng = random.Random(spec.seed)
         self._faults = (FaultyLine(spec, rng), FaultyLine(spec, rng)) if spec.active else None
-        try:  # the flash is opened last: nothing after it can fail and leave it locked
-            store = open_store(options.get("flash"))
-        except AppmodeError as exc:
-            raise SerialException(str(exc)) from None
-        self.board = Board(store, drive=drive, profile=profile)
-        self._wire = Wire(self.board, self._baudrate if pace else None)
+        name = options.get("share")
+        made = tuple((key, options[key]) for key in BOARD_OPTIONS if key in options)
+        with _SHARED_LOCK:
+            shared = _SHARED.get(name) if name is not None else None
+            if shared is None:
+                try:  # the flash is opened last: nothing after it can fail and leave it locked
+                    store = open_store(options.get("flash"))
+                except AppmodeError as exc:
+                    raise SerialException(str(exc)) from None
+                board = Board(store, drive=drive, profile=profile)
+                shared = Shared(Wire(board, None, None, None), time.monotonic(), made)
+                if name is not None:
+                    _SHARED[name] = shared
+            elif shared.options != made:
+                raise SerialException(
+                    f"sim:// share={name}: its board is open with "
+                    f"{dict(shared.options) or 'no options'}; open this port with the same "
+                    f"{', '.join(BOARD_OPTIONS)}"
+                )
+            if side in shared.open_ports:
+                raise SerialException(f"sim:// share={name}: its {side} port is already open")
+            shared.open_ports.add(side)
+        baud = self._baudrate if pace else None
+        port = shared.wire.ports[side]
+        port.to_board, port.to_host = Line(baud), Line(baud)
+        if side == APP:
+            shared.wire.to_board, shared.wire.to_host = port.to_board, port.to_host
+        self._shared, self._share_name, self._side = shared, name, side
+        self._wire = shared.wire
+        self.board = shared.wire.board
         self._rx.clear()
-        self._origin = time.monotonic()
+        self._origin = shared.origin
         self.is_open = True
 
     def close(self) -> None:
         self.is_open = False
         self._wire = None
-        if self.board is not None:
-            self.board.store.close()
+        shared, self._shared = self._shared, None
+        if shared is None:
+            return
+        with _SHARED_LOCK:
+            shared.open_ports.discard(self._side)
+            if shared.open_ports:
+                return
+            if self._share_name is not None:
+                _SHARED.pop(self._share_name, None)
+        shared.wire.board.store.close()
 
     def _reconfigure_port(self, force_update: bool = False) -> None:
         """Settings change nothing in the simulation (the line rate is fixed at open)."""
@@ -135,23 +198,31 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         return time.monotonic() - self._origin
 
     def _pump(self) -> Wire:
-        if not self.is_open or self._wire is None:
+        wire, shared = self._wire, self._shared
+        if not self.is_open or wire is None or shared is None:
             raise serial.PortNotOpenError()
-        now = self._now()
-        if self._faults is None:
-            self._rx += self._wire.pump(now)
-            return self._wire
-        to_board, to_host = self._faults
-        self._wire.write(to_board.take(now), now)
-        to_host.push(self._wire.pump(now), now)
-        self._rx += to_host.take(now)
-        return self._wire
+        side = self._side
+        with shared.lock:
+            now = self._now()
+            if self._faults is None:
+                self._rx += wire.pump(now, side)
+                return wire
+            to_board, to_host = self._faults
+            wire.write(to_board.take(now), now, side)
+            to_host.push(wire.pump(now, side), now)
+            self._rx += to_host.take(now)
+        return wire
 
     def _next_wakeup(self, wire: Wire) -> float:
-        times = [wire.next_wakeup()]
+        assert self._shared is not None
+        with self._shared.lock:
+            times = [wire.next_wakeup()]
         if self._faults is not None:
             times += [t for line in self._faults if (t := line.next_due()) is not None]
         return min(times)
+
+    def _line(self, wire: Wire) -> Line:
+        return wire.ports[self._side].to_board
 
     @property
     def in_waiting(self) -> int:
@@ -160,7 +231,7 @@ class SimSerial(SerialBase):  # type: ignore[misc]
 
     @property
     def out_waiting(self) -> int:
-        return len(self._pump().to_board)
+        return len(self._line(self._pump()))
 
     def read(self, size: int = 1) -> bytes:
         wire = self._pump()
@@ -181,18 +252,20 @@ class SimSerial(SerialBase):  # type: ignore[misc]
     def write(self, data: bytes) -> int:
         wire = self._pump()
         payload = serial.to_bytes(data)
-        while len(wire.to_board) > WRITE_BUFFER:  # the line is slower than the writer
-            time.sleep(max(0.0, wire.next_wakeup() - self._now()))
+        while len(self._line(wire)) > WRITE_BUFFER:  # the line is slower than the writer
+            time.sleep(max(0.0, self._next_wakeup(wire) - self._now()))
             wire = self._pump()
         if self._faults is None:
-            wire.write(payload, self._now())
+            assert self._shared is not None
+            with self._shared.lock:
+                wire.write(payload, self._now(), self._side)
         else:
             self._faults[0].push(payload, self._now())
         return len(payload)
 
     def flush(self) -> None:
         wire = self._pump()
-        while wire.to_board.next_due() is not None or (
+        while self._line(wire).next_due() is not None or (
             self._faults is not None and self._faults[0].next_due() is not None
         ):
             time.sleep(max(0.0, self._next_wakeup(wire) - self._now()))

@@ -489,9 +489,7 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
     return ParamsRecord(values, terminated, raw)  # out-of-range values too: boards hold them
 
 
-_FAST = re.compile(
-    rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)"
-)
+_FAST = re.compile(rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")
 """A complete A or B record: the common case, decoded without the general path. It opens
 with a literal `{`, so the search skips to each `{` and fails within a few bytes there:
 linear in the input, whatever it holds."""

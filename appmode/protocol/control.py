@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from appmode.protocol import app, settings
+from appmode.protocol import app, params, settings
 from appmode.protocol.params import DriveType
 from appmode.protocol.settings import Read, Setting, StoreOp
 
@@ -162,6 +162,16 @@ class EncoderReport:
 BoardEvent = Reply | EncoderReport | Garbage | app.BoardEvent
 ERRORS = (BadFrame, Garbage)
 """Event types that carry bytes which decoded to nothing."""
+
+
+def system_mode_set(event: object) -> int | None:
+    """The system_mode that an APP set frame or a UART2 settings frame sets, or None."""
+    if isinstance(event, app.SetParam) and event.index == params.SYSTEM_MODE:
+        return event.value
+    if isinstance(event, SetSetting) and event.setting.param == params.SYSTEM_MODE:
+        return event.value
+    return None
+
 
 # ---------------------------------------------------------------- encoding
 
@@ -334,10 +344,25 @@ class HostDecoder:
     LIMIT = max(MOTOR_FRAME_4, MAX_RUN)
     """Most bytes ever held between calls."""
 
-    def __init__(self, drive: DriveType = DriveType.OMNI, motor_width: int = 2) -> None:
+    def __init__(
+        self, drive: DriveType = DriveType.OMNI, motor_width: int = 2, app_mode: bool = False
+    ) -> None:
         self._buf = b""
         self.motor_width = motor_width
         self.drive = drive
+        self._app: app.HostDecoder | None = app.HostDecoder() if app_mode else None
+
+    @property
+    def app_mode(self) -> bool:
+        return self._app is not None
+
+    def set_app_mode(self, on: bool) -> list[HostEvent | app.HostEvent]:
+        """Switch between binary frames and APP commands (§12); what was held is reported."""
+        if on == self.app_mode:
+            return []
+        out = self.flush()
+        self._app = app.HostDecoder() if on else None
+        return out
 
     @property
     def drive(self) -> DriveType:
@@ -357,11 +382,13 @@ class HostDecoder:
 
     @property
     def buffered(self) -> int:
-        return len(self._buf)
+        return len(self._buf) + (self._app.buffered if self._app else 0)
 
-    def feed(self, data: bytes) -> list[HostEvent]:
+    def feed(self, data: bytes) -> list[HostEvent | app.HostEvent]:
+        if self._app is not None:
+            return list(self._app.feed(data))
         buf = self._buf + data if self._buf else bytes(data)
-        out: list[HostEvent] = []
+        out: list[HostEvent | app.HostEvent] = []
         pos, n = 0, len(buf)
         lengths = self._lengths
         while pos < n:
@@ -388,8 +415,10 @@ class HostDecoder:
         self._buf = buf[pos:]
         return out
 
-    def flush(self) -> list[HostEvent]:
+    def flush(self) -> list[HostEvent | app.HostEvent]:
         """Report what is held at the end of the stream (a truncated frame)."""
+        if self._app is not None:
+            return list(self._app.flush())
         raw, self._buf = self._buf, b""
         if not raw:
             return []

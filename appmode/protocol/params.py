@@ -130,9 +130,7 @@ def value_error(index: int, value: int) -> str | None:
 
 def changes(old: Sequence[int], new: Sequence[int]) -> list[str]:
     """`name old → new` for each parameter that differs."""
-    return [
-        f"{p.name} {a} → {b}" for p, a, b in zip(PARAMS, old, new, strict=True) if a != b
-    ]
+    return [f"{p.name} {a} → {b}" for p, a, b in zip(PARAMS, old, new, strict=True) if a != b]
 
 
 def check_value(index: int, value: int) -> None:

@@ -6,13 +6,15 @@ import codecs
 import contextlib
 import itertools
 import os
+import re
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
-from appmode.protocol import app
+from appmode.protocol import app, control, params
 from appmode.protocol.escaping import escape, unescape
+from appmode.protocol.params import DriveType
 
 HEADER = "# appmode transcript v1"
 SUFFIX = ".transcript"
@@ -21,6 +23,35 @@ MAX_TIME = 86400.0
 could not finish."""
 MAX_LINE = 64 * 1024
 """Bytes a line may have: a recorded line is one command or record, well under this."""
+SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
+DIRECTIONS = (SENT, RECEIVED, SENT2, RECEIVED2)
+UART2_DIRECTIONS = (SENT2, RECEIVED2)
+HEX_LINE = re.compile(r"(?:[0-9A-F]{2}|\?\?)(?: (?:[0-9A-F]{2}|\?\?))*")
+"""A UART2 line of bytes as hex pairs (`??`: any byte, in an expectation). A UART2 line
+of any other form is APP text (escaped), as UART2 carries in APP mode (§12); a recorder
+writes such text so that it never has this form."""
+
+
+def uart2_payload(raw: bytes, text: bool) -> str:
+    """A UART2 line's payload: hex pairs, or with `text` (APP mode) escaped text, with
+    every byte as `\\xNN` where plain escaping would look like hex pairs."""
+    if not text:
+        return raw.hex(" ").upper()
+    shown = escape(raw)
+    if HEX_LINE.fullmatch(shown):
+        return "".join(f"\\x{b:02X}" for b in raw)
+    return shown
+
+
+def uart2_bytes(payload: str) -> tuple[bytes, bytes] | None:
+    """A hex UART2 payload as (bytes with 00 for `??`, mask with 00 where `??`), or None
+    when it is text."""
+    if not HEX_LINE.fullmatch(payload):
+        return None
+    pairs = payload.split(" ")
+    data = bytes(0 if p == "??" else int(p, 16) for p in pairs)
+    mask = bytes(0 if p == "??" else 0xFF for p in pairs)
+    return data, mask
 
 
 class Recorder:
@@ -36,11 +67,16 @@ class Recorder:
         self.name = str(getattr(out, "name", "the transcript"))
         self._failed = False
         self._origin = origin
-        self._decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
-            ">": app.HostDecoder(),
-            "<": app.BoardDecoder(),
+        self._decoders: dict[
+            str, app.HostDecoder | app.BoardDecoder | control.HostDecoder | control.BoardDecoder
+        ] = {
+            SENT: app.HostDecoder(),
+            RECEIVED: app.BoardDecoder(),
+            SENT2: control.HostDecoder(),
+            RECEIVED2: control.BoardDecoder(),
         }
-        self._last = {">": origin, "<": origin}
+        self._app_mode = False
+        self._last = dict.fromkeys(DIRECTIONS, origin)
         self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
 
     @classmethod
@@ -66,9 +102,32 @@ class Recorder:
         self._last[direction] = time
         for event in self._decoders[direction].feed(data):
             self._line(time, direction, event.raw)
+            mode = control.system_mode_set(event)
+            if mode is not None:
+                self.follow(mode, time)
+
+    def follow(self, system_mode: int, time: float) -> None:
+        """Read UART2 as a board with this system_mode does: its drive type fixes the
+        length of motor frames and encoder reports, bit 7 makes UART2 APP text."""
+        drive = params.drive_type(system_mode) or DriveType.OMNI
+        host = self._decoders[SENT2]
+        board = self._decoders[RECEIVED2]
+        assert isinstance(host, control.HostDecoder) and isinstance(board, control.BoardDecoder)
+        on = bool(system_mode & params.MODE_BIT["app_mode"])
+        for event in host.set_app_mode(on):
+            self._line(time, SENT2, event.raw)
+        for reply in board.set_app_mode(on):
+            self._line(time, RECEIVED2, reply.raw)
+        self._app_mode = on
+        host.drive = drive
+        board.wheels = control.motor_count(drive)
 
     def _line(self, time: float, direction: str, raw: bytes) -> None:
-        self._write(f"{max(0.0, time - self._origin):.4f} {direction} {escape(raw)}\n")
+        if direction in UART2_DIRECTIONS:
+            payload = uart2_payload(raw, self._app_mode)
+        else:
+            payload = escape(raw)
+        self._write(f"{max(0.0, time - self._origin):.4f} {direction} {payload}\n")
 
     def _write(self, text: str) -> None:
         try:
@@ -198,8 +257,7 @@ def _parse(lines: Iterable[tuple[int, str]], path: str) -> Transcript:
         stripped = line.strip()
         if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
             raise TranscriptError(
-                f"{where}: {_cut(stripped[2:])!r} is not a version this appmode reads "
-                "(it reads v1)"
+                f"{where}: {_cut(stripped[2:])!r} is not a version this appmode reads (it reads v1)"
             )
         if not stripped:
             continue
@@ -211,9 +269,7 @@ def _parse(lines: Iterable[tuple[int, str]], path: str) -> Transcript:
             name, *args = stripped[1:].split() or [""]
             if name not in DIRECTIVES:
                 known = ", ".join(f"@{d}" for d in DIRECTIVES)
-                raise TranscriptError(
-                    f"{where}: unknown directive @{_cut(name)} (known: {known})"
-                )
+                raise TranscriptError(f"{where}: unknown directive @{_cut(name)} (known: {known})")
             items.append(Directive(lineno, name, tuple(args)))
             continue
         items.append(_entry(line.rstrip("\r\n"), lineno, where))
@@ -243,11 +299,16 @@ def _entry(line: str, lineno: int, where: str) -> Entry:
             f"{where}: time {_cut(time_text)!r} is more than a day (seconds in 0–{MAX_TIME:g}): "
             "split the transcript"
         )
-    if direction not in (">", "<"):
+    if direction not in DIRECTIONS:
         raise TranscriptError(
             f"{where}: direction {_cut(direction)!r} must be '>' (host to board) or '<' "
-            "(board to host)"
+            "(board to host) on the APP port, '2>' or '2<' on UART2"
         )
+    hexed = uart2_bytes(payload) if direction in UART2_DIRECTIONS else None
+    if hexed is not None:
+        if direction == SENT2 and "??" in payload:
+            raise TranscriptError(f"{where}: '??' matches a byte the board sends: not in a 2> line")
+        return Entry(lineno, time, direction, hexed[0], payload)
     try:
         data = unescape(payload)
     except ValueError as exc:
