@@ -29,6 +29,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     conform.add_argument(
         "--board", metavar="URL", help="run in real time against this board instead"
     )
+    conform.add_argument(
+        "--board2",
+        metavar="URL",
+        help="with --board: the same board's control port (UART2), for transcripts with "
+        "2> / 2< lines (a sim:// board has its own; elsewhere they are skipped without it)",
+    )
     add_profile(
         conform,
         "run the transcripts written for this board profile (@board profile=…); "
@@ -63,4 +69,8 @@ def run(args: argparse.Namespace) -> int:
         if sys.stdin.readline().strip().lower() not in ("y", "yes"):
             print("not run", file=sys.stderr)
             return 1
-    return run_conform(args.paths, args.board, args.junit, sys.stdout, args.profile)
+    if args.board2 and not args.board:
+        raise AppmodeError("--board2 names the control port of the --board: give --board too")
+    return run_conform(
+        args.paths, args.board, args.junit, sys.stdout, args.profile, board2=args.board2
+    )

@@ -36,8 +36,8 @@ def is_simulated(url: str) -> bool:
     return url.lower().startswith("sim://")
 
 
-def open_link(url: str, timeout: float | None = 0.05) -> serial.SerialBase:
-    """An open pyserial port for `url`, at 9600 8N1 unless the URL says otherwise."""
+def open_link(url: str, timeout: float | None = 0.05, baud: int = BAUD) -> serial.SerialBase:
+    """An open pyserial port for `url`, at `baud` (9600) 8N1 unless the URL says otherwise."""
     if "://" in url:
         scheme = url.split("://", 1)[0].lower()
         if scheme not in SCHEMES:
@@ -45,10 +45,10 @@ def open_link(url: str, timeout: float | None = 0.05) -> serial.SerialBase:
         if scheme in NETWORK_SCHEMES:
             _check_address(url, scheme)
         try:
-            return serial.serial_for_url(url, baudrate=BAUD, timeout=timeout)
+            return serial.serial_for_url(url, baudrate=baud, timeout=timeout)
         except (serial.SerialException, ValueError, OSError) as exc:
             raise AppmodeError(explain_open_error(url, exc)) from None
-    path, baud = parse_device(url)
+    path, baud = parse_device(url, baud)
     try:
         return serial.Serial(path, baudrate=baud, timeout=timeout, exclusive=os.name == "posix")
     except (serial.SerialException, ValueError, OSError) as exc:

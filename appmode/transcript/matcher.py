@@ -1,7 +1,9 @@
 """Transcripts as conformance tests (design.md): the matcher, with no I/O.
 
-`>` lines are sent at their times. Each `<` line that is a record is an expectation, to
-be matched in file order by a record the board sends; `*` in place of a field matches
+`>` lines are sent at their times (`2>` lines on UART2). Each `<` line that is a record
+is an expectation, to be matched in file order by a record the board sends (each `2<`
+line of hex pairs by a reply, report or undecodable run on UART2 with those bytes, `??`
+matching any byte); `*` in place of a field matches
 any integer, `LO..HI` any integer from LO to HI (`{A0:4..16:*:0}$`). A record matches an
 expectation only once every `>` line before it in the file has been sent, and within
 `tolerance` seconds of its time (default TOLERANCE). Other records are ignored — unless
@@ -21,10 +23,23 @@ from dataclasses import dataclass, field
 
 from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.errors import AppmodeError
-from appmode.protocol import app
+from appmode.protocol import app, control, params
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
-from appmode.protocol.transcript import MAX_TIME, Directive, Entry, Transcript
+from appmode.protocol.transcript import (
+    MAX_TIME,
+    RECEIVED2,
+    SENT,
+    SENT2,
+    Directive,
+    Entry,
+    Transcript,
+    uart2_bytes,
+)
+
+APP_PORT, UART2_PORT = "app", "uart2"
+Unit = app.Record | app.BoardEvent | object
+"""What a port delivers, one decoded unit: a record, or on UART2 a reply or report."""
 
 TOLERANCE = 0.5
 _FIELD = r"(?:-?\d+(?:\.\.-?\d+)?|\*)"
@@ -41,7 +56,13 @@ class Pattern:
     fields: tuple[Span, ...]
     text: str
 
-    def matches(self, record: app.Record) -> bool:
+    @property
+    def what(self) -> str:
+        return f"{self.letter} record"
+
+    def matches(self, record: Unit) -> bool:
+        if not isinstance(record, app.RECORDS):
+            return False
         letter, values = app.record_fields(record)
         return (
             letter == self.letter
@@ -49,6 +70,25 @@ class Pattern:
             and all(
                 f is None or f[0] <= v <= f[1] for f, v in zip(self.fields, values, strict=True)
             )
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class BytesPattern:
+    """A UART2 unit as hex pairs, `??` for any byte: `23 01 ?? ?? ?? ??`."""
+
+    data: bytes
+    mask: bytes
+    text: str
+
+    @property
+    def what(self) -> str:
+        return f"UART2 unit {self.data[:1].hex().upper()}"
+
+    def matches(self, unit: Unit) -> bool:
+        raw: bytes = getattr(unit, "raw", b"")
+        return len(raw) == len(self.data) and all(
+            (a ^ b) & m == 0 for a, b, m in zip(raw, self.data, self.mask, strict=True)
         )
 
 
@@ -69,10 +109,36 @@ def _span(text: str) -> Span:
     return (int(low), int(high or low))
 
 
+class Uart2Reader:
+    """Decodes what UART2 delivers as a board with the system_mode the sends set would
+    send it: the drive type fixes a report's length, bit 7 makes it APP text (§12)."""
+
+    def __init__(self, drive: DriveType | None) -> None:
+        self._decoder = control.BoardDecoder(control.motor_count(drive or DriveType.OMNI))
+        self._hosts: dict[str, app.HostDecoder | control.HostDecoder] = {
+            APP_PORT: app.HostDecoder(),
+            UART2_PORT: control.HostDecoder(),
+        }
+
+    def sent(self, port: str, data: bytes) -> list[Unit]:
+        """Follow what the host sends; what the decoder held when the mode changed."""
+        out: list[Unit] = []
+        for event in self._hosts[port].feed(data):
+            mode = control.system_mode_set(event)
+            if mode is not None:
+                out += self._decoder.set_app_mode(bool(mode & params.MODE_BIT["app_mode"]))
+                drive = params.drive_type(mode) or DriveType.OMNI
+                self._decoder.wheels = control.motor_count(drive)
+        return out
+
+    def received(self, data: bytes) -> list[Unit]:
+        return list(self._decoder.feed(data))
+
+
 @dataclass(frozen=True, slots=True)
 class Expectation:
     entry: Entry
-    pattern: Pattern
+    pattern: Pattern | BytesPattern
     tolerance: float
     strict: bool
     after: float
@@ -112,11 +178,13 @@ class Check:
                 align = True
             elif isinstance(item, Directive):
                 tolerance, strict = self._directive(item, tolerance, strict)
-            elif item.direction == ">":
+            elif item.direction in (SENT, SENT2):
                 self.sends.append(item)
                 last_send = max(last_send, item.time)
-            elif (pattern := parse_pattern(item.text)) is not None:
-                if any(f is not None and f[0] > f[1] for f in pattern.fields):
+            elif (pattern := _expected(item)) is not None:
+                if isinstance(pattern, Pattern) and any(
+                    f is not None and f[0] > f[1] for f in pattern.fields
+                ):
                     raise AppmodeError(
                         f"{self.transcript.path}:{item.lineno}: {item.text}: a field LO..HI "
                         "needs LO <= HI"
@@ -162,13 +230,20 @@ class Check:
         last = max((e.entry.time + e.tolerance for e in self.expectations), default=0.0)
         return max(last, self.transcript.duration)
 
-    def due(self, now: float) -> list[bytes]:
-        """The `>` payloads to send by `now`."""
+    def due(self, now: float) -> list[tuple[str, bytes]]:
+        """The `>` and `2>` payloads to send by `now`, each with its port."""
         out = []
         while self.sent < len(self.sends) and self.sends[self.sent].time <= now:
-            out.append(self.sends[self.sent].data)
+            entry = self.sends[self.sent]
+            out.append((UART2_PORT if entry.direction == SENT2 else APP_PORT, entry.data))
             self.sent += 1
         return out
+
+    @property
+    def uses_uart2(self) -> bool:
+        return any(e.direction == SENT2 for e in self.sends) or any(
+            e.entry.direction == RECEIVED2 for e in self.expectations
+        )
 
     def next_time(self) -> float | None:
         """The next time something is due: a send, or an expectation's deadline."""
@@ -182,12 +257,21 @@ class Check:
             times.append(self._deadline(exp))
         return min(times) if times else None
 
-    def on_record(self, record: app.Record, now: float) -> None:
+    def on_record(self, record: Unit, now: float, port: str = APP_PORT) -> None:
+        """A unit the board sent on `port`, decoded, at `now`."""
         if self.done or self.matched >= len(self.expectations):
             return
         exp = self.expectations[self.matched]
-        letter, _ = app.record_fields(record)
-        shown = escape(record.raw) if record.raw else escape(app.encode(record))
+        if (exp.entry.direction == RECEIVED2) != (port == UART2_PORT):
+            return  # the other port's: ignored like unmentioned telemetry
+        raw: bytes = getattr(record, "raw", b"")
+        if port == UART2_PORT and isinstance(exp.pattern, BytesPattern):
+            letter, shown = f"2<{raw[:1].hex()}", raw.hex(" ").upper()
+        elif isinstance(record, app.RECORDS):
+            letter = app.record_fields(record)[0]
+            shown = escape(raw) if raw else escape(app.encode(record))
+        else:
+            return
         if not self._active(exp):
             return  # what comes before the commands it answers is not an answer
         if not exp.align and now < self._time(exp) - exp.tolerance:
@@ -220,8 +304,9 @@ class Check:
             return
         exp = self.expectations[self.matched]
         if now >= self._deadline(exp):
-            seen = self.closest.get(exp.pattern.letter)
-            what = f"got {seen[1]} instead" if seen else f"no {exp.pattern.letter} record came"
+            key = exp.pattern.letter if isinstance(exp.pattern, Pattern) else None
+            seen = self.closest.get(key) if key else next(iter(self.closest.values()), None)
+            what = f"got {seen[1]} instead" if seen else f"no {exp.pattern.what} came"
             self._fail(exp, f"nothing matched by {self._deadline(exp):.3f} s; {what}")
 
     def _deadline(self, exp: Expectation) -> float:
@@ -232,6 +317,15 @@ class Check:
             f"{self.transcript.path}:{exp.entry.lineno}: expected {exp.pattern.text} at "
             f"{self._time(exp):.3f} s (±{exp.tolerance:g} s); {what}"
         )
+
+
+def _expected(entry: Entry) -> Pattern | BytesPattern | None:
+    """The expectation of a `<` or `2<` line, or None when it expects nothing."""
+    if entry.direction == RECEIVED2:
+        hexed = uart2_bytes(entry.text)
+        if hexed is not None:
+            return BytesPattern(hexed[0], hexed[1], entry.text)
+    return parse_pattern(entry.text)
 
 
 def _board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import itertools
 import sys
 import time
 import xml.etree.ElementTree as ET
@@ -11,17 +13,19 @@ from io import BytesIO
 from pathlib import Path
 from typing import TextIO
 
+import serial
+
 from appmode.board.firmware import Board
 from appmode.board.profiles import Profile, profile_named
 from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.host.client import Host, LinkLost
-from appmode.line.wire import Wire
-from appmode.ports.link import is_simulated
+from appmode.line.wire import UART2_BAUD, Wire
+from appmode.ports.link import is_simulated, open_link
 from appmode.protocol import app, params
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
-from appmode.transcript.matcher import Check
+from appmode.transcript.matcher import UART2_PORT, Check, Uart2Reader
 
 Progress = Callable[[str], None]
 
@@ -46,11 +50,18 @@ def run_virtual(transcript: Transcript) -> Result:
     needs = check.needs
     wire = Wire(Board(MemoryStore(), drive=needs.drive, profile=needs.profile), 9600)
     decoder = app.BoardDecoder()
+    uart2 = Uart2Reader(needs.drive)
     now = 0.0
     while not check.done and now <= check.end:
-        for data in check.due(now):
-            wire.write(data, now)
+        # what arrived by `now` first: it came before what is sent at `now`
         _feed(check, decoder, wire.pump_timed(now))
+        for when, data in wire.pump_timed(now, UART2_PORT):
+            for unit in uart2.received(data):
+                check.on_record(unit, when, UART2_PORT)
+        for port, data in check.due(now):
+            wire.write(data, now, port)
+            for unit in uart2.sent(port, data):
+                check.on_record(unit, now, UART2_PORT)
         check.on_time(now)
         due = check.next_time()
         if due is None:
@@ -78,11 +89,33 @@ def _result(transcript: Transcript, check: Check, now: float, wall: float) -> Re
     return Result(transcript.path, transcript.title, failure is None, now, wall, failure)
 
 
-def run_live(transcript: Transcript, url: str, progress: Progress | None = None) -> Result:
-    """Run in real time against any board URL."""
+def _shared(url: str) -> tuple[str, str]:
+    """Both ports of one new sim:// board."""
+    base = f"{url}{'&' if '?' in url else '?'}share=conform-{next(_SHARES)}"
+    return base, f"{base}&port=uart2"
+
+
+_SHARES = itertools.count(1)
+
+
+def run_live(
+    transcript: Transcript, url: str, progress: Progress | None = None, url2: str | None = None
+) -> Result:
+    """Run in real time against any board URL (and its control port at `url2`)."""
     started = time.perf_counter()
     check = Check(transcript)
-    with Host(url) as host:
+    link2 = None
+    if check.uses_uart2:
+        if url2 is None and is_simulated(url):
+            url, url2 = _shared(url)
+        if url2 is None:
+            why = "has UART2 lines: give the board's control port with --board2 URL"
+            return Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
+    with Host(url) as host, contextlib.ExitStack() as stack:
+        if url2 is not None and check.uses_uart2:
+            link2 = open_link(url2, timeout=0, baud=UART2_BAUD)
+            stack.callback(link2.close)
+        uart2 = Uart2Reader(check.needs.drive)
         if check.needs.drive is not None:
             values = host.read_params()
             have = params.drive_type(values[params.SYSTEM_MODE])
@@ -106,16 +139,34 @@ def run_live(transcript: Transcript, url: str, progress: Progress | None = None)
         while not check.done:
             now = host.now() - origin
             try:
-                for data in check.due(now):
-                    host.send(data)
+                for port, data in check.due(now):
+                    if port == UART2_PORT and link2 is not None:
+                        link2.write(data)
+                    else:
+                        host.send(data)
+                    for unit in uart2.sent(port, data):
+                        check.on_record(unit, now, UART2_PORT)
             except LinkLost as exc:
                 check.failure = f"{transcript.path}: at {now:.3f} s: {exc}"
                 break
+            except (serial.SerialException, OSError) as exc:
+                check.failure = f"{transcript.path}: at {now:.3f} s: UART2 link lost: {exc}"
+                break
             due = check.next_time()
-            wait = 0.05 if due is None else max(0.0, min(0.05, due - now))
+            most = 0.005 if link2 is not None else 0.05
+            wait = most if due is None else max(0.0, min(most, due - now))
             for event in host.poll(wait):
                 if isinstance(event, app.RECORDS):
                     check.on_record(event, host.now() - origin)
+            if link2 is not None:
+                try:
+                    waiting = link2.in_waiting
+                    data = link2.read(waiting) if waiting else b""
+                except (serial.SerialException, OSError) as exc:
+                    check.failure = f"{transcript.path}: UART2 link lost: {exc}"
+                    break
+                for unit in uart2.received(data):
+                    check.on_record(unit, host.now() - origin, UART2_PORT)
             check.on_time(host.now() - origin)
             if progress is not None and int(now * 2) != shown:
                 shown = int(now * 2)
@@ -173,7 +224,12 @@ def write_junit(path: str, results: list[Result]) -> None:
 
 
 def run_conform(
-    paths: list[str], board: str | None, junit: str | None, out: TextIO, profile: str = "sheet"
+    paths: list[str],
+    board: str | None,
+    junit: str | None,
+    out: TextIO,
+    profile: str = "sheet",
+    board2: str | None = None,
 ) -> int:
     """Run every transcript for `profile`; one line each; exit status 1 on any failure."""
     if junit:
@@ -200,7 +256,7 @@ def run_conform(
     found = _read_params(board) if live and board is not None else None
     results: list[Result] = []
     try:
-        _run_all(transcripts, board, progress, interactive, results, out)
+        _run_all(transcripts, board, progress, interactive, results, out, board2)
     finally:
         if board is not None and found is not None:
             out.write(restore_params(board, found) + "\n")
@@ -222,6 +278,7 @@ def _run_all(
     interactive: bool,
     results: list[Result],
     out: TextIO,
+    board2: str | None = None,
 ) -> None:
     for transcript in transcripts:
         needs = Check(transcript).needs
@@ -231,7 +288,7 @@ def _run_all(
             why = "starts at the board's power-up: run it on virtual time (no --board)"
             result = Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
         else:
-            result = run_live(transcript, board, progress)
+            result = run_live(transcript, board, progress, board2)
             if interactive:
                 print("\r\033[K", end="", file=sys.stderr, flush=True)
         results.append(result)
