@@ -12,9 +12,8 @@ from dataclasses import dataclass
 from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
-from appmode.protocol import app, control, params
 from appmode.protocol.escaping import escape, unescape
-from appmode.protocol.params import DriveType
+from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2, PortsReader
 
 HEADER = "# appmode transcript v1"
 SUFFIX = ".transcript"
@@ -23,7 +22,6 @@ MAX_TIME = 86400.0
 could not finish."""
 MAX_LINE = 64 * 1024
 """Bytes a line may have: a recorded line is one command or record, well under this."""
-SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
 DIRECTIONS = (SENT, RECEIVED, SENT2, RECEIVED2)
 UART2_DIRECTIONS = (SENT2, RECEIVED2)
 HEX_LINE = re.compile(r"(?:[0-9A-F]{2}|\?\?)(?: (?:[0-9A-F]{2}|\?\?))*")
@@ -67,15 +65,7 @@ class Recorder:
         self.name = str(getattr(out, "name", "the transcript"))
         self._failed = False
         self._origin = origin
-        self._decoders: dict[
-            str, app.HostDecoder | app.BoardDecoder | control.HostDecoder | control.BoardDecoder
-        ] = {
-            SENT: app.HostDecoder(),
-            RECEIVED: app.BoardDecoder(),
-            SENT2: control.HostDecoder(),
-            RECEIVED2: control.BoardDecoder(),
-        }
-        self._app_mode = False
+        self._reader = PortsReader()
         self._last = dict.fromkeys(DIRECTIONS, origin)
         self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
 
@@ -100,31 +90,17 @@ class Recorder:
 
     def __call__(self, direction: str, time: float, data: bytes) -> None:
         self._last[direction] = time
-        for event in self._decoders[direction].feed(data):
-            self._line(time, direction, event.raw)
-            mode = control.system_mode_set(event)
-            if mode is not None:
-                self.follow(mode, time)
+        for shown, event in self._reader.feed(direction, data):
+            self._line(time, shown, event.raw)
 
     def follow(self, system_mode: int, time: float) -> None:
-        """Read UART2 as a board with this system_mode does: its drive type fixes the
-        length of motor frames and encoder reports, bit 7 makes UART2 APP text."""
-        drive = params.drive_type(system_mode) or DriveType.OMNI
-        host = self._decoders[SENT2]
-        board = self._decoders[RECEIVED2]
-        assert isinstance(host, control.HostDecoder) and isinstance(board, control.BoardDecoder)
-        on = bool(system_mode & params.MODE_BIT["app_mode"])
-        for event in host.set_app_mode(on):
-            self._line(time, SENT2, event.raw)
-        for reply in board.set_app_mode(on):
-            self._line(time, RECEIVED2, reply.raw)
-        self._app_mode = on
-        host.drive = drive
-        board.wheels = control.motor_count(drive)
+        """Read UART2 as a board with this system_mode does (`PortsReader.follow`)."""
+        for shown, event in self._reader.follow(system_mode):
+            self._line(time, shown, event.raw)
 
     def _line(self, time: float, direction: str, raw: bytes) -> None:
         if direction in UART2_DIRECTIONS:
-            payload = uart2_payload(raw, self._app_mode)
+            payload = uart2_payload(raw, self._reader.app_mode)
         else:
             payload = escape(raw)
         self._write(f"{max(0.0, time - self._origin):.4f} {direction} {payload}\n")
@@ -149,9 +125,8 @@ class Recorder:
                 with contextlib.suppress(OSError):
                     self._out.close()
             return
-        for direction, decoder in self._decoders.items():
-            for event in decoder.flush():
-                self._line(self._last[direction], direction, event.raw)
+        for direction, event in self._reader.flush():
+            self._line(self._last[direction], direction, event.raw)
         if self._owned:
             try:
                 self._out.close()

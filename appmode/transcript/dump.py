@@ -12,34 +12,39 @@ from typing import Any, TextIO
 from appmode.board.profiles import PROFILES
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
-from appmode.protocol import app
+from appmode.protocol import app, control, control_view
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.reader import RECEIVED, RECEIVED2, PortsReader
 from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, describe, line, to_json
-from appmode.protocol.transcript import Transcript, read_transcript
-from appmode.transcript.matcher import Check, Pattern, parse_pattern
+from appmode.protocol.transcript import DIRECTIONS, Transcript, read_transcript
+from appmode.transcript.matcher import BytesPattern, Check, Pattern, parse_pattern
 
 CSV_FIELDS = ("t", "dir", *JSON_KEYS)
 
 
-def decoded(transcript: Transcript) -> Iterator[tuple[float, str, app.Event | Pattern]]:
-    """(time, direction, event) for every command and record of the transcript; a `<`
-    line with `*` or `LO..HI` fields is an expectation (a Pattern), not bytes."""
-    decoders: dict[str, app.HostDecoder | app.BoardDecoder] = {
-        ">": app.HostDecoder(),
-        "<": app.BoardDecoder(),
-    }
-    last = {">": 0.0, "<": 0.0}
+Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent
+
+
+def decoded(transcript: Transcript) -> Iterator[tuple[float, str, Decoded]]:
+    """(time, direction, event) for every command, record, frame and reply of the
+    transcript; a `<` line with `*` or `LO..HI` fields (a `2<` line with `??`) is an
+    expectation, not bytes. UART2 lines are read as the board the transcript describes
+    reads them (`PortsReader`: its drive type, APP text while system_mode bit 7 is set)."""
+    reader = PortsReader(drive=Check(transcript).needs.drive)
+    last = dict.fromkeys(DIRECTIONS, 0.0)
     for entry in transcript.entries:
         last[entry.direction] = entry.time
-        pattern = parse_pattern(entry.text) if entry.direction == "<" else None
-        if pattern is not None and any(f is None or f[0] != f[1] for f in pattern.fields):
-            yield entry.time, "<", pattern
+        if entry.direction == RECEIVED2 and "??" in entry.text:
+            yield entry.time, RECEIVED2, BytesPattern(entry.data, b"", entry.text)
             continue
-        for event in decoders[entry.direction].feed(entry.data):
-            yield entry.time, entry.direction, event
-    for direction, decoder in decoders.items():
-        for event in decoder.flush():
-            yield last[direction], direction, event
+        pattern = parse_pattern(entry.text) if entry.direction == RECEIVED else None
+        if pattern is not None and any(f is None or f[0] != f[1] for f in pattern.fields):
+            yield entry.time, RECEIVED, pattern
+            continue
+        for direction, event in reader.feed(entry.direction, entry.data):
+            yield entry.time, direction, event
+    for direction, event in reader.flush():
+        yield last[direction], direction, event
 
 
 def expectation_json(pattern: Pattern, layout: ALayout = VELOCITY) -> dict[str, Any]:
@@ -66,12 +71,21 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
         writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
         writer.writeheader()
     for t, direction, event in decoded(transcript):
-        if isinstance(event, Pattern):
+        shown = None
+        if isinstance(event, BytesPattern):
+            body = {"kind": "expectation", "raw": event.text}
+            raw, text = event.text.encode(), "expectation (?? matches any byte)"
+            shown = event.text
+        elif isinstance(event, Pattern):
             body = expectation_json(event, layout)
             raw = event.text.encode()
             text = "expectation " + " ".join(
                 f"{k}={v}" for k, v in body.items() if k not in ("kind", "letter", "raw")
             )
+        elif isinstance(event, control_view.EVENTS):
+            body = control_view.to_json(event)
+            raw, text = event.raw, control_view.describe(event)
+            shown = control_view.hex_text(raw)
         else:
             body = to_json(event, layout)
             raw, text = event.raw, describe(event, layout)
@@ -81,7 +95,7 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
             row = {k: ":".join(map(str, v)) if isinstance(v, list) else v for k, v in body.items()}
             writer.writerow({"t": t, "dir": direction, **row})
         else:
-            out.write(line(t, direction, raw, text) + "\n")
+            out.write(line(t, direction, raw, text, shown) + "\n")
     return 0
 
 
@@ -139,7 +153,7 @@ def run_plot(path: str, output: str) -> int:
             series["tB"].append(t)
             for k in ("pitch", "roll", "yaw", "battery"):
                 series[k].append(getattr(event, k))
-        elif direction == ">" and not isinstance(event, (Pattern, *app.ERRORS)):
+        elif direction == ">" and isinstance(event, app.Command):
             commands.append((t, event.raw.decode("latin-1")))
     if not series["tA"] and not series["tB"]:
         raise AppmodeError(f"{path} has no A or B records to plot")

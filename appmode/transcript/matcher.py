@@ -23,19 +23,11 @@ from dataclasses import dataclass, field
 
 from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.errors import AppmodeError
-from appmode.protocol import app, control, params
+from appmode.protocol import app
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
-from appmode.protocol.transcript import (
-    MAX_TIME,
-    RECEIVED2,
-    SENT,
-    SENT2,
-    Directive,
-    Entry,
-    Transcript,
-    uart2_bytes,
-)
+from appmode.protocol.reader import RECEIVED2, SENT, SENT2
+from appmode.protocol.transcript import MAX_TIME, Directive, Entry, Transcript, uart2_bytes
 
 APP_PORT, UART2_PORT = "app", "uart2"
 Unit = app.Record | app.BoardEvent | object
@@ -107,32 +99,6 @@ def _span(text: str) -> Span:
         return None
     low, _, high = text.partition("..")
     return (int(low), int(high or low))
-
-
-class Uart2Reader:
-    """Decodes what UART2 delivers as a board with the system_mode the sends set would
-    send it: the drive type fixes a report's length, bit 7 makes it APP text (§12)."""
-
-    def __init__(self, drive: DriveType | None) -> None:
-        self._decoder = control.BoardDecoder(control.motor_count(drive or DriveType.OMNI))
-        self._hosts: dict[str, app.HostDecoder | control.HostDecoder] = {
-            APP_PORT: app.HostDecoder(),
-            UART2_PORT: control.HostDecoder(),
-        }
-
-    def sent(self, port: str, data: bytes) -> list[Unit]:
-        """Follow what the host sends; what the decoder held when the mode changed."""
-        out: list[Unit] = []
-        for event in self._hosts[port].feed(data):
-            mode = control.system_mode_set(event)
-            if mode is not None:
-                out += self._decoder.set_app_mode(bool(mode & params.MODE_BIT["app_mode"]))
-                drive = params.drive_type(mode) or DriveType.OMNI
-                self._decoder.wheels = control.motor_count(drive)
-        return out
-
-    def received(self, data: bytes) -> list[Unit]:
-        return list(self._decoder.feed(data))
 
 
 @dataclass(frozen=True, slots=True)

@@ -24,8 +24,9 @@ from appmode.host.client import Host, LinkLost
 from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.link import is_simulated, open_link
 from appmode.protocol import app, params
+from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
-from appmode.transcript.matcher import UART2_PORT, Check, Uart2Reader
+from appmode.transcript.matcher import UART2_PORT, Check
 
 Progress = Callable[[str], None]
 
@@ -50,24 +51,30 @@ def run_virtual(transcript: Transcript) -> Result:
     needs = check.needs
     wire = Wire(Board(MemoryStore(), drive=needs.drive, profile=needs.profile), 9600)
     decoder = app.BoardDecoder()
-    uart2 = Uart2Reader(needs.drive)
+    reader = PortsReader(drive=needs.drive)
     now = 0.0
     while not check.done and now <= check.end:
         # what arrived by `now` first: it came before what is sent at `now`
         _feed(check, decoder, wire.pump_timed(now))
         for when, data in wire.pump_timed(now, UART2_PORT):
-            for unit in uart2.received(data):
-                check.on_record(unit, when, UART2_PORT)
+            _feed2(check, reader, RECEIVED2, data, when)
         for port, data in check.due(now):
             wire.write(data, now, port)
-            for unit in uart2.sent(port, data):
-                check.on_record(unit, now, UART2_PORT)
+            _feed2(check, reader, SENT2 if port == UART2_PORT else SENT, data, now)
         check.on_time(now)
         due = check.next_time()
         if due is None:
             break
         now = min(due, wire.board.next_slot())  # both lie after `now`
     return _result(transcript, check, now, time.perf_counter() - started)
+
+
+def _feed2(check: Check, reader: PortsReader, direction: str, data: bytes, now: float) -> None:
+    """Follow UART2: what it delivers (and what its decoder held when a frame sent changed
+    the board's mode) goes to the check."""
+    for shown, event in reader.feed(direction, data):
+        if shown == RECEIVED2:
+            check.on_record(event, now, UART2_PORT)
 
 
 def _feed(check: Check, decoder: app.BoardDecoder, timed: list[tuple[float, bytes]]) -> None:
@@ -115,7 +122,7 @@ def run_live(
         if url2 is not None and check.uses_uart2:
             link2 = open_link(url2, timeout=0, baud=UART2_BAUD)
             stack.callback(link2.close)
-        uart2 = Uart2Reader(check.needs.drive)
+        reader = PortsReader(drive=check.needs.drive)
         if check.needs.drive is not None:
             values = host.read_params()
             have = params.drive_type(values[params.SYSTEM_MODE])
@@ -144,8 +151,7 @@ def run_live(
                         link2.write(data)
                     else:
                         host.send(data)
-                    for unit in uart2.sent(port, data):
-                        check.on_record(unit, now, UART2_PORT)
+                    _feed2(check, reader, SENT2 if port == UART2_PORT else SENT, data, now)
             except LinkLost as exc:
                 check.failure = f"{transcript.path}: at {now:.3f} s: {exc}"
                 break
@@ -165,8 +171,7 @@ def run_live(
                 except (serial.SerialException, OSError) as exc:
                     check.failure = f"{transcript.path}: UART2 link lost: {exc}"
                     break
-                for unit in uart2.received(data):
-                    check.on_record(unit, host.now() - origin, UART2_PORT)
+                _feed2(check, reader, RECEIVED2, data, host.now() - origin)
             check.on_time(host.now() - origin)
             if progress is not None and int(now * 2) != shown:
                 shown = int(now * 2)

@@ -1,0 +1,90 @@
+"""Views of the control port's events (docs/protocol.md §8–§12): JSON and one-line text."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from appmode.protocol import control
+
+EVENTS = (
+    control.VelocityFrame,
+    control.MotorFrame,
+    control.PositionFrame,
+    control.SetSetting,
+    control.StoreFrame,
+    control.ReadFrame,
+    control.Reply,
+    control.EncoderReport,
+    control.BadFrame,
+    control.Garbage,
+)
+"""The control port's event types: what these views show."""
+KINDS = dict(
+    zip(
+        EVENTS,
+        (
+            "velocity_frame",
+            "motor_frame",
+            "position_frame",
+            "set_setting",
+            "store",
+            "read",
+            "reply",
+            "encoder_report",
+            "bad_frame",
+            "garbage",
+        ),
+        strict=True,
+    )
+)
+
+
+def hex_text(raw: bytes) -> str:
+    return raw.hex(" ").upper()
+
+
+def to_json(event: control.HostEvent | control.Reply | control.EncoderReport) -> dict[str, Any]:
+    """One JSON-ready object: `kind`, its values, and `raw` as hex pairs."""
+    body: dict[str, Any] = {"kind": KINDS[type(event)]}
+    if isinstance(event, control.VelocityFrame):
+        body.update(a=event.a, b=event.b, c=event.c, angle=event.angle)
+    elif isinstance(event, control.MotorFrame):
+        body["speeds"] = list(event.speeds)
+    elif isinstance(event, control.PositionFrame):
+        body.update(x=event.x, y=event.y, z=event.z)
+    elif isinstance(event, control.SetSetting):
+        body.update(name=event.setting.name, value=event.value)
+    elif isinstance(event, control.StoreFrame):
+        body["op"] = event.op.name
+    elif isinstance(event, control.ReadFrame):
+        body["name"] = event.read.name
+    elif isinstance(event, control.Reply):
+        body.update(name=event.name, value=event.value)
+    elif isinstance(event, control.EncoderReport):
+        body.update(targets=list(event.targets), actuals=list(event.actuals))
+    else:
+        body["reason"] = event.reason
+    return {**body, "raw": hex_text(event.raw)}
+
+
+def describe(event: control.HostEvent | control.Reply | control.EncoderReport) -> str:
+    """A short human description."""
+    if isinstance(event, control.VelocityFrame):
+        what = f"velocity {event.a} {event.b} {event.c}"
+        return f"{what} (angle mode: {event.c / 10:g}°)" if event.angle else what
+    if isinstance(event, control.MotorFrame):
+        return "motors " + " ".join(map(str, event.speeds))
+    if isinstance(event, control.PositionFrame):
+        return f"position x={event.x} y={event.y} z={event.z}"
+    if isinstance(event, control.SetSetting):
+        return f"set {event.setting.name} = {event.value}"
+    if isinstance(event, control.StoreFrame):
+        return event.op.meaning
+    if isinstance(event, control.ReadFrame):
+        return f"read {event.read.name}"
+    if isinstance(event, control.Reply):
+        return f"reply {event.name} = {event.value}"
+    if isinstance(event, control.EncoderReport):
+        pairs = zip("ABCD", event.targets, event.actuals, strict=False)
+        return "encoders " + " ".join(f"{w}={t}/{a}" for w, t, a in pairs)
+    return f"error: {event.reason}"
