@@ -553,6 +553,9 @@ class Board:
             if isinstance(event, control.VelocityFrame) and self._angle_mode(event):
                 self.pending_angle += event.c
                 did += f", angle mode: {self.pending_angle / 10:g}° pending"
+            elif event.raw == control.STOP and self.pending_angle:
+                self.pending_angle = 0.0  # the stop frame stops a rotation too (§12.1)
+                did += ", pending rotation dropped"
             self._note(now, "applied", f"{shown}: {did}", UART2)
         elif isinstance(event, control.PositionFrame):
             self._position(event, now, shown)

@@ -186,7 +186,7 @@ def _joined(run: list[p.Noise | p.Garbage]) -> p.Noise | p.Garbage:
 def line(time: float, direction: str, raw: bytes, text: str, shown: str | None = None) -> str:
     """`  1.234 < {A0:0:0:0}$   velocity …`: one event of a session, for people (its
     bytes escaped, or as `shown`)."""
-    return f"{time:7.3f} {direction:<2} {escape(raw) if shown is None else shown:<34} {text}"
+    return f"{time:7.3f} {direction} {escape(raw) if shown is None else shown:<34} {text}"
 
 
 def params_table(values: tuple[int, ...], defaults: tuple[int, ...] = DEFAULTS) -> str:

@@ -37,7 +37,7 @@ def uart2_payload(raw: bytes, text: bool) -> str:
         return raw.hex(" ").upper()
     shown = escape(raw)
     if HEX_LINE.fullmatch(shown):
-        return "".join(f"\\x{b:02X}" for b in raw)
+        return "".join(f"\\x{b:02x}" for b in raw)
     return shown
 
 

@@ -242,3 +242,13 @@ def test_s12_app_mode_moves_the_app_protocol_to_uart2() -> None:
     board.receive(b"{8:0}", 1.5)  # UART3 still receives and obeys
     board.poll_uart2(1.5)
     assert board.poll(2.0) != b"" and board.poll_uart2(2.0) == b""
+
+
+def test_s8_3_the_stop_frame_also_drops_a_pending_rotation() -> None:
+    board = Board()
+    board.receive_uart2(encode(control.velocity(DriveType.OMNI, angle=900)), 0.0)
+    board.advance(0.5)
+    assert board.pending_angle > 0
+    board.receive_uart2(control.STOP, 0.5)
+    board.advance(1.5)
+    assert board.pending_angle == 0 and abs(board.vehicle.vz) < 1

@@ -19,7 +19,6 @@ from appmode.protocol.control import (
     HostDecoder,
     MotorFrame,
     PositionFrame,
-    ReadFrame,
     Reply,
     SetSetting,
     StoreFrame,
@@ -86,7 +85,7 @@ def test_s8_2_the_motor_frame_length_follows_the_drive_type() -> None:
 
 
 def test_s8_3_the_stop_frame_is_a_velocity_of_zeros() -> None:
-    assert control.STOP == hexes("FF FE 01 00 00 00 00 00 00 00")
+    assert hexes("FF FE 01 00 00 00 00 00 00 00") == control.STOP
     assert encode(control.velocity(DriveType.OMNI)) == control.STOP
 
 
@@ -127,9 +126,7 @@ def test_s9_2_motor_bits_four_motors_bit_3_is_motor_4() -> None:
 def test_s9_2_one_byte_motors_of_the_reference_firmware() -> None:
     raw = encode(MotorFrame((10, -20, 30)), motor_width=1)
     assert raw == hexes("FF FE 02 0A 14 1E 00 00 00 02")
-    assert decode_whole(partial(HostDecoder, DriveType.OMNI, 1), raw) == [
-        MotorFrame((10, -20, 30))
-    ]
+    assert decode_whole(partial(HostDecoder, DriveType.OMNI, 1), raw) == [MotorFrame((10, -20, 30))]
 
 
 def test_s9_3_position_frame() -> None:

@@ -32,7 +32,8 @@ def run(*args: str, timeout: float = 60, stdin: bytes = b"") -> subprocess.Compl
 
 
 class BoardProcess:
-    """`appmode board ...` running; `url` is what it printed after 'port: '."""
+    """`appmode board ...` running; `url` is what it printed after 'port: ', `uart2`
+    after 'uart2: '."""
 
     def __init__(self, *args: str) -> None:
         self.proc = subprocess.Popen(
@@ -43,6 +44,7 @@ class BoardProcess:
             cwd=ROOT,
         )
         self.url = self._read_port_line()
+        self.uart2 = self._read_uart2_line()
 
     def _read_port_line(self, timeout: float = 20.0) -> str:
         assert self.proc.stdout is not None
@@ -56,6 +58,15 @@ class BoardProcess:
             err = self.stop()
             raise AssertionError(f"board said {first!r}; stderr: {err}")
         return first[len("port: ") :].strip()
+
+    def _read_uart2_line(self) -> str:
+        """The control port's line, printed right after the port line."""
+        assert self.proc.stdout is not None
+        second = self.proc.stdout.readline()
+        if not second.startswith("uart2: "):
+            err = self.stop()
+            raise AssertionError(f"board said {second!r} after its port line; stderr: {err}")
+        return second[len("uart2: ") :].strip()
 
     def stop(self, sig: int = signal.SIGTERM) -> str:
         """Stop it (SIGTERM by default); return its stderr."""

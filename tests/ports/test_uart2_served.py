@@ -1,0 +1,95 @@
+"""The board's control port served for real (docs/protocol.md §8): a second pty beside
+the APP port, a plain pyserial client, and sim:// opening both ports of one board."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import serial
+
+from appmode.protocol import app, control
+from appmode.protocol.params import DriveType
+from tests.support.processes import board_process, run
+
+READ_MAX_SPEED = bytes.fromhex("FF FE 80 80 11 00 00 00 00 00")
+
+
+def a_records(port: serial.Serial, seconds: float) -> list[app.Velocity]:
+    port.reset_input_buffer()
+    time.sleep(seconds)
+    events = app.BoardDecoder().feed(port.read(port.in_waiting))
+    return [e for e in events if isinstance(e, app.Velocity)]
+
+
+def test_board_serves_uart2_and_a_plain_pyserial_script_uses_it(tmp_path: Path) -> None:
+    record = tmp_path / "both.transcript"
+    with board_process("--pty", "--record", str(record)) as board:
+        assert board.uart2.startswith("/dev/") and board.uart2 != board.url
+        with (
+            serial.Serial(board.uart2, 115200, timeout=1) as u2,
+            serial.Serial(board.url, 9600, timeout=1) as uart3,
+        ):
+            u2.write(READ_MAX_SPEED)
+            assert u2.read(6) == bytes.fromhex("23 01 00 00 01 F4")
+            u2.write(bytes.fromhex("FF FE 01 00 00 01 2C 00 00 00"))  # y = 300
+            time.sleep(1.0)
+            assert a_records(uart3, 0.3)[-1].y == 300, "the APP port's A record follows"
+            u2.write(control.STOP)
+            uart3.write(b"JA")  # after the take-over the letters do not drive
+            time.sleep(1.0)
+            assert {r.y for r in a_records(uart3, 0.3)} == {0}
+        log = board.stop()
+    assert "uart2 info     UART2 takes over the motion at its byte 10" in log
+    assert "uart3 rejected A: ignored: UART2 drives (§8.3)" in log
+    lines = record.read_text().splitlines()
+    assert any(line.endswith("2> FF FE 80 80 11 00 00 00 00 00") for line in lines)
+    assert any(line.endswith("2< 23 01 00 00 01 F4") for line in lines)
+    dumped = run("dump", str(record))
+    assert "reply max_speed = 500" in dumped.stdout
+
+
+def test_uart2_replies_are_paced_at_115200_never_early() -> None:
+    with (
+        board_process("--pty", "--quiet") as board,
+        serial.Serial(board.uart2, 115200, timeout=1) as u2,
+    ):
+        u2.write(READ_MAX_SPEED * 20)
+        start = time.monotonic()
+        got = b""
+        while len(got) < 120 and time.monotonic() - start < 5:
+            got += u2.read(120 - len(got))
+        elapsed = time.monotonic() - start
+    assert got == bytes.fromhex("23 01 00 00 01 F4") * 20
+    assert elapsed >= 120 * 10 / 115200  # 10.4 ms of wire time at the least
+
+
+def test_sim_share_opens_both_ports_of_one_board() -> None:
+    url = "sim://?share=t1&pace=0"
+    with (
+        serial.serial_for_url(url, timeout=0.5) as uart3,
+        serial.serial_for_url(url + "&port=uart2", timeout=0.5) as u2,
+    ):
+        assert uart3.board is u2.board
+        uart3.write(b"JA")
+        u2.write(control.encode(control.velocity(DriveType.OMNI, y=120)))
+        time.sleep(0.5)
+        assert u2.in_waiting == 0  # the board runs when a port is used: no reply yet
+        assert u2.board.uart2_control
+        assert a_records(uart3, 0.3)[-1].y == 120
+        u2.write(READ_MAX_SPEED)
+        assert u2.read(6) == bytes.fromhex("23 01 00 00 01 F4")
+
+
+def test_sim_share_refuses_a_port_opened_twice_or_other_options() -> None:
+    with serial.serial_for_url("sim://?share=t2", timeout=0.1):
+        for url, said in (
+            ("sim://?share=t2", "app port is already open"),
+            ("sim://?share=t2&drive=diff&port=uart2", "open this port with the same"),
+        ):
+            try:
+                serial.serial_for_url(url, timeout=0.1)
+            except serial.SerialException as exc:
+                assert said in str(exc)
+            else:
+                raise AssertionError(f"{url} opened")
