@@ -26,7 +26,7 @@ from appmode.protocol.control import (
     encode,
 )
 from appmode.protocol.params import DriveType
-from tests.support.decoders import assert_split_invariant, decode_whole
+from tests.support.decoders import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
 MAX_SPEED = settings.BY_NAME["max_speed"]
 
@@ -214,32 +214,14 @@ def test_host_decoder_never_raises_bounded_and_every_byte_in_one_event(
     data: bytes, cuts: list[int]
 ) -> None:
     data = data + encode(control.velocity(DriveType.OMNI, 1, 2, 3)) + data
-    decoder = HostDecoder(DriveType.MECANUM)
-    events: list[object] = []
-    pos = 0
-    for size in [*cuts, len(data)]:
-        events += decoder.feed(data[pos : pos + size])
-        assert decoder.buffered <= HostDecoder.LIMIT
-        pos += size
-    events += decoder.flush()
-    assert b"".join(e.raw for e in events) == data  # type: ignore[attr-defined]
-    assert events == decode_whole(partial(HostDecoder, DriveType.MECANUM), data)
+    assert_any_bytes_ok(partial(HostDecoder, DriveType.MECANUM), data, cuts)
 
 
 @given(st.binary(max_size=200), st.lists(st.integers(1, 40), max_size=10))
 def test_board_decoder_never_raises_bounded_and_every_byte_in_one_event(
     data: bytes, cuts: list[int]
 ) -> None:
-    decoder = BoardDecoder()
-    events: list[object] = []
-    pos = 0
-    for size in [*cuts, len(data)]:
-        events += decoder.feed(data[pos : pos + size])
-        assert decoder.buffered <= decoder.limit
-        pos += size
-    events += decoder.flush()
-    assert b"".join(e.raw for e in events) == data  # type: ignore[attr-defined]
-    assert events == decode_whole(BoardDecoder, data)
+    assert_any_bytes_ok(BoardDecoder, data, cuts, BoardDecoder().limit)
 
 
 @pytest.mark.parametrize(

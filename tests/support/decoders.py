@@ -34,16 +34,17 @@ def assert_split_invariant(make: Callable[[], Decoder], data: bytes) -> list[Any
 
 
 def assert_any_bytes_ok(
-    make: type[app.HostDecoder] | type[app.BoardDecoder], data: bytes, cuts: list[int]
+    make: Callable[[], Any], data: bytes, cuts: list[int], limit: int | None = None
 ) -> None:
-    """Fed in pieces of `cuts` sizes: no exception, buffer within LIMIT, every byte in one
-    event, and the same events as fed whole."""
+    """Fed in pieces of `cuts` sizes: no exception, buffer within `limit` (the decoder's
+    LIMIT by default), every byte in one event, and the same events as fed whole."""
     decoder = make()
+    bound = decoder.LIMIT if limit is None else limit
     events: list[Any] = []
     pos = 0
     for size in [*cuts, len(data)]:
         events += decoder.feed(data[pos : pos + size])
-        assert decoder.buffered <= make.LIMIT
+        assert decoder.buffered <= bound
         pos += size
     events += decoder.flush()
     assert b"".join(e.raw for e in events) == data
