@@ -34,6 +34,7 @@ import link_roundtrip
 import minibalance
 import replay_timing
 import serial
+import uart2
 from common import board, percentile
 
 from appmode.board.firmware import TICK, Board
@@ -468,6 +469,7 @@ def main() -> None:
         ("replay", lambda: bench_replay(1000 if quick else 10_000)),
         ("conform timing", lambda: bench_conform_timing(200 if quick else 600)),
         ("minibalance", lambda: minibalance.rows(30 if quick else 100)),
+        ("uart2", lambda: uart2.rows(quick)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

@@ -93,3 +93,12 @@ def test_sim_share_refuses_a_port_opened_twice_or_other_options() -> None:
                 assert said in str(exc)
             else:
                 raise AssertionError(f"{url} opened")
+
+
+def test_a_second_of_garbage_at_115200_is_counted_and_the_board_keeps_serving() -> None:
+    with serial.serial_for_url("sim://?share=flood&port=uart2", timeout=3) as u2:
+        flood = bytes(range(256)) * 45  # 11,520 bytes: a second of the line
+        u2.write(flood + READ_MAX_SPEED)
+        assert u2.read(6) == bytes.fromhex("23 01 00 00 01 F4")
+        assert u2.board.uart2_errors >= len(flood) // 64  # runs of at most 64 bytes
+        assert u2.board.vehicle.vx == u2.board.vehicle.vy == u2.board.vehicle.vz == 0

@@ -1,0 +1,213 @@
+"""The control port (UART2, docs/protocol.md §8–§12): decoder throughput, a read's round
+trip over a pty, paced throughput at 115200 bps, and the CPU of a board serving both
+ports with the encoder report on.
+
+A read is answered in the board's next 10 ms control tick (§11), so its round trip is up
+to 10 ms of waiting plus 1.4 ms of wire time (10 bytes in, 6 out). What the host can
+improve is what comes beyond the tick: the reply's arrival is measured against the
+board's 10 ms grid (its phase estimated from the earliest replies).
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import os
+import random
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import serial
+from common import percentile
+
+from appmode.protocol import control
+from appmode.protocol.params import DriveType
+
+TICK = 0.010
+BYTE = 10 / 115200
+READ = control.encode(control.read("max_speed"))
+
+
+@contextmanager
+def served(*args: str) -> Iterator[tuple[subprocess.Popen[str], str, str]]:
+    """`appmode board --pty ARGS`: the process, its APP port and its UART2."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "board", "--pty", "--quiet", *args],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        app = proc.stdout.readline().split(" ", 1)[1].strip()
+        uart2 = proc.stdout.readline().split(" ", 1)[1].strip()
+        yield proc, app, uart2
+    finally:
+        proc.terminate()
+        proc.wait(10)
+
+
+def decoder_rows(size: int) -> list[tuple[str, str, str]]:
+    rng = random.Random(3)
+    frames = [
+        control.encode(control.velocity(DriveType.MECANUM, rng.randint(-500, 500), 300, 0))
+        for _ in range(50)
+    ] + [READ, control.encode(control.MotorFrame((1, -2, 3, -4)))]
+    stream = b"".join(rng.choice(frames) for _ in range(size // 11))
+    replies = control.encode(control.Reply(1, 500)) + control.encode(
+        control.EncoderReport((1, 2, 3, 4), (5, 6, 7, 8))
+    )
+    board_stream = replies * (len(stream) // len(replies))
+    rows = []
+    for name, make, data in (
+        ("host→board", lambda: control.HostDecoder(DriveType.MECANUM), stream),
+        ("board→host", control.BoardDecoder, board_stream),
+    ):
+        start = time.perf_counter()
+        decoder = make()
+        for i in range(0, len(data), 4096):
+            decoder.feed(data[i : i + 4096])
+        whole = len(data) / (time.perf_counter() - start) / 1e6
+        part = data[: len(data) // 10]
+        start = time.perf_counter()
+        decoder = make()
+        for i in range(len(part)):
+            decoder.feed(part[i : i + 1])
+        single = len(part) / (time.perf_counter() - start) / 1e6
+        rows.append(
+            (
+                f"UART2 decoder, {name}",
+                f"{whole:.1f} MB/s in 4 KiB reads; {single:.2f} MB/s a byte at a time "
+                f"({whole / single:.0f}x)",
+                "≫ 11,520 bytes/s",
+            )
+        )
+    return rows
+
+
+def round_trip_rows(trials: int) -> list[tuple[str, str, str]]:
+    with served() as (_, _, uart2), serial.Serial(uart2, 115200, timeout=1) as port:
+        arrivals, trips = [], []
+        rng = random.Random(5)
+        for _ in range(trials):
+            time.sleep(rng.uniform(0.002, 0.03))
+            start = time.monotonic()
+            port.write(READ)
+            got = b""
+            while len(got) < 6:
+                got += port.read(6 - len(got))
+            end = time.monotonic()
+            assert got == bytes.fromhex("23 01 00 00 01 F4"), got
+            trips.append(end - start)
+            arrivals.append(end)
+    wire_out = 6 * BYTE
+    phases = sorted((a - wire_out) % TICK for a in arrivals)
+    # the board's tick phase: where the replies' phases begin, after the widest gap
+    gaps = [(b - a, b) for a, b in itertools.pairwise(phases)]
+    gaps.append((phases[0] + TICK - phases[-1], phases[0]))
+    phase = max(gaps)[1]
+    beyond = [((a - wire_out - phase) % TICK) * 1000 for a in arrivals]
+    return [
+        (
+            "UART2 read round trip over a pty (FF FE 80 80 11 … → 23 01 …)",
+            f"median {percentile([t * 1000 for t in trips], 50):.2f} ms, p99 "
+            f"{percentile([t * 1000 for t in trips], 99):.2f} ms (n={trials}; includes the "
+            "wait for the next 10 ms tick)",
+            "answered in the next tick",
+        ),
+        (
+            "UART2 reply beyond its tick (the reply's 0.52 ms of wire excluded)",
+            f"median {percentile(beyond, 50):.2f} ms, p99 {percentile(beyond, 99):.2f} ms",
+            "p99 < 2 ms",
+        ),
+    ]
+
+
+def throughput_rows(frames: int) -> list[tuple[str, str, str]]:
+    """Reads written back to back: the board takes them at the line rate and answers each
+    in the tick after it arrives. The replies' arrival between the 10th and the 90th
+    percent of them gives the rate the input moved at (±10 ms of tick phase at each end)."""
+    with served() as (_, _, uart2), serial.Serial(uart2, 115200, timeout=2) as port:
+        writer = threading.Thread(target=port.write, args=(READ * frames,))
+        writer.start()  # the write blocks while the board holds the line back
+        times: list[float] = []
+        got = b""
+        while len(got) < 6 * frames:
+            chunk = port.read(max(1, min(port.in_waiting, 6 * frames - len(got))))
+            if not chunk:
+                raise SystemExit("replies stopped")
+            now = time.monotonic()
+            before = len(got) // 6
+            got += chunk
+            times += [now] * (len(got) // 6 - before)
+        writer.join()
+    assert got == bytes.fromhex("23 01 00 00 01 F4") * frames
+    first, last = frames // 10, frames * 9 // 10
+    rate = (last - first) * len(READ) / (times[last] - times[first])
+    error = 2 * TICK / (times[last] - times[first]) * 100
+    return [
+        (
+            f"UART2 paced input, {frames:,} reads back to back",
+            f"{rate / 11520 * 100:.2f} % (±{error:.2f}) of 11,520 bytes/s, all {frames:,} answered",
+            "≥ 99.5 %, never above 100 %",
+        )
+    ]
+
+
+def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
+    with (
+        served("--drive", "mecanum") as (proc, app, uart2),
+        serial.Serial(uart2, 115200, timeout=0.1) as port,
+        serial.Serial(app, 9600, timeout=0.1) as app_port,
+    ):
+        report = control.SetSetting(control.settings.BY_NAME["system_mode"], 0x41)
+        port.write(control.encode(report))
+        port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
+        time.sleep(0.5)
+        clock = os.sysconf("SC_CLK_TCK")
+
+        def cpu() -> float:
+            with open(f"/proc/{proc.pid}/stat") as handle:
+                fields = handle.read().rsplit(")", 1)[1].split()
+            return (int(fields[11]) + int(fields[12])) / clock
+
+        before, start = cpu(), time.monotonic()
+        received = 0
+        while time.monotonic() - start < seconds:
+            received += len(port.read(4096)) + len(app_port.read(4096))
+        used = cpu() - before
+        elapsed = time.monotonic() - start
+        port.write(control.STOP)
+    reports = received / elapsed
+    return [
+        (
+            "board serving both ports, encoder report on (mecanum, driving)",
+            f"{used / elapsed * 100:.2f} % of a core over {elapsed:.0f} s "
+            f"({reports:,.0f} bytes/s read from both ports)",
+            "< 2 % of a core",
+        )
+    ]
+
+
+def rows(quick: bool) -> list[tuple[str, str, str]]:
+    return [
+        *decoder_rows(1_000_000 if quick else 4_000_000),
+        *round_trip_rows(200 if quick else 1000),
+        *throughput_rows(2000 if quick else 10_000),
+        *cpu_rows(10 if quick else 30),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="shorter runs")
+    args = parser.parse_args()
+    for label, result, target in rows(args.quick):
+        print(f"| {label} | {result} | {target} |")
+
+
+if __name__ == "__main__":
+    main()
