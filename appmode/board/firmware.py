@@ -133,6 +133,10 @@ class Board:
             due = min(due, -(-self._tick_ms // REPORT_MS) * REPORT_MS)
         return self._boot + due / 1000
 
+    def next_reply(self) -> float:
+        """When the board next answers a read on UART2 (infinity when none is pending)."""
+        return self._boot + self._tick_ms / 1000 if self._reads else math.inf
+
     def advance(self, now: float) -> None:
         """Run every tick and record due by `now`."""
         due = math.floor((now - self._boot) * 1000 + 1e-6)

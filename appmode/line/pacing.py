@@ -45,6 +45,10 @@ class Line:
         start, _ = self._bursts[0]
         return start + (self._taken + 1) * self.byte_time
 
+    def last_due(self) -> float | None:
+        """When the last byte queued is delivered, or None when the line is idle."""
+        return self._free_at if self._bursts else None
+
     def take(self, now: float) -> bytes:
         """Every byte delivered by `now`."""
         return b"".join(data for _, data in self.take_timed(now))

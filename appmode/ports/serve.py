@@ -38,10 +38,11 @@ Log = Callable[[str], None]
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
-RUN = {APP: 0.004, UART2: 0.001}
+RUN = {APP: 0.004, UART2: 0.002}
 """Seconds of wire time written at most at once to a paced client: bytes trickle in as
-from a real UART (a C record over 32 ms at 9600 bps), not a record at a time. UART2's
-runs are shorter: a read's reply is due within its 10 ms tick (§11)."""
+from a real UART (a C record over 32 ms at 9600 bps), not a record at a time. On UART2
+a burst shorter than a run (a read's 6-byte reply, due in its 10 ms tick, §11) is
+written whole as soon as its last stop bit is done."""
 INPUT_BACKLOG = 256
 """Bytes received but not yet on the simulated line beyond which the server stops reading:
 the rest waits in the pty or socket, and a writer faster than 9600 bps is held back, as
@@ -305,6 +306,13 @@ class Served:
                     mine = min(mine, line)
             if step:
                 mine = math.ceil(mine / RUN[name] - 1e-9) * RUN[name]
+            if name == UART2 and step:
+                # a reply is due within its tick: run the board at the slot, and write a
+                # burst shorter than a run whole when its last stop bit is done
+                mine = min(mine, wire.board.next_reply())
+                first, last = port.to_host.next_due(), port.to_host.last_due()
+                if first is not None and last is not None and last - first < RUN[name]:
+                    mine = min(mine, last)
             due = min(due, mine)
         if any(e.backlog for e in self.endpoints.values()):
             due = min(due, self.last_write + RETRY_WRITE)
