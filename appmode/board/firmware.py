@@ -115,7 +115,7 @@ class Board:
         self.pending_angle = 0.0  # 0.1°, signed (§9.1)
         self._command: control.HostFrame | None = None  # the last motion frame obeyed
         self._position_goal: tuple[float, float, float] | None = None
-        self._wheel_targets: tuple[float, ...] = ()
+        self._target_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
         self._reads: list[settings.Read] = []
         self._out2 = bytearray()
         self._frames = control.HostDecoder(self.drive_type, profile.motor_width)
@@ -250,24 +250,23 @@ class Board:
                 self._drive_uart2(speed)
             return
         if profile.ramp is None:
-            target = self._target(speed)
-            vehicle.step(target, ticks * TICK)
+            self._target_velocity = self._target(speed)
+            vehicle.step(self._target_velocity, ticks * TICK)
         else:
             pushes = self._pushes() if self._powered(self._tick_ms) else (0, 0, 0)
             for _ in range(min(ticks, MAX_RAMP)):  # beyond that a ramp has long settled
                 vehicle.ramp(pushes, speed, profile.ramp, profile.coast, TICK)
-            target = (vehicle.vx, vehicle.vy, vehicle.vz)
-        self._wheel_targets = kinematics.wheels(self.drive_type, *target)
+            self._target_velocity = (vehicle.vx, vehicle.vy, vehicle.vz)
 
     def _drive_uart2(self, speed: float) -> None:
         """One control tick with UART2 in control: its last motion frame, angle mode's
         pending rotation, position mode's goal (§9)."""
-        command, drive, vehicle = self._command, self.drive_type, self.vehicle
+        command, vehicle = self._command, self.vehicle
         x = y = z = 0.0
         if isinstance(command, control.VelocityFrame):
             x, y, z = self._velocity_target(command, speed)
         elif isinstance(command, control.MotorFrame):
-            x, y, z = kinematics.body(drive, tuple(map(float, command.speeds)))
+            x, y, z = kinematics.body(self.drive_type, tuple(map(float, command.speeds)))
         elif self._position_goal is not None:
             travel = (vehicle.travel_x, vehicle.travel_y, vehicle.travel_z)
             x, y, z = (
@@ -276,14 +275,19 @@ class Board:
             )
         if self.pending_angle:
             z = math.copysign(speed * ANGLE_SPEED, self.pending_angle)
-        vehicle.step((x, y, z), TICK)
+        self._target_velocity = (x, y, z)
+        vehicle.step(self._target_velocity, TICK)
         if self.pending_angle:
             left = self.pending_angle - vehicle.vz * YAW_GAIN * TICK * 10
             self.pending_angle = left if left * self.pending_angle > 0 else 0.0
-        if isinstance(command, control.MotorFrame):
-            self._wheel_targets = tuple(map(float, command.speeds))
-        else:
-            self._wheel_targets = kinematics.wheels(drive, x, y, z)
+
+    def _wheel_targets(self) -> tuple[float, ...]:
+        """What each wheel is driven at: a motor frame's speeds while UART2 drives by
+        one, else the wheels of the body's target velocity."""
+        command = self._command
+        if isinstance(command, control.MotorFrame) and self.uart2_control:
+            return tuple(map(float, command.speeds))
+        return kinematics.wheels(self.drive_type, *self._target_velocity)
 
     def _angle_mode(self, frame: control.VelocityFrame) -> bool:
         return (
@@ -316,9 +320,10 @@ class Board:
             self._mode("encoder_report")
             and not self._mode("app_mode")
             and self._tick_ms % REPORT_MS == 0
-            and 0x80 in self.profile.control_modes
+            and control.SETTINGS in self.profile.control_modes
         ):
-            targets, actuals = self._encoders(self._wheel_targets), self._encoders(self._wheels())
+            targets = self._encoders(self._wheel_targets())
+            actuals = self._encoders(self._wheels())
             self._out2 += control.encode(control.EncoderReport(targets, actuals))
 
     def _wheels(self) -> tuple[float, ...]:

@@ -54,9 +54,17 @@ class Wire:
             APP: Port(Line(baud), Line(baud), ">", "<"),
             UART2: Port(Line(baud2), Line(baud2), "2>", "2<"),
         }
-        self.to_board = self.ports[APP].to_board
-        self.to_host = self.ports[APP].to_host
         self.tap = tap
+
+    @property
+    def to_board(self) -> Line:
+        """The APP port's line to the board."""
+        return self.ports[APP].to_board
+
+    @property
+    def to_host(self) -> Line:
+        """The APP port's line to the host."""
+        return self.ports[APP].to_host
 
     @property
     def dropped(self) -> int:

@@ -168,8 +168,6 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         baud = self._baudrate if pace else None
         port = shared.wire.ports[side]
         port.to_board, port.to_host = Line(baud), Line(baud)
-        if side == APP:
-            shared.wire.to_board, shared.wire.to_host = port.to_board, port.to_host
         self._shared, self._share_name, self._side = shared, name, side
         self._wire = shared.wire
         self.board = shared.wire.board

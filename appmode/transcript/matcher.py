@@ -23,15 +23,14 @@ from dataclasses import dataclass, field
 
 from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.errors import AppmodeError
+from appmode.line.wire import APP as APP_PORT
+from appmode.line.wire import UART2 as UART2_PORT
 from appmode.protocol import app
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2
+from appmode.protocol.reader import Event as Unit
 from appmode.protocol.transcript import MAX_TIME, Directive, Entry, Transcript, uart2_bytes
-
-APP_PORT, UART2_PORT = "app", "uart2"
-Unit = app.Record | app.BoardEvent | object
-"""What a port delivers, one decoded unit: a record, or on UART2 a reply or report."""
 
 TOLERANCE = 0.5
 _FIELD = r"(?:-?\d+(?:\.\.-?\d+)?|\*)"
@@ -78,7 +77,7 @@ class BytesPattern:
         return f"UART2 unit {self.data[:1].hex().upper()}"
 
     def matches(self, unit: Unit) -> bool:
-        raw: bytes = getattr(unit, "raw", b"")
+        raw = unit.raw
         return len(raw) == len(self.data) and all(
             (a ^ b) & m == 0 for a, b, m in zip(raw, self.data, self.mask, strict=True)
         )
@@ -230,7 +229,7 @@ class Check:
         exp = self.expectations[self.matched]
         if (exp.entry.direction == RECEIVED2) != (port == UART2_PORT):
             return  # the other port's: ignored like unmentioned telemetry
-        raw: bytes = getattr(record, "raw", b"")
+        raw = record.raw
         if port == UART2_PORT and isinstance(exp.pattern, BytesPattern):
             letter, shown = f"2<{raw[:1].hex()}", raw.hex(" ").upper()
         elif isinstance(record, app.RECORDS):

@@ -21,12 +21,13 @@ from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.host.client import Host, LinkLost
+from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.link import is_simulated, open_link
 from appmode.protocol import app, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
-from appmode.transcript.matcher import UART2_PORT, Check
+from appmode.transcript.matcher import Check
 
 Progress = Callable[[str], None]
 
