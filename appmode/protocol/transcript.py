@@ -280,6 +280,11 @@ def _entry(line: str, lineno: int, where: str) -> Entry:
             "(board to host) on the APP port, '2>' or '2<' on UART2"
         )
     hexed = uart2_bytes(payload) if direction in UART2_DIRECTIONS else None
+    if direction in UART2_DIRECTIONS and hexed is None and " " in payload:
+        raise TranscriptError(
+            f"{where}: {_cut(payload)!r} is neither hex pairs (upper case, one space apart: "
+            "FF FE 01 …) nor APP text (escaped, so it has no spaces)"
+        )
     if hexed is not None:
         if direction == SENT2 and "??" in payload:
             raise TranscriptError(f"{where}: '??' matches a byte the board sends: not in a 2> line")

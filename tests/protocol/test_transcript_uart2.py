@@ -85,3 +85,9 @@ def test_question_marks_match_any_byte_only_in_expectations() -> None:
 def test_unknown_directions_name_both_ports() -> None:
     with pytest.raises(TranscriptError, match="'2>' or '2<' on UART2"):
         parse_transcript(f"{HEAD}0.1 3> FF\n")
+
+
+@pytest.mark.parametrize("payload", ["FF FE 0G", "ff fe 01", "FF  FE"])
+def test_a_uart2_line_with_spaces_must_be_hex_pairs(payload: str) -> None:
+    with pytest.raises(TranscriptError, match="neither hex pairs"):
+        parse_transcript(f"{HEAD}0.1 2> {payload}\n")
