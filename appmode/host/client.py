@@ -18,8 +18,9 @@ import serial
 from appmode.errors import AppmodeError
 from appmode.host.query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
-from appmode.line.wire import Tap
-from appmode.ports.link import open_link
+from appmode.line.wire import UART2, Tap
+from appmode.ports.link import is_simulated, open_link
+from appmode.ports.sim import sim_side
 from appmode.protocol import app, params
 from appmode.protocol.layouts import VELOCITY, ALayout
 
@@ -46,6 +47,11 @@ class Host:
         stop_on_close: bool = True,
         layout: ALayout = VELOCITY,
     ) -> None:
+        if is_simulated(url) and sim_side(url) == UART2:
+            raise AppmodeError(
+                f"{url} is the simulated board's control port (UART2, binary frames): this "
+                "command speaks the APP protocol; leave out port=uart2"
+            )
         self.url = url
         self.tap = tap
         self.stop_on_close = stop_on_close

@@ -103,3 +103,9 @@ def test_a_second_of_garbage_at_115200_is_counted_and_the_board_keeps_serving() 
         assert u2.read(6) == bytes.fromhex("23 01 00 00 01 F4")
         assert u2.board.uart2_errors >= len(flood) // 64  # runs of at most 64 bytes
         assert u2.board.vehicle.vx == u2.board.vehicle.vy == u2.board.vehicle.vz == 0
+
+
+def test_app_commands_refuse_the_control_port_of_a_sim_board() -> None:
+    done = run("send", "sim://?port=uart2", "J", "A")
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "leave out port=uart2" in done.stderr
