@@ -1,10 +1,15 @@
-"""Helpers for the benchmark scripts: start `appmode board` and stop it."""
+"""Helpers for the benchmark scripts: start `appmode board` and stop it, measure a
+process's CPU and wake-ups."""
 
 from __future__ import annotations
 
+import os
+import selectors
 import statistics
 import subprocess
 import sys
+import time
+import tty
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -39,3 +44,43 @@ def summary_ms(values: list[float]) -> str:
         f"median {statistics.median(ms):.3f} ms, p99 {percentile(ms, 99):.3f} ms, "
         f"max {max(ms):.3f} ms (n={len(ms)})"
     )
+
+
+def cpu_seconds(pid: int) -> float:
+    """CPU time process `pid` has run, to the nanosecond (/proc/PID/schedstat; the
+    tick counts of /proc/PID/stat are samples, too coarse for a 1 % share)."""
+    with open(f"/proc/{pid}/schedstat") as stat:
+        return int(stat.read().split()[0]) / 1e9
+
+
+def wakeups(pid: int) -> int:
+    """How many times process `pid` has gone to sleep and woken (its voluntary context
+    switches): a served board's wake-ups."""
+    with open(f"/proc/{pid}/status") as status:
+        for line in status:
+            if line.startswith("voluntary_ctxt_switches:"):
+                return int(line.split()[1])
+    raise SystemExit(f"no voluntary_ctxt_switches in /proc/{pid}/status")
+
+
+def wakeup_floor(seconds: float, rate: float) -> float:
+    """CPU of a loop doing nothing but what trickled output needs: `rate` timed wake-ups
+    a second, each writing 4 bytes into a pty (the machine's cost, not appmode's)."""
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    idle, _ = os.pipe()
+    sel = selectors.DefaultSelector()
+    sel.register(idle, selectors.EVENT_READ)
+    start_cpu, start = time.process_time(), time.monotonic()
+    count = 0
+    while time.monotonic() - start < seconds:
+        sel.select(1 / rate)
+        os.write(master, b"abcd")
+        count += 1
+        if count % 64 == 0:
+            os.read(slave, 4096)
+    share = (time.process_time() - start_cpu) / (time.monotonic() - start) * 100
+    sel.close()
+    for fd in (master, slave, idle):
+        os.close(fd)
+    return share

@@ -14,7 +14,6 @@ import os
 import platform
 import random
 import select
-import selectors
 import shutil
 import statistics
 import subprocess
@@ -35,18 +34,13 @@ import minibalance
 import replay_timing
 import serial
 import uart2
-from common import board, percentile
+from common import board, cpu_seconds, percentile, wakeup_floor, wakeups
 
 from appmode.board.firmware import TICK, Board
 from appmode.protocol.app import RECORDS, BoardDecoder
 
 Row = tuple[str, str, str]
 TICKS = os.sysconf("SC_CLK_TCK")
-
-
-def cpu_seconds(pid: int) -> float:
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / TICKS
 
 
 def rss_mib(pid: int) -> float:
@@ -121,12 +115,14 @@ def bench_board_cpu(seconds: float) -> list[Row]:
     try:
         time.sleep(1.0)
         start_cpu, start = cpu_seconds(proc.pid), time.monotonic()
+        start_wakeups = wakeups(proc.pid)
         received = 0
         while time.monotonic() - start < seconds:
             time.sleep(0.05)
             with contextlib.suppress(BlockingIOError):
                 received += len(os.read(fd, 4096))
         share = (cpu_seconds(proc.pid) - start_cpu) / (time.monotonic() - start) * 100
+        rate = (wakeups(proc.pid) - start_wakeups) / (time.monotonic() - start)
     finally:
         os.close(fd)
         stop(proc)
@@ -138,33 +134,10 @@ def bench_board_cpu(seconds: float) -> list[Row]:
         ),
         (
             "its floor: a bare loop, same wake-ups and pty writes",
-            f"{wakeup_floor(seconds, received / seconds / 4):.2f} % of a core",
+            f"{wakeup_floor(seconds, rate):.2f} % of a core ({rate:.0f} wake-ups/s)",
             "",
         ),
     ]
-
-
-def wakeup_floor(seconds: float, rate: float) -> float:
-    """CPU of a loop doing nothing but what trickled output needs: `rate` timed wake-ups
-    a second, each writing 4 bytes into a pty (the machine's cost, not appmode's)."""
-    master, slave = os.openpty()
-    tty.setraw(slave)
-    idle, _ = os.pipe()
-    sel = selectors.DefaultSelector()
-    sel.register(idle, selectors.EVENT_READ)
-    start_cpu, start = time.process_time(), time.monotonic()
-    wakeups = 0
-    while time.monotonic() - start < seconds:
-        sel.select(1 / rate)
-        os.write(master, b"abcd")
-        wakeups += 1
-        if wakeups % 64 == 0:
-            os.read(slave, 4096)
-    share = (time.process_time() - start_cpu) / (time.monotonic() - start) * 100
-    sel.close()
-    for fd in (master, slave, idle):
-        os.close(fd)
-    return share
 
 
 def bench_drive_cpu(seconds: float) -> list[Row]:

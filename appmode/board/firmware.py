@@ -126,12 +126,20 @@ class Board:
 
     def next_slot(self) -> float:
         """When the board next sends something: a record, a reply, an encoder report."""
-        due = self._record_ms
+        return min(self.next_sends())
+
+    def next_sends(self) -> tuple[float, float]:
+        """When the board next sends on UART3 and on UART2 (infinity: nothing planned).
+        Records go out on UART3, or on UART2 in APP mode (§12); replies and encoder
+        reports on UART2."""
+        uart3, uart2 = float(self._record_ms), math.inf
+        if self._mode("app_mode"):
+            uart3, uart2 = uart2, uart3
         if self._reads:
-            due = min(due, self._tick_ms)
+            uart2 = min(uart2, self._tick_ms)
         elif self._mode("encoder_report") and not self._mode("app_mode"):
-            due = min(due, -(-self._tick_ms // REPORT_MS) * REPORT_MS)
-        return self._boot + due / 1000
+            uart2 = min(uart2, -(-self._tick_ms // REPORT_MS) * REPORT_MS)
+        return self._boot + uart3 / 1000, self._boot + uart2 / 1000
 
     def next_reply(self) -> float:
         """When the board next answers a read on UART2 (infinity when none is pending)."""

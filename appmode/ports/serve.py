@@ -28,7 +28,7 @@ from appmode.board.profiles import SHEET, profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
-from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
+from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
 from appmode.ports.link import BAUD, explain_open_error, parse_device
 from appmode.protocol import params
 from appmode.protocol.params import SYSTEM_MODE, DriveType
@@ -295,16 +295,16 @@ class Served:
         time) and the bytes whose stop bit is done are written, never early, never more
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
-        slot = wire.board.next_slot()
+        slots = dict(zip(PORTS, wire.board.next_sends(), strict=True))
         due = math.inf
         for name in self.endpoints:
             port = wire.ports[name]
             step = port.to_host.byte_time
-            mine = slot + step  # the next slot's output: its first byte
+            mine = slots[name] + step  # the port's next output: its first byte
             for line in (port.to_board.next_due(), port.to_host.next_due()):
                 if line is not None:
                     mine = min(mine, line)
-            if step:
+            if step and mine < math.inf:
                 mine = math.ceil(mine / RUN[name] - 1e-9) * RUN[name]
             if name == UART2 and step:
                 # a reply is due within its tick: run the board at the slot, and write a
