@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
-from appmode.host.client import Host, LinkLost
+from appmode.host.client import Host
+from appmode.host.link import LinkLost
 from appmode.host.query import ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
 from appmode.host.tokens import Wait, parse_token

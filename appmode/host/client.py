@@ -1,21 +1,21 @@
 """The host over a link: read, set and save parameters, send, and follow records.
 
 Thread-free: every call reads what the board has sent meanwhile and lets the host state
-(`client.HostState`) resend or give up on a parameter query. When the link is lost the
-host says so (a LinkStatus event), retries the same URL every RETRY seconds, and says so
-again when it is back. Closing sends `Z` first.
+(`state.HostState`) resend or give up on a parameter query. A lost link is reopened
+(`link.Link`). Closing sends `Z` last.
 """
 
 from __future__ import annotations
 
 import contextlib
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from types import TracebackType
 
 import serial
 
 from appmode.errors import AppmodeError
+from appmode.host.link import Link, LinkLost
 from appmode.host.query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.line.wire import UART2, Tap
@@ -24,19 +24,11 @@ from appmode.ports.sim import sim_side
 from appmode.protocol import app, params
 from appmode.protocol.layouts import VELOCITY, ALayout
 
-RETRY = 0.5
-STEP = 0.001
-"""Seconds between looks at the port while waiting less than its read timeout."""
-
 Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning
 
 
-class LinkLost(AppmodeError):
-    """The link is down; the host is trying to get it back."""
-
-
-class Host:
-    """A session with one board."""
+class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
+    """A session with one board's APP port."""
 
     def __init__(
         self,
@@ -52,106 +44,27 @@ class Host:
                 f"{url} is the simulated board's control port (UART2, binary frames): this "
                 "command speaks the APP protocol; leave out port=uart2"
             )
-        self.url = url
-        self.tap = tap
+        super().__init__(url, tap, clock, opener)
         self.stop_on_close = stop_on_close
         self.state = HostState(layout)
-        self._clock = clock
-        self._opener = opener
-        self._port: serial.SerialBase | None = opener(url)
-        self._origin = clock()  # after opening: an in-process sim:// board booted just now
-        self._lost_at = 0.0
-        self._pending: list[Event] = []
 
-    # ------------------------------------------------------------ link
-
-    def now(self) -> float:
-        """Seconds since the session started."""
-        return self._clock() - self._origin
-
-    @property
-    def connected(self) -> bool:
-        return self._port is not None
-
-    @property
-    def link(self) -> serial.SerialBase | None:
-        """The open port (None while the link is down)."""
-        return self._port
-
-    def _lost(self, exc: Exception) -> None:
-        if self._port is not None:
-            with contextlib.suppress(serial.SerialException, OSError):
-                self._port.close()
-        self._port = None
-        self._lost_at = self.now()
+    def _on_lost(self) -> None:
         self.state.reset_decoder()
-        self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
-
-    def _reconnect(self) -> None:
-        if self.now() - self._lost_at < RETRY:
-            return
-        self._lost_at = self.now()
-        try:
-            self._port = self._opener(self.url)
-        except AppmodeError:
-            return
-        self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
 
     def send(self, data: bytes) -> None:
         """Write bytes to the board; LinkLost if the link is down."""
-        if self._port is None:
-            self._reconnect()
-        if self._port is None:
-            raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
-        try:
-            self._port.write(data)
-        except (serial.SerialException, OSError) as exc:
-            self._lost(exc)
-            raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
+        self._write(data)
         self.state.sent(data, self.now())
-        if self.tap is not None:
-            self.tap(">", self.now(), data)
 
     def send_command(self, command: app.Command) -> None:
         self.send(app.encode(command))
 
-    def poll(self, timeout: float) -> list[Event]:
-        """What arrives within `timeout` seconds: returns as soon as something does, and
-        never after the deadline. A wait longer than the port's read timeout blocks in
-        the port; a shorter one looks every STEP seconds, so a caller with something to
-        send at the deadline (conform, replay) is not held up by the read."""
-        deadline = self.now() + timeout
-        while True:
-            wait = None if self._port is None else self._port.timeout
-            block = wait is not None and deadline - self.now() >= wait
-            events = self._read_once(block=block)
-            left = deadline - self.now()
-            if events or left <= 0:
-                return events
-            if not block:
-                time.sleep(min(RETRY / 5 if self._port is None else STEP, left))
-
-    def poll_nowait(self) -> list[Event]:
-        """What has arrived, without waiting."""
-        return self._read_once(block=False)
-
     def _read_once(self, block: bool) -> list[Event]:
-        if self._port is None:
-            self._reconnect()
         events = self._take_pending()
-        if self._port is not None:
-            try:
-                waiting = self._port.in_waiting
-                data = self._port.read(max(1, waiting)) if block or waiting else b""
-            except (serial.SerialException, OSError) as exc:
-                self._lost(exc)
-                data = b""
-            events += self._take_pending()
-            if data:
-                now = self.now()
-                if self.tap is not None:
-                    self.tap("<", now, data)
-                events += self.state.feed(data, now)
+        data = self._read_bytes(block)
+        events += self._take_pending()
+        if data:
+            events += self.state.feed(data, self.now())
         outcome = self.state.tick(self.now())
         if outcome is not None:
             events.append(outcome)
@@ -163,17 +76,6 @@ class Host:
         if data:
             with contextlib.suppress(LinkLost):  # the query times out and retries
                 self.send(data)
-
-    def _take_pending(self) -> list[Event]:
-        events, self._pending = self._pending, []
-        return events
-
-    def events(self, duration: float | None = None) -> Iterator[Event]:
-        """Records, errors and link changes as they arrive, for `duration` seconds."""
-        end = None if duration is None else self.now() + duration
-        while end is None or self.now() < end:
-            step = 0.2 if end is None else max(0.0, min(0.2, end - self.now()))
-            yield from self.poll(step)
 
     # ------------------------------------------------------------ parameters
 
@@ -222,11 +124,7 @@ class Host:
             return self.close()  # the port is gone: nothing was sent
         except AppmodeError:
             pass  # written; only its recording failed, which must not keep the port open
-        if self._port is not None:
-            with contextlib.suppress(serial.SerialException, OSError):
-                self._port.flush()
-            self._port.close()
-            self._port = None
+        self._close_port()
         return stop
 
     def __enter__(self) -> Host:

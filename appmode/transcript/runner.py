@@ -20,7 +20,8 @@ from appmode.board.profiles import Profile, profile_named
 from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
-from appmode.host.client import Host, LinkLost
+from appmode.host.client import Host
+from appmode.host.link import LinkLost
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.link import is_simulated, open_link

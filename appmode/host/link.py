@@ -1,0 +1,159 @@
+"""A host's side of a link, whatever it speaks: open a URL, write, read, notice a lost
+link and reopen the same URL every RETRY seconds, saying so each time (LinkStatus).
+
+Thread-free: the protocol hosts (`client.Host` on the APP port, `control_client.
+ControlHost` on UART2) build on it and decode what `_read_once` brings.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable, Iterator
+from typing import Generic, TypeVar
+
+import serial
+
+from appmode.errors import AppmodeError
+from appmode.host.state import LinkStatus
+from appmode.line.wire import Tap
+
+RETRY = 0.5
+STEP = 0.001
+"""Seconds between looks at the port while waiting less than its read timeout."""
+
+E = TypeVar("E")
+
+
+class LinkLost(AppmodeError):
+    """The link is down; the host is trying to get it back."""
+
+
+class Link(Generic[E]):
+    """One open port and its session clock; `sent`/`received` name the tap directions."""
+
+    sent = ">"
+    received = "<"
+
+    def __init__(
+        self,
+        url: str,
+        tap: Tap | None,
+        clock: Callable[[], float],
+        opener: Callable[[str], serial.SerialBase],
+    ) -> None:
+        self.url = url
+        self.tap = tap
+        self._clock = clock
+        self._opener = opener
+        self._port: serial.SerialBase | None = opener(url)
+        self._origin = clock()  # after opening: an in-process sim:// board booted just now
+        self._lost_at = 0.0
+        self._pending: list[E | LinkStatus] = []
+
+    def now(self) -> float:
+        """Seconds since the session started."""
+        return self._clock() - self._origin
+
+    @property
+    def connected(self) -> bool:
+        return self._port is not None
+
+    @property
+    def link(self) -> serial.SerialBase | None:
+        """The open port (None while the link is down)."""
+        return self._port
+
+    def _on_lost(self) -> None:
+        """What the protocol forgets when the link drops (a decoder's partial bytes)."""
+
+    def _lost(self, exc: Exception) -> None:
+        if self._port is not None:
+            with contextlib.suppress(serial.SerialException, OSError):
+                self._port.close()
+        self._port = None
+        self._lost_at = self.now()
+        self._on_lost()
+        self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
+
+    def _reconnect(self) -> None:
+        if self.now() - self._lost_at < RETRY:
+            return
+        self._lost_at = self.now()
+        try:
+            self._port = self._opener(self.url)
+        except AppmodeError:
+            return
+        self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
+
+    def _write(self, data: bytes) -> None:
+        """Write bytes to the board and tap them; LinkLost if the link is down."""
+        if self._port is None:
+            self._reconnect()
+        if self._port is None:
+            raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
+        try:
+            self._port.write(data)
+        except (serial.SerialException, OSError) as exc:
+            self._lost(exc)
+            raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
+        if self.tap is not None:
+            self.tap(self.sent, self.now(), data)
+
+    def _read_bytes(self, block: bool) -> bytes:
+        """What the port has (waiting for the first byte up to its timeout if `block`),
+        tapped; b"" when nothing came or the link is down."""
+        if self._port is None:
+            self._reconnect()
+        if self._port is None:
+            return b""
+        try:
+            waiting = self._port.in_waiting
+            data: bytes = self._port.read(max(1, waiting)) if block or waiting else b""
+        except (serial.SerialException, OSError) as exc:
+            self._lost(exc)
+            return b""
+        if data and self.tap is not None:
+            self.tap(self.received, self.now(), data)
+        return data
+
+    def _read_once(self, block: bool) -> list[E | LinkStatus]:
+        raise NotImplementedError
+
+    def poll(self, timeout: float) -> list[E | LinkStatus]:
+        """What arrives within `timeout` seconds: returns as soon as something does, and
+        never after the deadline. A wait longer than the port's read timeout blocks in
+        the port; a shorter one looks every STEP seconds, so a caller with something to
+        send at the deadline (conform, replay) is not held up by the read."""
+        deadline = self.now() + timeout
+        while True:
+            wait = None if self._port is None else self._port.timeout
+            block = wait is not None and deadline - self.now() >= wait
+            events = self._read_once(block=block)
+            left = deadline - self.now()
+            if events or left <= 0:
+                return events
+            if not block:
+                time.sleep(min(RETRY / 5 if self._port is None else STEP, left))
+
+    def poll_nowait(self) -> list[E | LinkStatus]:
+        """What has arrived, without waiting."""
+        return self._read_once(block=False)
+
+    def events(self, duration: float | None = None) -> Iterator[E | LinkStatus]:
+        """What arrives, as it arrives, for `duration` seconds (forever: None)."""
+        end = None if duration is None else self.now() + duration
+        while end is None or self.now() < end:
+            step = 0.2 if end is None else max(0.0, min(0.2, end - self.now()))
+            yield from self.poll(step)
+
+    def _take_pending(self) -> list[E | LinkStatus]:
+        events, self._pending = self._pending, []
+        return events
+
+    def _close_port(self) -> None:
+        if self._port is not None:
+            with contextlib.suppress(serial.SerialException, OSError):
+                self._port.flush()
+            self._port.close()
+            self._port = None
