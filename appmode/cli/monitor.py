@@ -7,16 +7,19 @@ import sys
 from contextlib import ExitStack
 from typing import TextIO
 
+from appmode.cli import control_port
 from appmode.cli.hostio import open_host, show
 from appmode.cli.options import (
     DAY,
     Subparsers,
     add_profile,
     add_record,
+    add_uart2,
     add_url,
     layout_for,
     number_type,
 )
+from appmode.errors import AppmodeError
 from appmode.host.client import Event
 from appmode.protocol import app
 from appmode.protocol.layouts import VELOCITY, ALayout
@@ -39,6 +42,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="send Z when the monitor ends (it sends nothing otherwise)",
     )
+    add_uart2(mon, "print the replies and encoder reports of the board's control port")
     add_record(mon)
     return mon
 
@@ -66,6 +70,18 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.uart2:
+        if args.filter is not None:
+            raise AppmodeError("--filter picks APP records: not with --uart2")
+        return control_port.run_monitor(
+            args.url,
+            as_json=args.json,
+            duration=args.duration,
+            count=args.count,
+            record=args.record,
+            out=sys.stdout,
+            stop_on_exit=args.stop_on_exit,
+        )
     return run_monitor(
         args.url,
         as_json=args.json,

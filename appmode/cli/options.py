@@ -28,6 +28,14 @@ def add_url(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("url", metavar="URL", help=URL_FORMS)
 
 
+def add_uart2(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument(
+        "--uart2",
+        action="store_true",
+        help=f"{what}; a sim:// URL opens the simulated board's control port",
+    )
+
+
 def add_record(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--record", metavar="FILE", help="record the session as a transcript (flushed line by line)"

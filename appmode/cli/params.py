@@ -9,8 +9,16 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.board.profiles import SHEET, Profile
+from appmode.cli import control_port
 from appmode.cli.hostio import open_host
-from appmode.cli.options import Subparsers, add_profile, add_record, add_url, profile_for
+from appmode.cli.options import (
+    Subparsers,
+    add_profile,
+    add_record,
+    add_uart2,
+    add_url,
+    profile_for,
+)
 from appmode.errors import AppmodeError
 from appmode.host import saves
 from appmode.protocol import params
@@ -42,11 +50,26 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "remembers what was saved for --verify-saved",
     )
     saving.add_argument(
+        "--load",
+        action="store_true",
+        help="with --uart2: load the saved settings into the running copy first",
+    )
+    saving.add_argument(
+        "--defaults",
+        action="store_true",
+        help="with --uart2: load the factory defaults into the running copy first",
+    )
+    saving.add_argument(
         "--verify-saved",
         action="store_true",
         help="after the board restarted: check it holds what --save saved (exit 1 if not)",
     )
     prm.add_argument("--json", action="store_true", help="print one JSON object")
+    add_uart2(
+        prm,
+        "the ten settings over the board's control port (binary frames at 115200 bps; "
+        "--save, --load, --defaults as its load/save frames)",
+    )
     add_profile(
         prm,
         "the board's profile, for the defaults shown: sheet or minibalance (the reference "
@@ -58,6 +81,18 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.uart2:
+        if args.verify_saved:
+            raise AppmodeError(
+                "--verify-saved is for the APP port: over --uart2, restart the board and "
+                "read the settings again"
+            )
+        store = next((op for op in ("load", "defaults", "save") if getattr(args, op)), None)
+        return control_port.run_params(
+            args.url, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
+        )
+    if args.load or args.defaults:
+        raise AppmodeError("--load and --defaults are frames of the control port: add --uart2")
     return run_params(
         args.url,
         args.set,

@@ -7,16 +7,19 @@ import sys
 from contextlib import ExitStack
 from typing import TextIO
 
+from appmode.cli import control_port
 from appmode.cli.hostio import open_host, show
 from appmode.cli.options import (
     DAY,
     Subparsers,
     add_profile,
     add_record,
+    add_uart2,
     add_url,
     layout_for,
     number_type,
 )
+from appmode.host import control_tokens
 from appmode.host.tokens import Wait, parse_token
 from appmode.protocol.app import HostDecoder
 from appmode.protocol.layouts import VELOCITY, ALayout
@@ -45,12 +48,28 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--raw", action="store_true", help="send frames even if the board would reject them"
     )
     send.add_argument("--json", action="store_true", help="print JSON Lines")
+    add_uart2(send, "send over the board's control port; " + control_tokens.HELP)
+    send.add_argument(
+        "--no-report",
+        action="store_true",
+        help="with --uart2: leave the encoder report as it is (it is on for the session)",
+    )
     add_profile(send, default=None)
     add_record(send)
     return send
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.uart2:
+        return control_port.run_send(
+            args.url,
+            args.tokens,
+            listen=args.listen,
+            report=not args.no_report,
+            as_json=args.json,
+            record=args.record,
+            out=sys.stdout,
+        )
     return run_send(
         args.url,
         args.tokens,

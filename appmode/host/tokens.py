@@ -21,19 +21,24 @@ class Wait:
     seconds: float
 
 
+def parse_wait(token: str) -> Wait:
+    """`wait:SECONDS` (0 to an hour)."""
+    try:
+        seconds = float(token[5:])
+    except ValueError:
+        seconds = -1.0
+    if not 0 <= seconds <= 3600:
+        raise AppmodeError(f"token {token!r}: wait takes seconds, e.g. wait:0.5")
+    return Wait(seconds)
+
+
 def parse_token(token: str, raw: bool = False) -> bytes | Wait:
     """The bytes a token sends, or a Wait; AppmodeError names the token and the fix.
 
     Frames are checked as the board would decode them, unless `raw` is set.
     """
     if token.startswith("wait:"):
-        try:
-            seconds = float(token[5:])
-        except ValueError:
-            seconds = -1.0
-        if not 0 <= seconds <= 3600:
-            raise AppmodeError(f"token {token!r}: wait takes seconds, e.g. wait:0.5")
-        return Wait(seconds)
+        return parse_wait(token)
     try:
         data = unescape(token)
     except ValueError as exc:

@@ -415,6 +415,16 @@ class HostDecoder:
         self._buf = buf[pos:]
         return out
 
+    def rest(self) -> bytes:
+        """Zeros completing the frame being received (its mode `01` after a bare header),
+        so that what is sent next is read from its start; b"" when no frame is open."""
+        buf = self._buf
+        if self._app is not None or not buf.startswith(HEADER):
+            return b""
+        if len(buf) == len(HEADER):
+            return bytes([VELOCITY]) + bytes(FRAME - len(HEADER) - 1)
+        return bytes(self._lengths[buf[2]] - len(buf))
+
     def flush(self) -> list[HostEvent | app.HostEvent]:
         """Report what is held at the end of the stream (a truncated frame)."""
         if self._app is not None:
@@ -429,16 +439,27 @@ class HostDecoder:
 
 # ---------------------------------------------------------------- board stream decoder
 
+_REPORT_3, _REPORT_4 = 2 + 8 * 3, 2 + 8 * 4
+
+
+def _report_length(buf: bytes, pos: int) -> int | None:
+    """The length of the report at `pos` when its wheel count is not given: 3 wheels if
+    its 26th byte is `19`, else 4; None while too few bytes tell."""
+    if len(buf) - pos < _REPORT_3:
+        return None
+    return _REPORT_3 if buf[pos + _REPORT_3 - 1] == REPORT_END else _REPORT_4
+
 
 class BoardDecoder:
     """board→host bytes → `#` replies and encoder reports (§11, §12); while `app_mode`
     (system_mode bit 7) is on, APP records (§3) instead. `wheels` (3 or 4) fixes a
-    report's length."""
+    report's length; None tells it by where the report's `19` is: a 3-wheel report's
+    end falls where a 4-wheel report holds wheel D's top byte, never 19 for a speed."""
 
-    def __init__(self, wheels: int = 4, app_mode: bool = False) -> None:
+    def __init__(self, wheels: int | None = 4, app_mode: bool = False) -> None:
         self._buf = b""
         self.wheels = wheels
-        self.limit = max(2 + 8 * wheels, MAX_RUN, app.BoardDecoder.LIMIT)
+        self.limit = max(2 + 8 * (wheels or 4), MAX_RUN, app.BoardDecoder.LIMIT)
         """Most bytes ever held between calls."""
         self._app: app.BoardDecoder | None = app.BoardDecoder() if app_mode else None
 
@@ -464,7 +485,7 @@ class BoardDecoder:
         buf = self._buf + data if self._buf else bytes(data)
         out: list[BoardEvent] = []
         pos, n = 0, len(buf)
-        report_len = 2 + 8 * self.wheels
+        fixed = None if self.wheels is None else 2 + 8 * self.wheels
         while pos < n:
             byte = buf[pos]
             if byte == REPLY:
@@ -477,7 +498,8 @@ class BoardDecoder:
                 pos += REPLY_LEN
                 continue
             if byte == REPORT:
-                if n - pos < report_len:
+                report_len = fixed or _report_length(buf, pos)
+                if report_len is None or n - pos < report_len:
                     break
                 raw = buf[pos : pos + report_len]
                 if raw[-1] == REPORT_END:

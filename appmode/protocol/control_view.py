@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from appmode.protocol import control
+from appmode.protocol import control, settings
 
 EVENTS = (
     control.VelocityFrame,
@@ -88,3 +88,17 @@ def describe(event: control.HostEvent | control.Reply | control.EncoderReport) -
         pairs = zip("ABCD", event.targets, event.actuals, strict=False)
         return "encoders " + " ".join(f"{w}={t}/{a}" for w, t, a in pairs)
     return f"error: {event.reason}"
+
+
+def settings_table(values: dict[str, int]) -> str:
+    """The ten settings as an aligned table (docs/protocol.md §10): id, name, value,
+    range, default; a value outside its range (a board may hold one) is flagged."""
+    rows = [f"{'id':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
+    for setting in settings.SETTINGS:
+        value = values[setting.name]
+        flag = "" if settings.value_error(setting, value) is None else "  out of range"
+        rows.append(
+            f"{setting.id:>2}  {setting.name:<18} {value:>10}  "
+            f"{setting.range_text:<14} {setting.default:>7}{flag}"
+        )
+    return "\n".join(rows)

@@ -242,3 +242,37 @@ def test_a_megabyte_of_garbage_decodes_in_linear_time(data: bytes) -> None:
         events = [*decoder.feed(data), *decoder.flush()]
         assert b"".join(e.raw for e in events) == data
         assert time.perf_counter() - start < 20.0
+
+
+@pytest.mark.parametrize("wheels", [3, 4])
+def test_s12_a_report_of_either_length_decodes_without_its_wheel_count(wheels: int) -> None:
+    report = EncoderReport(tuple(range(-wheels, 0)), tuple(range(100, 100 + wheels)))
+    data = encode(report) + encode(Reply(1, 500)) + encode(report)
+    events = assert_split_invariant(partial(BoardDecoder, None), data)
+    assert [type(e) for e in events] == [EncoderReport, Reply, EncoderReport]
+    assert events[0].targets == report.targets and events[2].actuals == report.actuals
+
+
+@given(st.binary(max_size=300), st.lists(st.integers(1, 40), min_size=1, max_size=20))
+def test_the_report_length_finder_keeps_every_byte_in_one_event(
+    data: bytes, cuts: list[int]
+) -> None:
+    assert_any_bytes_ok(partial(BoardDecoder, None), data, cuts, limit=BoardDecoder(None).limit)
+
+
+@pytest.mark.parametrize(
+    ("sent", "rest"),
+    [
+        ("", ""),
+        ("12 34", ""),
+        ("FF FE", "01 00 00 00 00 00 00 00"),
+        ("FF FE 01 03", "00 00 00 00 00 00"),
+        ("FF FE 80 80 11", "00 00 00 00 00"),
+    ],
+)
+def test_rest_completes_an_open_frame_so_the_next_is_read_whole(sent: str, rest: str) -> None:
+    decoder = HostDecoder(DriveType.MECANUM)
+    decoder.feed(bytes.fromhex(sent))
+    assert decoder.rest() == bytes.fromhex(rest)
+    after = decoder.feed(decoder.rest() + control.STOP)
+    assert after[-1] == control.VelocityFrame(0, 0, 0), "the stop frame is read whole"

@@ -1,0 +1,96 @@
+"""Command-line tokens for `appmode send --uart2`: frames by name, raw hex and waits."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from appmode.errors import AppmodeError
+from appmode.host.tokens import Wait, parse_wait
+from appmode.protocol import control, settings
+
+HELP = (
+    "tokens are velocity:X,Y,Z (diff-gyro: velocity:LEFT,RIGHT), rotate:DEGREES, "
+    "motors:A,B,C[,D], position:X,Y,Z, read:NAME, set:NAME=VALUE, save, load, defaults, "
+    "stop, wait:SECONDS and raw hex (FFFE0100000000000000)"
+)
+WORDS = ("velocity", "rotate", "motors", "position", "read", "set")
+
+
+@dataclass(frozen=True, slots=True)
+class Step:
+    """A named step; `values` are checked for their drive type when sent."""
+
+    kind: str
+    values: tuple[int, ...] = ()
+    name: str = ""
+
+
+Token = Step | Wait | bytes
+
+
+def parse_token(token: str) -> Token:
+    """A Step, a Wait or raw bytes; AppmodeError names the token and the fix."""
+    if token.startswith("wait:"):
+        return parse_wait(token)
+    word, sep, rest = token.partition(":")
+    word = word.lower()
+    if not sep:
+        if word in settings.STORE_BY_NAME or word == "stop":
+            return Step(word)
+        return _hex(token)
+    if word not in WORDS:
+        raise AppmodeError(f"token {token!r} is not understood: {HELP}")
+    if word == "read":
+        try:
+            return Step(word, name=settings.read_named(rest).name)
+        except ValueError as exc:
+            raise AppmodeError(f"token {token!r}: {exc}") from None
+    if word == "set":
+        name, eq, value = rest.partition("=")
+        number = _numbers(token, value)
+        try:
+            setting = settings.lookup(name)
+        except ValueError as exc:
+            raise AppmodeError(f"token {token!r}: {exc}") from None
+        if not eq or len(number) != 1:
+            raise AppmodeError(f"token {token!r}: expected set:NAME=VALUE, e.g. set:max_speed=800")
+        error = settings.value_error(setting, number[0])
+        if error is not None:
+            raise AppmodeError(f"token {token!r}: {error}")
+        return Step(word, number, setting.name)
+    if word == "rotate":
+        try:
+            degrees = float(rest)
+        except ValueError:
+            degrees = float("nan")
+        if not abs(degrees) <= control.U16 / 10:
+            raise AppmodeError(f"token {token!r}: rotate takes degrees, e.g. rotate:90")
+        return Step(word, (round(degrees * 10),))
+    values = _numbers(token, rest)
+    counts = {"velocity": (2, 3), "motors": (3, 4), "position": (3,)}[word]
+    if len(values) not in counts:
+        raise AppmodeError(
+            f"token {token!r}: {word} takes {' or '.join(map(str, counts))} numbers; {HELP}"
+        )
+    for each in values:
+        if abs(each) > control.U16:
+            raise AppmodeError(f"token {token!r}: {each} is beyond ±{control.U16}")
+    return Step(word, values)
+
+
+def _numbers(token: str, text: str) -> tuple[int, ...]:
+    try:
+        return tuple(int(part) for part in text.split(","))
+    except ValueError:
+        raise AppmodeError(f"token {token!r}: expected whole numbers; {HELP}") from None
+
+
+def _hex(token: str) -> bytes:
+    text = token.replace(" ", "").replace(",", "")
+    try:
+        data = bytes.fromhex(text)
+    except ValueError:
+        data = b""
+    if not data:
+        raise AppmodeError(f"token {token!r} is not understood: {HELP}")
+    return data
