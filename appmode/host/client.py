@@ -10,7 +10,6 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable
-from types import TracebackType
 
 import serial
 
@@ -109,31 +108,8 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
 
     # ------------------------------------------------------------ end
 
-    def close(self) -> bytes | None:
-        """Stop the car (`Z` is the last byte sent, after `{}` if a frame is open and `K`
-        and the page letter if a button-page rotation may go on: SessionEnd), then
-        close the port. Returns the bytes of that stop, or None if the link was down.
-        A passive host (`stop_on_close=False`, a monitor) sends nothing."""
-        if self._port is None:
-            return None
-        stop = self.state.end.stop if self.stop_on_close else b""
-        try:
-            if stop:
-                self.send(stop)
-        except LinkLost:
-            return self.close()  # the port is gone: nothing was sent
-        except AppmodeError:
-            pass  # written; only its recording failed, which must not keep the port open
-        self._close_port()
-        return stop
+    def _stop(self) -> bytes:
+        return self.state.end.stop
 
-    def __enter__(self) -> Host:
-        return self
-
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        value: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
+    def _send_stop(self, data: bytes) -> None:
+        self.send(data)

@@ -14,12 +14,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterable, Iterator
 from functools import partial
-from types import TracebackType
 
 import serial
 
 from appmode.errors import AppmodeError
-from appmode.host.link import STEP, Link, LinkLost
+from appmode.host.link import STEP, Link
 from appmode.host.query import AGREE, TRIES
 from appmode.host.state import LinkStatus
 from appmode.line.wire import UART2_BAUD, Tap
@@ -329,30 +328,9 @@ class ControlHost(Link[control.BoardEvent]):
             return b"{}Z" if self._sent.buffered else b"Z"
         return self._sent.rest() + control.STOP
 
-    def close(self) -> bytes | None:
-        """Stop the car (stop_bytes last), then close the port; the bytes sent, or None
-        if the link was down. A passive host (`stop_on_close=False`) sends nothing."""
-        if self._port is None:
-            return None
-        stop = self.stop_bytes if self.stop_on_close else b""
-        try:
-            if stop:
-                self.send(stop)
-        except LinkLost:
-            return self.close()
-        except AppmodeError:
-            pass  # written; only its recording failed, which must not keep the port open
-        self._close_port()
-        return stop
+    def _stop(self) -> bytes:
+        return self.stop_bytes
 
-    def __enter__(self) -> ControlHost:
-        return self
-
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        value: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
+    def _send_stop(self, data: bytes) -> None:
+        self.send(data)
 

@@ -10,7 +10,8 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator
-from typing import Generic, TypeVar
+from types import TracebackType
+from typing import Any, Generic, TypeVar
 
 import serial
 
@@ -23,6 +24,7 @@ STEP = 0.001
 """Seconds between looks at the port while waiting less than its read timeout."""
 
 E = TypeVar("E")
+L = TypeVar("L", bound="Link[Any]")
 
 
 class LinkLost(AppmodeError):
@@ -34,6 +36,7 @@ class Link(Generic[E]):
 
     sent = ">"
     received = "<"
+    stop_on_close = True
 
     def __init__(
         self,
@@ -151,9 +154,41 @@ class Link(Generic[E]):
         events, self._pending = self._pending, []
         return events
 
-    def _close_port(self) -> None:
+    def _stop(self) -> bytes:
+        """The bytes that leave the car stopped, sent last when the session closes."""
+        raise NotImplementedError
+
+    def close(self) -> bytes | None:
+        """Stop the car (`_stop()` is the last thing sent), then close the port. Returns
+        the bytes of that stop, or None if the link was down. A passive host
+        (`stop_on_close` False, a monitor) sends nothing."""
+        if self._port is None:
+            return None
+        stop = self._stop() if self.stop_on_close else b""
+        try:
+            if stop:
+                self._send_stop(stop)
+        except LinkLost:
+            return self.close()  # the port is gone: nothing was sent
+        except AppmodeError:
+            pass  # written; only its recording failed, which must not keep the port open
         if self._port is not None:
             with contextlib.suppress(serial.SerialException, OSError):
                 self._port.flush()
             self._port.close()
             self._port = None
+        return stop
+
+    def _send_stop(self, data: bytes) -> None:
+        self._write(data)
+
+    def __enter__(self: L) -> L:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
