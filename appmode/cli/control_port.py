@@ -6,19 +6,18 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Iterable
-from contextlib import ExitStack, closing
+from contextlib import ExitStack
 from typing import TextIO
 
+from appmode.cli.hostio import with_recording
 from appmode.errors import AppmodeError
 from appmode.host.control_client import ControlHost, Event
 from appmode.host.control_tokens import Step, parse_token
 from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
-from appmode.ports.sim import sim_directives
 from appmode.protocol import control, control_view, params, settings
 from appmode.protocol.control_view import describe, hex_text, settings_table, to_json
 from appmode.protocol.render import line
-from appmode.protocol.transcript import Recorder
 
 TAKEOVER = (
     "frames sent on the control port take over the car's motion from the APP port "
@@ -29,17 +28,8 @@ TAKEOVER = (
 def open_control_host(
     stack: ExitStack, url: str, record: str | None, stop_on_close: bool = True
 ) -> ControlHost:
-    """The control-port host, then its recording (as hostio.open_host)."""
-    host = ControlHost(url, stop_on_close=stop_on_close)
-    try:
-        recorder = Recorder.create(record, 0.0, sim_directives(url)) if record else None
-    except BaseException:
-        host.close()
-        raise
-    if recorder is not None:
-        stack.enter_context(closing(recorder))
-        host.tap = recorder
-    return stack.enter_context(host)
+    """The control-port host, then its recording (hostio.with_recording)."""
+    return with_recording(stack, ControlHost(url, stop_on_close=stop_on_close), record)
 
 
 def show(host: ControlHost, event: Event, out: TextIO, as_json: bool) -> None:

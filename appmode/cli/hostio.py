@@ -6,15 +6,18 @@ from __future__ import annotations
 import json
 import sys
 from contextlib import ExitStack, closing
-from typing import TextIO
+from typing import TextIO, TypeVar
 
 from appmode.host.client import Event, Host
+from appmode.host.control_client import ControlHost
 from appmode.host.query import QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
 from appmode.ports.sim import sim_directives
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import describe, line, to_json
 from appmode.protocol.transcript import Recorder
+
+H = TypeVar("H", Host, ControlHost)
 
 
 def open_host(
@@ -24,11 +27,15 @@ def open_host(
     stop_on_close: bool = True,
     layout: ALayout = VELOCITY,
 ) -> Host:
-    """The host, then its recording: a URL that does not open leaves the file untouched.
-    The recording is closed after the host, so it holds the final stop."""
-    host = Host(url, stop_on_close=stop_on_close, layout=layout)
+    """The APP host, then its recording (`with_recording`)."""
+    return with_recording(stack, Host(url, stop_on_close=stop_on_close, layout=layout), record)
+
+
+def with_recording(stack: ExitStack, host: H, record: str | None) -> H:
+    """An opened host, then its recording: a URL that does not open leaves the file
+    untouched. The recording is closed after the host, so it holds the final stop."""
     try:
-        recorder = Recorder.create(record, 0.0, sim_directives(url)) if record else None
+        recorder = Recorder.create(record, 0.0, sim_directives(host.url)) if record else None
     except BaseException:
         host.close()
         raise
