@@ -6,18 +6,18 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Iterable
-from contextlib import ExitStack
+from contextlib import ExitStack, suppress
 from typing import TextIO
 
 from appmode.cli.hostio import with_recording
 from appmode.errors import AppmodeError
 from appmode.host.control_client import ControlHost, Event
-from appmode.host.control_tokens import Step, parse_token
+from appmode.host.control_tokens import Step, parse_setting, parse_token
 from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
-from appmode.protocol import control, control_view, params, settings
-from appmode.protocol.control_view import describe, hex_text, settings_table, to_json
-from appmode.protocol.render import line
+from appmode.protocol import control, params, reader, settings
+from appmode.protocol.control_view import settings_table
+from appmode.protocol.render import line, view
 
 TAKEOVER = (
     "frames sent on the control port take over the car's motion from the APP port "
@@ -32,69 +32,25 @@ def open_control_host(
     return with_recording(stack, ControlHost(url, stop_on_close=stop_on_close), record)
 
 
-def show(host: ControlHost, event: Event, out: TextIO, as_json: bool) -> None:
-    """One event the board sent: text or a JSON line; link changes on stderr."""
+def show(
+    host: ControlHost, direction: str, event: reader.Event | LinkStatus, out: TextIO, as_json: bool
+) -> None:
+    """One event: a line of text, or (what the board sent) a JSON line; link changes on
+    stderr. APP records show as such while APP mode (bit 7) moves them here (§12)."""
     if isinstance(event, LinkStatus):
         print(f"appmode: {event.text}", file=sys.stderr, flush=True)
         return
-    if not isinstance(event, (control.Reply, control.EncoderReport, control.Garbage)):
-        text = f"APP mode: {type(event).__name__}"  # records while bit 7 is on (§12)
-        body = {"kind": "app", "raw": event.raw.decode("latin-1")}
-        if as_json:
-            out.write(json.dumps({"t": round(host.now(), 3), **body}) + "\n")
-        else:
-            out.write(line(host.now(), "2<", event.raw, text) + "\n")
-        out.flush()
-        return
+    if as_json and direction == host.sent:
+        return  # JSON Lines hold what came back, as for the APP port
+    body, text, shown = view(event)
     if as_json:
-        out.write(json.dumps({"t": round(host.now(), 3), **to_json(event)}) + "\n")
+        out.write(json.dumps({"t": round(host.now(), 3), **body}) + "\n")
     else:
-        out.write(line(host.now(), "2<", event.raw, describe(event), hex_text(event.raw)) + "\n")
+        out.write(line(host.now(), direction, event.raw, text, shown) + "\n")
     out.flush()
 
 
-def print_session(host: ControlHost, out: TextIO, as_json: bool) -> None:
-    """Print the session as it goes: each event as it is decoded, and (as text) the
-    bytes sent, through the host's tap (after the recording, if any)."""
-    record = host.tap
-    sending = control.HostDecoder()
-
-    def tap(direction: str, now: float, data: bytes) -> None:
-        if record is not None:
-            record(direction, now, data)
-        if direction != host.sent or as_json:
-            return
-        sending.drive = host.known_drive or params.DriveType.OMNI
-        events = [e for e in sending.feed(data) if isinstance(e, control_view.EVENTS)]
-        text = ", ".join(describe(e) for e in events) or "(part of a frame)"
-        out.write(line(now, direction, data, text, hex_text(data)) + "\n")
-        out.flush()
-
-    host.tap = tap
-    host.watch = lambda event: show(host, event, out, as_json)
-
-
 # ---------------------------------------------------------------- params --uart2
-
-
-def parse_setting(text: str) -> tuple[settings.Setting, int]:
-    """`NAME=VALUE` (or `ID=VALUE`), checked against the settings table."""
-    name, sep, value = text.partition("=")
-    if not sep:
-        raise AppmodeError(f"--set {text!r}: expected NAME=VALUE, e.g. max_speed=800")
-    try:
-        setting = settings.lookup(name)
-    except ValueError as exc:
-        raise AppmodeError(f"--set {text!r}: {exc}") from None
-    number = params.whole(value)
-    if number is None:
-        raise AppmodeError(
-            f"--set {text!r}: {setting.name} takes a whole number in {setting.range_text}"
-        )
-    error = settings.value_error(setting, number)
-    if error is not None:
-        raise AppmodeError(f"--set {text!r}: {error}")
-    return setting, number
 
 
 def run_params(
@@ -108,7 +64,7 @@ def run_params(
 ) -> int:
     """Read the ten settings; `load` or `defaults` first, then set each (verified by
     reading back), then `save`; print them."""
-    changes = [parse_setting(text) for text in assignments]  # all checked first
+    changes = [parse_setting(text, f"--set {text!r}") for text in assignments]  # checked first
     print(f"appmode: {TAKEOVER}", file=sys.stderr)
     with ExitStack() as stack:
         host = open_control_host(stack, url, record)
@@ -152,23 +108,23 @@ def run_send(
     steps = [parse_token(token) for token in tokens]  # all checked before sending
     with ExitStack() as stack:
         host = open_control_host(stack, url, record)
-        print_session(host, out, as_json)
+        host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         report_bit = params.MODE_BIT["encoder_report"]
-        before = host.read("system_mode") if report else None
-        if before is not None and not before & report_bit:
-            host.send_frame(_set("system_mode", before | report_bit))
-        for step in steps:
-            if isinstance(step, Wait):
-                _drain(host.events(step.seconds))
-            elif isinstance(step, Step) and step.kind == "rotate":
-                host.start_rotation(step.values[0] / 10)
-                host.wait_rotation()
-            else:
-                _perform(host, step)
-            _drain(host.poll(0))
-        _drain(host.events(listen))
-        if before is not None and not before & report_bit:
-            host.send_frame(_set("system_mode", before))
+        mode = host.read("system_mode") if report else report_bit
+        with ExitStack() as session:
+            if not mode & report_bit:  # on for the session, then as it was (before the stop)
+                host.send_frame(_set("system_mode", mode | report_bit))
+                session.callback(_restore, host, _set("system_mode", mode))
+            for step in steps:
+                if isinstance(step, Wait):
+                    _drain(host.events(step.seconds))
+                elif isinstance(step, Step) and step.kind == "rotate":
+                    host.start_rotation(step.values[0] / 10)
+                    host.wait_rotation()
+                else:
+                    _perform(host, step)
+                _drain(host.poll(0))
+            _drain(host.events(listen))
         if host.close() is None:
             print("appmode: the link is down: the final stop frame was not sent", file=sys.stderr)
             return 1
@@ -176,39 +132,48 @@ def run_send(
 
 
 def _drain(events: Iterable[Event]) -> None:
-    """Read on (the session is printed as it is decoded: print_session)."""
+    """Read on (the session is printed as it is decoded: `host.watch`)."""
     for _ in events:
         pass
+
+
+def _restore(host: ControlHost, frame: control.SetSetting) -> None:
+    """Put a setting back as the session ends, if the link still lets it."""
+    with suppress(AppmodeError):
+        host.send_frame(frame)
 
 
 def _set(name: str, value: int) -> control.SetSetting:
     return control.SetSetting(settings.BY_NAME[name], value)
 
 
-def _perform(host: ControlHost, step: Step | bytes) -> bytes:
-    """Send one step; the bytes sent."""
+def _perform(host: ControlHost, step: Step | bytes) -> None:
+    """Send one step."""
     if isinstance(step, bytes):
         host.send(step)
-        return step
+        return
     kind, values = step.kind, step.values
     if kind == "velocity":
-        if host.drive is params.DriveType.DIFF_GYRO and len(values) == 2:
-            return host.velocity(left=values[0], right=values[1])
-        if len(values) != 3:
+        if host.drive is params.DriveType.DIFF_GYRO:
+            if len(values) != 2:
+                raise AppmodeError("velocity: a diff-gyro car takes LEFT,RIGHT duties")
+            host.velocity(left=values[0], right=values[1])
+        elif len(values) != 3:
             raise AppmodeError(f"velocity: a {host.drive.cli_name} car takes X,Y,Z")
-        return host.velocity(*values)
-    if kind == "motors":
-        return host.motors(values)
-    if kind == "position":
-        return host.position(*values)
-    if kind == "read":
-        return host.send_frame(control.read(step.name))
-    if kind == "set":
-        return host.send_frame(_set(step.name, values[0]))
-    if kind == "stop":
+        else:
+            host.velocity(*values)
+    elif kind == "motors":
+        host.motors(values)
+    elif kind == "position":
+        host.position(*values)
+    elif kind == "read":
+        host.send_frame(control.read(step.name))
+    elif kind == "set":
+        host.send_frame(_set(step.name, values[0]))
+    elif kind == "stop":
         host.stop()
-        return control.STOP
-    return host.send_frame(control.store(kind))
+    else:
+        host.store(kind)
 
 
 # ---------------------------------------------------------------- monitor --uart2
@@ -231,7 +196,7 @@ def run_monitor(
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         try:
             for event in host.events(duration):
-                show(host, event, out, as_json)
+                show(host, host.received, event, out, as_json)
                 errors += isinstance(event, control.Garbage)
                 seen += isinstance(event, (control.Reply, control.EncoderReport))
                 if count is not None and seen >= count:

@@ -110,6 +110,3 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
 
     def _stop(self) -> bytes:
         return self.state.end.stop
-
-    def _send_stop(self, data: bytes) -> None:
-        self.send(data)

@@ -18,13 +18,13 @@ from functools import partial
 import serial
 
 from appmode.errors import AppmodeError
-from appmode.host.link import STEP, Link
+from appmode.host.link import Link
 from appmode.host.query import AGREE, TRIES
 from appmode.host.state import LinkStatus
 from appmode.line.wire import UART2_BAUD, Tap
 from appmode.ports.link import is_simulated, open_link
 from appmode.ports.sim import sim_side
-from appmode.protocol import control, params, settings
+from appmode.protocol import control, params, reader, settings
 from appmode.protocol.params import DriveType
 
 READ_TIMEOUT = 0.1
@@ -77,8 +77,9 @@ class ControlHost(Link[control.BoardEvent]):
         self._sent = control.HostDecoder(drive or DriveType.OMNI)
         """What was sent, decoded as the board does: is a frame left open?"""
         self._held: list[Event] = []
-        self.watch: Callable[[Event], None] | None = None
-        """Called with each event as it is decoded (a session printing as it goes)."""
+        self.watch: Callable[[str, reader.Event | LinkStatus], None] | None = None
+        """Called with each frame sent (`2>`) and each event received (`2<`) as it is
+        decoded: a session printing as it goes."""
 
     # ------------------------------------------------------------ bytes
 
@@ -90,11 +91,17 @@ class ControlHost(Link[control.BoardEvent]):
         self._write(data)
         for event in self._sent.feed(data):
             self._follow(event)
+            if self.watch is not None:
+                self.watch(self.sent, event)
 
-    def send_frame(self, frame: control.HostFrame) -> bytes:
-        """Encode and send a frame (ValueError when a value is out of range), after
-        zeros completing a frame that raw bytes left open, so the board reads it whole."""
-        data = self._sent.rest() + control.encode(frame)
+    def send_frame(self, *frames: control.HostFrame) -> bytes:
+        """Encode and send frames, after zeros completing a frame that raw bytes left
+        open, so that the board reads them whole; the bytes sent. AppmodeError names a
+        value out of range."""
+        try:
+            data = self._sent.rest() + b"".join(control.encode(f) for f in frames)
+        except ValueError as exc:
+            raise AppmodeError(f"{type(frames[0]).__name__}: {exc}") from None
         self.send(data)
         return data
 
@@ -124,25 +131,19 @@ class ControlHost(Link[control.BoardEvent]):
             events += self._decoder.feed(data)
         if self.watch is not None:
             for event in events:
-                self.watch(event)
+                self.watch(self.received, event)
         return events
 
-    def _wait(self, done: Callable[[Event], bool], timeout: float) -> bool:
+    def _wait(self, done: Callable[[Event], bool], timeout: float) -> None:
         """Read until an event satisfies `done` or `timeout` passes; every event read is
-        kept for the next poll (a caller printing the session sees it)."""
-        deadline = self.now() + timeout
-        while True:
-            wait = None if self._port is None else self._port.timeout
-            left = deadline - self.now()
-            events = self._receive(block=wait is not None and left >= wait)
+        kept for the next poll."""
+
+        def read(block: bool) -> list[Event]:
+            events = self._receive(block)
             self._held += events
-            if any(done(e) for e in events):
-                return True
-            left = deadline - self.now()
-            if left <= 0:
-                return False
-            if not events and (wait is None or left < wait):
-                time.sleep(min(STEP, left))
+            return events
+
+        self._read_until(timeout, read, lambda events: any(done(e) for e in events))
 
     # ------------------------------------------------------------ reads
 
@@ -165,7 +166,7 @@ class ControlHost(Link[control.BoardEvent]):
                     replies[event.id].append(event.value)
                 return all(len(v) >= AGREE for v in replies.values())
 
-            self.send(b"".join(control.encode(control.ReadFrame(r)) * AGREE for r in want))
+            self.send_frame(*(control.ReadFrame(r) for r in want for _ in range(AGREE)))
             self._wait(done, self.timeout)
             for r in want:
                 values = replies[r.reply_id]
@@ -266,8 +267,11 @@ class ControlHost(Link[control.BoardEvent]):
             raise AppmodeError(f"velocity: {exc}") from None
         return self.send_frame(frame)
 
-    def stop(self) -> None:
-        self.send(control.STOP)
+    def stop(self) -> bytes:
+        """Stop the car now (stop_bytes); the bytes sent."""
+        stop = self.stop_bytes
+        self.send(stop)
+        return stop
 
     def motors(self, speeds: tuple[int, ...]) -> bytes:
         if len(speeds) != self.wheels():
@@ -275,16 +279,10 @@ class ControlHost(Link[control.BoardEvent]):
                 f"motors: a {self.drive.cli_name} car has {self.wheels()} motors, "
                 f"not {len(speeds)}"
             )
-        return self._checked(control.MotorFrame(speeds))
+        return self.send_frame(control.MotorFrame(speeds))
 
     def position(self, x: int, y: int, z: int) -> bytes:
-        return self._checked(control.PositionFrame(x, y, z))
-
-    def _checked(self, frame: control.HostFrame) -> bytes:
-        try:
-            return self.send_frame(frame)
-        except ValueError as exc:
-            raise AppmodeError(f"{type(frame).__name__}: {exc}") from None
+        return self.send_frame(control.PositionFrame(x, y, z))
 
     def rotate(self, degrees: float, timeout: float = ROTATE_TIMEOUT) -> float:
         """Turn by `degrees` in angle mode (§9.1) and wait until the pending angle is 0;
@@ -330,7 +328,4 @@ class ControlHost(Link[control.BoardEvent]):
 
     def _stop(self) -> bytes:
         return self.stop_bytes
-
-    def _send_stop(self, data: bytes) -> None:
-        self.send(data)
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from appmode.errors import AppmodeError
 from appmode.host.tokens import Wait, parse_wait
-from appmode.protocol import control, settings
+from appmode.protocol import control, params, settings
 
 HELP = (
     "tokens are velocity:X,Y,Z (diff-gyro: velocity:LEFT,RIGHT), rotate:DEGREES, "
@@ -46,18 +46,8 @@ def parse_token(token: str) -> Token:
         except ValueError as exc:
             raise AppmodeError(f"token {token!r}: {exc}") from None
     if word == "set":
-        name, eq, value = rest.partition("=")
-        number = _numbers(token, value)
-        try:
-            setting = settings.lookup(name)
-        except ValueError as exc:
-            raise AppmodeError(f"token {token!r}: {exc}") from None
-        if not eq or len(number) != 1:
-            raise AppmodeError(f"token {token!r}: expected set:NAME=VALUE, e.g. set:max_speed=800")
-        error = settings.value_error(setting, number[0])
-        if error is not None:
-            raise AppmodeError(f"token {token!r}: {error}")
-        return Step(word, number, setting.name)
+        setting, value = parse_setting(rest, f"token {token!r}")
+        return Step(word, (value,), setting.name)
     if word == "rotate":
         try:
             degrees = float(rest)
@@ -76,6 +66,25 @@ def parse_token(token: str) -> Token:
         if abs(each) > control.U16:
             raise AppmodeError(f"token {token!r}: {each} is beyond ±{control.U16}")
     return Step(word, values)
+
+
+def parse_setting(text: str, where: str) -> tuple[settings.Setting, int]:
+    """`NAME=VALUE` (or `ID=VALUE`), checked against the settings table; AppmodeError
+    starts with `where` (the option or token it came from)."""
+    name, sep, value = text.partition("=")
+    if not sep:
+        raise AppmodeError(f"{where}: expected NAME=VALUE, e.g. max_speed=800")
+    try:
+        setting = settings.lookup(name)
+    except ValueError as exc:
+        raise AppmodeError(f"{where}: {exc}") from None
+    number = params.whole(value)
+    if number is None:
+        raise AppmodeError(f"{where}: {setting.name} takes a whole number in {setting.range_text}")
+    error = settings.value_error(setting, number)
+    if error is not None:
+        raise AppmodeError(f"{where}: {error}")
+    return setting, number
 
 
 def _numbers(token: str, text: str) -> tuple[int, ...]:

@@ -24,6 +24,7 @@ STEP = 0.001
 """Seconds between looks at the port while waiting less than its read timeout."""
 
 E = TypeVar("E")
+R = TypeVar("R")
 L = TypeVar("L", bound="Link[Any]")
 
 
@@ -125,16 +126,26 @@ class Link(Generic[E]):
 
     def poll(self, timeout: float) -> list[E | LinkStatus]:
         """What arrives within `timeout` seconds: returns as soon as something does, and
-        never after the deadline. A wait longer than the port's read timeout blocks in
-        the port; a shorter one looks every STEP seconds, so a caller with something to
-        send at the deadline (conform, replay) is not held up by the read."""
+        never after the deadline."""
+        return self._read_until(timeout, self._read_once, bool)
+
+    def _read_until(
+        self,
+        timeout: float,
+        read: Callable[[bool], list[R]],
+        enough: Callable[[list[R]], bool],
+    ) -> list[R]:
+        """Call `read` until what it returns is `enough` or `timeout` passes; its last
+        return. A wait longer than the port's read timeout blocks in the port; a
+        shorter one looks every STEP seconds, so a caller with something to send at the
+        deadline (conform, replay) is not held up by the read."""
         deadline = self.now() + timeout
         while True:
             wait = None if self._port is None else self._port.timeout
             block = wait is not None and deadline - self.now() >= wait
-            events = self._read_once(block=block)
+            events = read(block)
             left = deadline - self.now()
-            if events or left <= 0:
+            if enough(events) or left <= 0:
                 return events
             if not block:
                 time.sleep(min(RETRY / 5 if self._port is None else STEP, left))
@@ -154,6 +165,10 @@ class Link(Generic[E]):
         events, self._pending = self._pending, []
         return events
 
+    def send(self, data: bytes) -> None:
+        """Write bytes to the board; LinkLost if the link is down."""
+        self._write(data)
+
     def _stop(self) -> bytes:
         """The bytes that leave the car stopped, sent last when the session closes."""
         raise NotImplementedError
@@ -167,7 +182,7 @@ class Link(Generic[E]):
         stop = self._stop() if self.stop_on_close else b""
         try:
             if stop:
-                self._send_stop(stop)
+                self.send(stop)
         except LinkLost:
             return self.close()  # the port is gone: nothing was sent
         except AppmodeError:
@@ -178,9 +193,6 @@ class Link(Generic[E]):
             self._port.close()
             self._port = None
         return stop
-
-    def _send_stop(self, data: bytes) -> None:
-        self._write(data)
 
     def __enter__(self: L) -> L:
         return self

@@ -12,10 +12,10 @@ from typing import Any, TextIO
 from appmode.board.profiles import PROFILES
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
-from appmode.protocol import app, control, control_view
+from appmode.protocol import app, control
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.reader import RECEIVED, RECEIVED2, PortsReader
-from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, describe, line, to_json
+from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, line, view
 from appmode.protocol.transcript import DIRECTIONS, Transcript, read_transcript
 from appmode.transcript.matcher import BytesPattern, Check, Pattern, parse_pattern
 
@@ -82,13 +82,9 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
             text = "expectation " + " ".join(
                 f"{k}={v}" for k, v in body.items() if k not in ("kind", "letter", "raw")
             )
-        elif isinstance(event, control_view.EVENTS):
-            body = control_view.to_json(event)
-            raw, text = event.raw, control_view.describe(event)
-            shown = control_view.hex_text(raw)
         else:
-            body = to_json(event, layout)
-            raw, text = event.raw, describe(event, layout)
+            body, text, shown = view(event, layout)
+            raw = event.raw
         if fmt == "json":
             out.write(json.dumps({"t": t, "dir": direction, **body}) + "\n")
         elif fmt == "csv":
