@@ -194,9 +194,9 @@ def run_monitor(
     with ExitStack() as stack:
         host = open_control_host(stack, url, record, stop_on_close=stop_on_exit)
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+        host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         try:
             for event in host.events(duration):
-                show(host, host.received, event, out, as_json)
                 errors += isinstance(event, control.Garbage)
                 seen += isinstance(event, (control.Reply, control.EncoderReport))
                 if count is not None and seen >= count:

@@ -105,6 +105,7 @@ def build_app(
             session.say(f"{warning} — :save keeps it; quit again to leave")
             return
         app.exit()
+
     view = View()
     status = Window(
         FormattedTextControl(lambda: _top(session, view), focusable=True),
@@ -127,9 +128,7 @@ def build_app(
         wrap_lines=True,
         always_hide_cursor=True,
     )
-    rule = Window(
-        FormattedTextControl(lambda: _rule(view)), height=1, style="fg:ansibrightblack"
-    )
+    rule = Window(FormattedTextControl(lambda: _rule(view)), height=1, style="fg:ansibrightblack")
     command_line = VSplit(
         [Window(FormattedTextControl(":"), width=1), Window(BufferControl(command), height=1)]
     )

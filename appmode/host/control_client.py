@@ -11,6 +11,7 @@ sends a zero velocity frame last (after completing a frame left open by raw byte
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Callable, Iterable, Iterator
 from functools import partial
@@ -18,8 +19,17 @@ from functools import partial
 import serial
 
 from appmode.errors import AppmodeError
-from appmode.host.link import Link
-from appmode.host.query import AGREE, TRIES
+from appmode.host.control_query import (
+    ROTATE_POLL,
+    ROTATE_TIMEOUT,
+    ControlOutcome,
+    ReadDone,
+    ReadQuery,
+    rotation_done,
+)
+from appmode.host.control_state import TAKEOVER_BYTE, ControlState
+from appmode.host.link import Link, LinkLost
+from appmode.host.query import TRIES, QueryFailed
 from appmode.host.state import LinkStatus
 from appmode.line.wire import UART2_BAUD, Tap
 from appmode.ports.link import is_simulated, open_link
@@ -29,11 +39,8 @@ from appmode.protocol.params import DriveType
 
 READ_TIMEOUT = 0.1
 """Seconds to wait for a reply: the board answers in its next 10 ms tick (§11)."""
-ROTATE_TIMEOUT = 20.0
-ROTATE_POLL = 0.1
-"""Seconds between reads of the pending angle while a rotation goes on."""
 
-Event = control.BoardEvent | LinkStatus
+Event = control.BoardEvent | ControlOutcome | LinkStatus
 OPEN_UART2 = partial(open_link, baud=UART2_BAUD)
 
 
@@ -45,7 +52,7 @@ def uart2_url(url: str) -> str:
     return url
 
 
-class ControlHost(Link[control.BoardEvent]):
+class ControlHost(Link[control.BoardEvent | ControlOutcome]):
     """A session with one board's control port."""
 
     sent = "2>"
@@ -61,6 +68,7 @@ class ControlHost(Link[control.BoardEvent]):
         drive: DriveType | None = None,
         timeout: float = READ_TIMEOUT,
         tries: int = TRIES,
+        takeover_byte: int = TAKEOVER_BYTE,
     ) -> None:
         url = uart2_url(url)
         if is_simulated(url) and sim_side(url) != "uart2":
@@ -72,10 +80,7 @@ class ControlHost(Link[control.BoardEvent]):
         self.stop_on_close = stop_on_close
         self.timeout = timeout
         self.tries = tries
-        self._drive = drive
-        self._decoder = control.BoardDecoder(None)
-        self._sent = control.HostDecoder(drive or DriveType.OMNI)
-        """What was sent, decoded as the board does: is a frame left open?"""
+        self.state = ControlState(drive, takeover_byte)
         self._held: list[Event] = []
         self.watch: Callable[[str, reader.Event | LinkStatus], None] | None = None
         """Called with each frame sent (`2>`) and each event received (`2<`) as it is
@@ -84,104 +89,85 @@ class ControlHost(Link[control.BoardEvent]):
     # ------------------------------------------------------------ bytes
 
     def _on_lost(self) -> None:
-        self._decoder = control.BoardDecoder(None, self._decoder.app_mode)
+        self.state.reset_decoder()
 
     def send(self, data: bytes) -> None:
         """Write bytes to the control port; LinkLost if the link is down."""
         self._write(data)
-        for event in self._sent.feed(data):
-            self._follow(event)
-            if self.watch is not None:
-                self.watch(self.sent, event)
+        events, reread = self.state.sent(data, self.now())
+        self._watch(self.sent, events)
+        self._watch(self.received, reread)
+        self._held += reread
 
     def send_frame(self, *frames: control.HostFrame) -> bytes:
         """Encode and send frames, after zeros completing a frame that raw bytes left
         open, so that the board reads them whole; the bytes sent. AppmodeError names a
         value out of range."""
         try:
-            data = self._sent.rest() + b"".join(control.encode(f) for f in frames)
+            data = b"".join(control.encode(f) for f in frames)
         except ValueError as exc:
             raise AppmodeError(f"{type(frames[0]).__name__}: {exc}") from None
+        return self._send_whole(data)
+
+    def _send_whole(self, data: bytes) -> bytes:
+        data = self.state.sent_decoder.rest() + data
         self.send(data)
         return data
 
-    def _follow(self, event: object) -> None:
-        """Track a system_mode this host set: the drive type fixes frame lengths and
-        the encoding of velocity, bit 7 moves the APP protocol onto this port (§12)."""
-        mode = control.system_mode_set(event)
-        if mode is None:
-            return
-        drive = params.drive_type(mode)
-        if drive is not None:
-            self._drive = drive
-            self._sent.drive = drive
-        on = bool(mode & params.MODE_BIT["app_mode"])
-        self._held += self._decoder.set_app_mode(on)
-        self._sent.set_app_mode(on)
-
     def _read_once(self, block: bool) -> list[Event]:
-        events, self._held = self._held, []
-        return events + self._receive(block and not events)
-
-    def _receive(self, block: bool) -> list[Event]:
-        events: list[Event] = list(self._take_pending())
-        data = self._read_bytes(block)
-        events += self._take_pending()
+        held, self._held = self._held, []
+        new = self._take_pending()
+        data = self._read_bytes(block and not (held or new))
+        new += self._take_pending()
         if data:
-            events += self._decoder.feed(data)
+            new += self.state.feed(data, self.now())
+        outcome = self.state.tick(self.now())
+        if outcome is not None:
+            new.append(outcome)
+        self._flush_outbox()
+        self._watch(self.received, new)
+        return held + new
+
+    def _watch(self, direction: str, events: Iterable[object]) -> None:
         if self.watch is not None:
             for event in events:
-                self.watch(self.received, event)
-        return events
+                if not isinstance(event, (ReadDone, QueryFailed)):
+                    self.watch(direction, event)  # type: ignore[arg-type]
 
-    def _wait(self, done: Callable[[Event], bool], timeout: float) -> None:
-        """Read until an event satisfies `done` or `timeout` passes; every event read is
-        kept for the next poll."""
-
-        def read(block: bool) -> list[Event]:
-            events = self._receive(block)
-            self._held += events
-            return events
-
-        self._read_until(timeout, read, lambda events: any(done(e) for e in events))
+    def _flush_outbox(self) -> None:
+        data = self.state.take_outbox()
+        if data:
+            with contextlib.suppress(LinkLost):  # the query times out and tries again
+                self._send_whole(data)
 
     # ------------------------------------------------------------ reads
 
+    def start_query(self, query: ReadQuery) -> None:
+        """Begin a read or set without waiting; its outcome comes with the events."""
+        self.state.start_query(query, self.now())
+        self._flush_outbox()
+
+    def query(self, query: ReadQuery) -> dict[str, int]:
+        """Run a read or set to its end; AppmodeError if it fails. Other events read
+        meanwhile are kept for the next poll."""
+        self.start_query(query)
+        kept: list[Event] = []
+        try:
+            while True:
+                for event in self.poll(query.timeout):
+                    if isinstance(event, ReadDone):
+                        return event.values
+                    if isinstance(event, QueryFailed):
+                        raise AppmodeError(event.text)
+                    kept.append(event)
+        finally:
+            self._held = kept + self._held
+
     def read_values(self, names: Iterable[str]) -> dict[str, int]:
-        """Read values by name (settings, `pending_angle`, `speed_a`…, `position_a`…).
-        Each read is sent AGREE times at once, so the board answers every copy in the
-        same tick, from the same state: a value is reported when its replies agree. A
-        round without that is sent again; AppmodeError after `tries` rounds."""
-        reads = list(dict.fromkeys(settings.read_named(name) for name in names))
-        agreed: dict[str, int] = {}
-        heard = False
-        for _ in range(self.tries):
-            want = [r for r in reads if r.name not in agreed]
-            if not want:
-                break
-            replies: dict[int, list[int]] = {r.reply_id: [] for r in want}
-
-            def done(event: Event, replies: dict[int, list[int]] = replies) -> bool:
-                if isinstance(event, control.Reply) and event.id in replies:
-                    replies[event.id].append(event.value)
-                return all(len(v) >= AGREE for v in replies.values())
-
-            self.send_frame(*(control.ReadFrame(r) for r in want for _ in range(AGREE)))
-            self._wait(done, self.timeout)
-            for r in want:
-                values = replies[r.reply_id]
-                heard = heard or bool(values)
-                if len(values) >= AGREE and len(set(values)) == 1:
-                    agreed[r.name] = values[0]
-        missing = [r.name for r in reads if r.name not in agreed]
-        if missing:
-            what = "no two replies agreed" if heard else "no reply"
-            raise AppmodeError(
-                f"{what} reading {', '.join(missing)} on {self.url} after {self.tries} "
-                "tries: is this the board's control port (UART2, 115200 bps)? The "
-                "reference firmware does not answer reads (docs/protocol.md §13)"
-            )
-        return {r.name: agreed[r.name] for r in reads}
+        """Read values by name (settings, `pending_angle`, `speed_a`…, `position_a`…),
+        each reported only when its replies agree (control_query); AppmodeError after
+        `tries` rounds."""
+        return self.query(self._query(names, None))
 
     def read(self, name: str) -> int:
         return self.read_values([name])[settings.read_named(name).name]
@@ -193,22 +179,19 @@ class ControlHost(Link[control.BoardEvent]):
     @property
     def drive(self) -> DriveType:
         """The board's drive type (read from system_mode the first time it is needed)."""
-        if self._drive is None:
+        if self.state.drive is None:
             mode = self.read("system_mode")
-            drive = params.drive_type(mode)
-            if drive is None:
+            if self.state.drive is None:
                 raise AppmodeError(
                     f"the board's system_mode is {mode}: its drive type (bits 0–2) is not "
                     "one of 0–3; set it with --set system_mode=N"
                 )
-            self._drive = drive
-            self._sent.drive = drive
-        return self._drive
+        return self.state.drive
 
     @property
     def known_drive(self) -> DriveType | None:
         """The drive type if known, without asking the board."""
-        return self._drive
+        return self.state.drive
 
     def wheels(self) -> int:
         return control.motor_count(self.drive)
@@ -228,27 +211,23 @@ class ControlHost(Link[control.BoardEvent]):
     def set(self, name: str, value: int) -> int:
         """Set a setting and verify it by reading back (the set is sent again while the
         board shows another value); returns the value read."""
-        setting = settings.lookup(name)
-        error = settings.value_error(setting, value)
-        if error is not None:
-            raise AppmodeError(error)
-        got = None
-        for _ in range(self.tries):
-            self.send_frame(control.SetSetting(setting, value))
-            got = self.read(setting.name)
-            if got == value:
-                return got
-        raise AppmodeError(
-            f"{setting.name} still reads {got} on {self.url} after {self.tries} sets of "
-            f"{value}: the board does not take it"
-        )
+        query = self._query((), (name, value))
+        return self.query(query)[query.names[0]]
+
+    def _query(self, names: Iterable[str], change: tuple[str, int] | None) -> ReadQuery:
+        """A read or set with this host's timeout and tries; AppmodeError for an
+        unknown name or a value out of range."""
+        try:
+            return ReadQuery(names, change, self.timeout, self.tries, self.url)
+        except ValueError as exc:
+            raise AppmodeError(str(exc)) from None
 
     def store(self, op: str) -> None:
         """`load`, `defaults` or `save` (§10). No reply comes: a save is confirmed only
         by reading the settings after the board restarts."""
         self.send_frame(control.store(op))
         if op != "save":
-            self._drive = None  # system_mode may have changed: read it when needed
+            self.state.forget_drive()  # system_mode may have changed: read it when needed
 
     def set_mode_bit(self, name: str, on: bool) -> int:
         """Turn a system_mode bit (`encoder_report`, `app_mode`…) on or off, verified."""
@@ -276,8 +255,7 @@ class ControlHost(Link[control.BoardEvent]):
     def motors(self, speeds: tuple[int, ...]) -> bytes:
         if len(speeds) != self.wheels():
             raise AppmodeError(
-                f"motors: a {self.drive.cli_name} car has {self.wheels()} motors, "
-                f"not {len(speeds)}"
+                f"motors: a {self.drive.cli_name} car has {self.wheels()} motors, not {len(speeds)}"
             )
         return self.send_frame(control.MotorFrame(speeds))
 
@@ -298,17 +276,11 @@ class ControlHost(Link[control.BoardEvent]):
 
     def wait_rotation(self, timeout: float = ROTATE_TIMEOUT) -> None:
         """Wait until the pending angle reads 0; AppmodeError after `timeout`."""
-        deadline = self.now() + timeout
+        start = self.now()
         while True:
-            self._wait(lambda event: False, ROTATE_POLL)
-            left = self.read("pending_angle")
-            if left == 0:
+            self._held = [*self.events(ROTATE_POLL), *self._held]  # kept for the next poll
+            if rotation_done(self.read("pending_angle"), self.now() - start, timeout):
                 return
-            if self.now() > deadline:
-                raise AppmodeError(
-                    f"rotate: {left / 10:g}° still to turn after {timeout:g} s (is the car "
-                    "held, or max_speed 0?)"
-                )
 
     def reports(self, duration: float | None = None) -> Iterator[control.EncoderReport]:
         """Encoder reports as they arrive (turn them on with set_mode_bit)."""
@@ -322,10 +294,10 @@ class ControlHost(Link[control.BoardEvent]):
     def stop_bytes(self) -> bytes:
         """What closing sends: the zero velocity frame, after zeros completing a frame
         left open by raw bytes; in APP mode (§12) `Z`, after `{}` closing an open frame."""
-        if self._sent.app_mode:
-            return b"{}Z" if self._sent.buffered else b"Z"
-        return self._sent.rest() + control.STOP
+        sent = self.state.sent_decoder
+        if sent.app_mode:
+            return b"{}Z" if sent.buffered else b"Z"
+        return sent.rest() + control.STOP
 
     def _stop(self) -> bytes:
         return self.stop_bytes
-

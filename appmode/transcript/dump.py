@@ -135,9 +135,7 @@ def run_plot(path: str, output: str) -> int:
     transcript = read_transcript(path)
     layout = Check(transcript).needs.profile.a_layout
     motion: dict[int, list[int]] = {i: [] for i in layout.motion}
-    series: dict[str, list[Any]] = {
-        k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")
-    }
+    series: dict[str, list[Any]] = {k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")}
     commands: list[tuple[float, str]] = []
     for t, direction, event in decoded(transcript):
         if isinstance(event, app.Velocity):

@@ -182,7 +182,6 @@ class Check:
 
     # ------------------------------------------------------------ driving it
 
-
     @property
     def done(self) -> bool:
         return self.failure is not None or (

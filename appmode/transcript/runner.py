@@ -313,9 +313,7 @@ def _run_all(
         out.flush()
 
 
-def _for_profile(
-    transcripts: list[Transcript], profile: Profile, out: TextIO
-) -> list[Transcript]:
+def _for_profile(transcripts: list[Transcript], profile: Profile, out: TextIO) -> list[Transcript]:
     """The transcripts written for `profile` (`@board profile=…`, default sheet); says how
     many others there were."""
     chosen = [t for t in transcripts if Check(t).needs.profile is profile]

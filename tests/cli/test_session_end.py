@@ -128,7 +128,14 @@ def test_send_ending_inside_a_frame_still_stops_the_car(tokens: list[str]) -> No
         # the open frame is abandoned, never applied: max_speed is still the default
         assert board_state(board.url) == (STOPPED, DEFAULTS)
     assert done.stdout.splitlines()[-1].split()[1:] == [
-        ">", "{}Z", "closes", "the", "open", "frame,", "then", "stop"
+        ">",
+        "{}Z",
+        "closes",
+        "the",
+        "open",
+        "frame,",
+        "then",
+        "stop",
     ], "the user sees how the car was stopped"
 
 

@@ -242,8 +242,15 @@ def test_dump_shows_wildcard_lines_as_expectations_and_csv_every_field(tmp_path:
     assert "expectation x=0 y=* z=0 extra=0" in text and "error" not in text
     objects = [json.loads(line) for line in run("dump", str(path), "--json").stdout.splitlines()]
     assert objects[2] == {
-        "t": 0.2, "dir": "<", "kind": "expectation", "letter": "A",
-        "x": 0, "y": "*", "z": 0, "extra": 0, "raw": "{A0:*:0:0}$",
+        "t": 0.2,
+        "dir": "<",
+        "kind": "expectation",
+        "letter": "A",
+        "x": 0,
+        "y": "*",
+        "z": 0,
+        "extra": 0,
+        "raw": "{A0:*:0:0}$",
     }
     rows = list(csv.DictReader(io.StringIO(run("dump", str(path), "--csv").stdout)))
     for row, obj in zip(rows, objects, strict=True):  # every field of the JSON is a column
@@ -307,8 +314,6 @@ def test_command_labels_close_in_time_share_one_label() -> None:
     from appmode.transcript.dump import command_labels
 
     commands = [(0.0, "J"), (0.004, "{Q:P}"), (0.5, "B"), (0.502, "C"), (0.503, "D"), (1.0, "Z")]
-    assert command_labels(commands, 0.01) == [
-        (0.0, "J {Q:P}"), (0.5, "B C D"), (1.0, "Z")
-    ]
+    assert command_labels(commands, 0.01) == [(0.0, "J {Q:P}"), (0.5, "B C D"), (1.0, "Z")]
     many = [(i * 0.001, "{0:12345}") for i in range(5)]
     assert command_labels(many, 0.01) == [(0.0, "{0:12345} {0:12…")]

@@ -1,0 +1,155 @@
+"""The control-port host as a state machine, with no I/O: what it knows of the board.
+
+`ControlState.feed(data, now)` decodes the board's bytes (replies, encoder reports, APP
+records in APP mode) and keeps the last report, the values read and the link counters;
+`sent(data, now)` follows what the host sent, decoded as the board does: the frame in
+force, the drive type and APP mode a system_mode set selects, and when the host's bytes
+took the motion over (§8.3). A running ReadQuery is fed here and wants bytes sent
+through the outbox. A view (the console) reads it all.
+"""
+
+from __future__ import annotations
+
+from appmode.host.control_query import ControlOutcome, ReadDone, ReadQuery
+from appmode.host.query import QueryFailed
+from appmode.host.state import LinkStats
+from appmode.protocol import app, control, params
+from appmode.protocol.params import DriveType
+
+TAKEOVER_BYTE = 10
+"""The board follows the control port from this byte on (the sheet; §13's is the 11th)."""
+
+MOTION = (control.VelocityFrame, control.MotorFrame, control.PositionFrame)
+Received = control.BoardEvent | ControlOutcome
+Sent = control.HostEvent | app.HostEvent
+
+
+class ControlState:
+    """Last report and values seen, the frame in force and link counters."""
+
+    def __init__(self, drive: DriveType | None = None, takeover_byte: int = TAKEOVER_BYTE) -> None:
+        self.drive = drive
+        """The board's drive type: told, or learnt from a system_mode read or sent."""
+        self.takeover_byte = takeover_byte
+        self.decoder = control.BoardDecoder(None)
+        self.sent_decoder = control.HostDecoder(drive or DriveType.OMNI)
+        """What was sent, decoded as the board does: is a frame left open?"""
+        self.stats = LinkStats()
+        self.report: control.EncoderReport | None = None
+        self.report_at: float | None = None
+        self.values: dict[str, int] = {}
+        """Every value read so far (agreed replies), by name."""
+        self.in_force: control.VelocityFrame | control.MotorFrame | control.PositionFrame | None
+        self.in_force = None
+        self.took_over_at: float | None = None
+        """When this host's bytes made the control port drive the car."""
+        self.query: ReadQuery | None = None
+        self._outbox = bytearray()
+        self._errors_at_start = 0
+
+    @property
+    def app_mode(self) -> bool:
+        """system_mode bit 7 as this host last set it: the port speaks the APP protocol."""
+        return self.sent_decoder.app_mode
+
+    # ------------------------------------------------------------ bytes
+
+    def feed(self, data: bytes, now: float) -> list[Received]:
+        """Decode board bytes; returns the events and the outcome of a query they end."""
+        self.stats.bytes_in += len(data)
+        return self._apply(self.decoder.feed(data), now)
+
+    def sent(self, data: bytes, now: float) -> tuple[list[Sent], list[Received]]:
+        """Follow bytes the host sent: (their events, board bytes read anew when a
+        system_mode set switched APP mode)."""
+        before = self.stats.bytes_out
+        self.stats.bytes_out += len(data)
+        if before < self.takeover_byte <= self.stats.bytes_out and self.took_over_at is None:
+            self.took_over_at = now
+        events = self.sent_decoder.feed(data)
+        reread: list[Received] = []
+        for event in events:
+            if isinstance(
+                event, (control.VelocityFrame, control.MotorFrame, control.PositionFrame)
+            ):
+                self.in_force = None if event.raw == control.STOP else event
+            mode = control.system_mode_set(event)
+            if mode is not None:
+                reread += self._follow_mode(mode, now)
+        return events, reread
+
+    def _follow_mode(self, mode: int, now: float) -> list[Received]:
+        """A system_mode the host set: the drive type fixes frame lengths and the
+        encoding of velocity, bit 7 moves the APP protocol onto this port (§12)."""
+        self.learn_drive(mode)
+        on = bool(mode & params.MODE_BIT["app_mode"])
+        self.sent_decoder.set_app_mode(on)
+        return self._apply(self.decoder.set_app_mode(on), now)
+
+    def learn_drive(self, mode: int) -> None:
+        """Take the drive type from a system_mode (read or sent), if it names one."""
+        drive = params.drive_type(mode)
+        if drive is not None:
+            self.drive = drive
+            self.sent_decoder.drive = drive
+
+    def forget_drive(self) -> None:
+        """system_mode may have changed on the board (load, defaults): read it anew."""
+        self.drive = None
+
+    def reset_decoder(self) -> None:
+        """Forget a partial reply or report (after the link was lost)."""
+        self.decoder = control.BoardDecoder(None, self.decoder.app_mode)
+
+    def _apply(self, events: list[control.BoardEvent], now: float) -> list[Received]:
+        out: list[Received] = []
+        for event in events:
+            out.append(event)
+            if isinstance(event, (*control.ERRORS, *app.ERRORS)):
+                self.stats.count_error(now, len(event.raw))
+                continue
+            self.stats.count_record(now)
+            if isinstance(event, control.EncoderReport):
+                self.report, self.report_at = event, now
+            elif isinstance(event, control.Reply) and self.query is not None:
+                outcome = self._step(*self.query.on_reply(event, now))
+                if outcome is not None:
+                    out.append(outcome)
+        return out
+
+    # ------------------------------------------------------------ queries
+
+    def start_query(self, query: ReadQuery, now: float) -> None:
+        """Begin a read or set; its bytes wait in the outbox."""
+        self.query = query
+        self._errors_at_start = self.stats.errors
+        self._outbox += query.start(now)
+
+    def tick(self, now: float) -> ControlOutcome | None:
+        """Let time pass: a query may send its next round (into the outbox) or fail."""
+        if self.query is None:
+            return None
+        return self._step(*self.query.on_time(now))
+
+    def take_outbox(self) -> bytes:
+        """Bytes the state wants sent."""
+        data = bytes(self._outbox)
+        self._outbox.clear()
+        return data
+
+    def _step(self, data: bytes, outcome: ControlOutcome | None) -> ControlOutcome | None:
+        self._outbox += data
+        if outcome is None:
+            return None
+        self.query = None
+        if isinstance(outcome, ReadDone):
+            self.values.update(outcome.values)
+            if "system_mode" in outcome.values:
+                self.learn_drive(outcome.values["system_mode"])
+        elif isinstance(outcome, QueryFailed) and self.stats.errors > self._errors_at_start:
+            garbled = self.stats.errors - self._errors_at_start
+            outcome = QueryFailed(
+                f"{outcome.text} ({garbled} garbled replies or bytes came meanwhile: "
+                "the link is noisy)"
+            )
+        return outcome
