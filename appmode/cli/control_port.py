@@ -12,7 +12,7 @@ from typing import TextIO
 from appmode.cli.hostio import with_recording
 from appmode.errors import AppmodeError
 from appmode.host.control_client import ControlHost, Event
-from appmode.host.control_tokens import Step, parse_setting, parse_token
+from appmode.host.control_tokens import Step, parse_setting, parse_token, perform
 from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
 from appmode.protocol import control, params, reader, settings
@@ -122,7 +122,7 @@ def run_send(
                     host.start_rotation(step.values[0] / 10)
                     host.wait_rotation()
                 else:
-                    _perform(host, step)
+                    perform(host, step)
                 _drain(host.poll(0))
             _drain(host.events(listen))
         if host.close() is None:
@@ -145,35 +145,6 @@ def _restore(host: ControlHost, frame: control.SetSetting) -> None:
 
 def _set(name: str, value: int) -> control.SetSetting:
     return control.SetSetting(settings.BY_NAME[name], value)
-
-
-def _perform(host: ControlHost, step: Step | bytes) -> None:
-    """Send one step."""
-    if isinstance(step, bytes):
-        host.send(step)
-        return
-    kind, values = step.kind, step.values
-    if kind == "velocity":
-        if host.drive is params.DriveType.DIFF_GYRO:
-            if len(values) != 2:
-                raise AppmodeError("velocity: a diff-gyro car takes LEFT,RIGHT duties")
-            host.velocity(left=values[0], right=values[1])
-        elif len(values) != 3:
-            raise AppmodeError(f"velocity: a {host.drive.cli_name} car takes X,Y,Z")
-        else:
-            host.velocity(*values)
-    elif kind == "motors":
-        host.motors(values)
-    elif kind == "position":
-        host.position(*values)
-    elif kind == "read":
-        host.send_frame(control.read(step.name))
-    elif kind == "set":
-        host.send_frame(_set(step.name, values[0]))
-    elif kind == "stop":
-        host.stop()
-    else:
-        host.store(kind)
 
 
 # ---------------------------------------------------------------- monitor --uart2

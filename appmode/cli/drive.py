@@ -3,10 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
-from appmode.cli.options import Subparsers, add_profile, add_record, layout_for, number_type
+from appmode.cli.options import (
+    Subparsers,
+    add_profile,
+    add_record,
+    add_uart2,
+    layout_for,
+    number_type,
+    profile_for,
+)
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
+from appmode.errors import AppmodeError
+from appmode.ports.link import is_simulated
+from appmode.protocol.params import DRIVE_NAMES, DriveType
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -17,7 +29,10 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "(q w e / a s d / z x c) to drive, space to stop, and a command line (:) for "
         "everything else. With no URL it drives the embedded simulated board. When stdin "
         "is not a terminal, commands are read from it line by line (try: help). Whatever "
-        "ends the session, the last byte sent is Z.",
+        "ends the session, the last byte sent is Z. With --uart2 it drives over the "
+        "board's control port instead (velocity frames; the last frame sent is the zero "
+        "velocity frame); with --uart2-url (or a second URL) it holds both ports of one "
+        "board: it drives over UART2 and shows the APP port's records.",
     )
     drive.add_argument(
         "url",
@@ -26,6 +41,25 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         metavar="URL",
         help="the board (default: sim://, the simulated board); see "
         "'appmode params -h' for URL forms",
+    )
+    drive.add_argument(
+        "url2",
+        nargs="?",
+        metavar="URL2",
+        help="the same board's control port: as --uart2-url",
+    )
+    add_uart2(drive, "drive over the board's control port (UART2, velocity frames)")
+    drive.add_argument(
+        "--uart2-url",
+        metavar="URL",
+        help="open the board's control port there too: drive over it and show the APP "
+        "port's records (two sim:// URLs are one simulated board)",
+    )
+    drive.add_argument(
+        "--drive-type",
+        choices=DRIVE_NAMES,
+        help="with UART2: the car's drive type, for a board that does not answer reads "
+        "(default: read from system_mode)",
     )
     drive.add_argument(
         "--hold-first",
@@ -57,22 +91,58 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from appmode.console.app import run_drive
+    from appmode.console.control_session import ControlSession
     from appmode.console.hold import HoldToDrive
     from appmode.console.session import Session
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
-    url = args.url
-    if args.profile and url.lower().startswith("sim://") and "profile=" not in url:
-        url += f"{'&' if '?' in url else '?'}profile={args.profile}"
-    session = Session(
+    url = _with_profile(args.url, args.profile)
+    on_message = None if interactive else _print_message
+    layout = layout_for(url, args.profile)
+    uart2_url = args.uart2_url or args.url2
+    if args.url2 and args.uart2_url:
+        raise AppmodeError("give the control port once: a second URL or --uart2-url")
+    if uart2_url is None and not args.uart2:
+        if args.drive_type:
+            raise AppmodeError("--drive-type is for the control port: add --uart2")
+        return run_drive(
+            Session(url, driving, args.record, on_message, layout),
+            interactive,
+            sys.stdin,
+            sys.stdout,
+        )
+    app_url = None
+    if uart2_url is not None:
+        app_url, url = url, _with_profile(uart2_url, args.profile)
+        if is_simulated(app_url) and is_simulated(url):
+            app_url = _shared(app_url)  # a bare sim:// is the same board's other port:
+            url = _shared(url) if "?" in url else app_url + "&port=uart2"
+    session = ControlSession(
         url,
         driving,
         args.record,
-        on_message=None if interactive else _print_message,
-        layout=layout_for(url, args.profile),
+        on_message,
+        app_url=app_url,
+        layout=layout,
+        drive=DriveType.from_cli_name(args.drive_type) if args.drive_type else None,
+        takeover_byte=profile_for(url, args.profile).takeover_byte,
     )
     return run_drive(session, interactive, sys.stdin, sys.stdout)
+
+
+def _with_profile(url: str, profile: str | None) -> str:
+    """A sim:// URL with `--profile` as its profile."""
+    if profile and url.lower().startswith("sim://") and "profile=" not in url:
+        url += f"{'&' if '?' in url else '?'}profile={profile}"
+    return url
+
+
+def _shared(url: str) -> str:
+    """A sim:// URL that names its board, so that both ports open one board."""
+    if "share=" in url.lower():
+        return url
+    return url + f"{'&' if '?' in url else '?'}share=drive-{os.getpid()}"
 
 
 def _print_message(text: str) -> None:

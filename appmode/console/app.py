@@ -8,6 +8,7 @@ history): the status panel, the 3×3 key grid and arrows to drive, and a command
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import sys
 import time
 from collections.abc import Iterable
@@ -35,53 +36,30 @@ from prompt_toolkit.layout.dimension import Dimension
 from prompt_toolkit.layout.menus import CompletionsMenu
 from prompt_toolkit.output import Output
 
-from appmode.console.panel import (
-    ARROWS,
-    KEY_GRID,
-    WIDTH,
-    Fragments,
-    status_fragments,
-    status_text,
-)
-from appmode.console.session import (
-    COMMAND_NAMES,
-    MESSAGES,
-    PAGE_WORDS,
-    QUIT_WORDS,
-    Quit,
-    Session,
-    ShowHelp,
-    ShowStatus,
-    help_lines,
-)
+from appmode.console.base import QUIT_WORDS, BaseSession, Quit, ShowHelp, ShowStatus, Step
+from appmode.console.panel import status_fragments, status_text
+from appmode.console.panel_parts import ARROWS, KEY_GRID, WIDTH, Fragments
 from appmode.files import data_folder
 from appmode.host.signals import ENDING_SIGNALS
 from appmode.host.tokens import Wait
-from appmode.protocol import params
-from appmode.protocol.directions import grid_for
 
 REFRESH = 0.02
 """Seconds between reads of the link (and checks of the hold-to-drive timers)."""
+MESSAGES = 8
+"""Message lines shown when the terminal's height cannot be known."""
 REDRAW = 0.1
 """How often the panel is checked, and redrawn if what it shows changed (a key redraws at
 once)."""
 
 
-def _completer() -> NestedCompleter:
-    names = {p.name: None for p in params.PARAMS}
-    table: dict[str, object] = {name: None for name in COMMAND_NAMES}
-    table.update(
-        set=names,
-        page={word: None for word in PAGE_WORDS},
-        latch={"on": None, "off": None},
-        record={"stop": None},
-        speed={"+100": None, "-100": None},
-    )
+def _completer(session: BaseSession) -> NestedCompleter:
+    table: dict[str, object] = dict.fromkeys(session.command_names)
+    table.update(latch={"on": None, "off": None}, record={"stop": None}, **session.completions)
     return NestedCompleter.from_nested_dict(table)
 
 
 def build_app(
-    session: Session,
+    session: BaseSession,
     input: Input | None = None,
     output: Output | None = None,
     history: History | None = None,
@@ -90,7 +68,7 @@ def build_app(
     # Completions show on Tab only, not while typing.
     command = Buffer(
         multiline=False,
-        completer=_completer(),
+        completer=_completer(session),
         history=history or InMemoryHistory(),
         complete_while_typing=False,
     )
@@ -137,7 +115,7 @@ def build_app(
     keys = KeyBindings()
 
     def drive_key(row: int, col: int) -> None:
-        session.press(grid_for(session.page)[row][col])
+        session.press(session.grid_key(row, col))
 
     for r, row in enumerate(KEY_GRID):
         for c, key in enumerate(row):
@@ -145,18 +123,17 @@ def build_app(
             keys.add(key.upper(), filter=driving)(lambda e, r=r, c=c: drive_key(r, c))
     for arrow, (r, c) in ARROWS.items():
         keys.add(arrow, filter=driving)(lambda e, r=r, c=c: drive_key(r, c))
+    for key, what in session.hold_keys.items():
+        keys.add(key, filter=driving)(lambda e, what=what: session.press(what))
     keys.add(" ", filter=driving)(lambda e: session.stop())
-    for letter in "IJK":
-        keys.add(letter.lower(), filter=driving)(lambda e, x=letter: session.switch_page(x))
+    for key, line in session.keys.items():
+        keys.add(key, filter=driving)(lambda e, line=line: _key_command(session, line))
     keys.add("l", filter=driving)(
         lambda e: session.run("latch off" if session.driving.latched else "latch on")
     )
-    keys.add("+", filter=driving)(lambda e: session.run("speed +100"))
-    keys.add("=", filter=driving)(lambda e: session.run("speed +100"))
-    keys.add("-", filter=driving)(lambda e: session.run("speed -100"))
-    keys.add("p", filter=driving)(lambda e: session.run("params"))
     keys.add("?", filter=driving)(lambda e: view.toggle("help"))
-    keys.add("v", filter=driving)(lambda e: view.toggle("waves"))
+    if session.waveforms:
+        keys.add("v", filter=driving)(lambda e: view.toggle("waves"))
     keys.add("escape", filter=driving & Condition(lambda: view.top != "panel"))(
         lambda e: view.toggle(view.top)
     )
@@ -235,6 +212,12 @@ def build_app(
     return app
 
 
+def _key_command(session: BaseSession, line: str) -> None:
+    """A key that runs a command line; a quit from it would be a surprise: none do."""
+    with contextlib.suppress(Quit):
+        session.run(line)
+
+
 class View:
     """What the console shows above its messages, and how far back they are scrolled."""
 
@@ -248,9 +231,9 @@ class View:
         self.top = "panel" if self.top == name else name
 
 
-def _top(session: Session, view: View) -> Fragments:
+def _top(session: BaseSession, view: View) -> Fragments:
     if view.top == "help":
-        return [("", "\n".join(help_lines()))]
+        return [("", "\n".join(session.help_lines()))]
     fragments = status_fragments(session, waveforms=view.top == "waves")
     style, text, *_ = fragments[-1]
     return [*fragments[:-1], (style, text.rstrip("\n"))]  # no blank line under it
@@ -262,7 +245,7 @@ def _rule(view: View) -> str:
     return "─" * WIDTH
 
 
-async def run_app(app: Application[None], session: Session) -> None:
+async def run_app(app: Application[None], session: BaseSession) -> None:
     """Run the console until quit; the link is read every REFRESH seconds."""
 
     async def ticker() -> None:
@@ -298,7 +281,7 @@ async def run_app(app: Application[None], session: Session) -> None:
 
 
 def run_drive(
-    session: Session,
+    session: BaseSession,
     interactive: bool,
     script: Iterable[str],
     out: TextIO,
@@ -342,7 +325,7 @@ def command_history() -> History:
     return FileHistory(str(path))
 
 
-def run_script(session: Session, lines: Iterable[str], out: TextIO) -> int:
+def run_script(session: BaseSession, lines: Iterable[str], out: TextIO) -> int:
     """Script mode: run commands line by line; `wait S` lets S seconds pass.
 
     A parameter read or set finishes before the next line runs.
@@ -359,20 +342,20 @@ def run_script(session: Session, lines: Iterable[str], out: TextIO) -> int:
     return 0
 
 
-def _show(session: Session, step: Wait | ShowStatus | ShowHelp | None) -> None:
+def _show(session: BaseSession, step: Step) -> None:
     """What a command returned for the view: the panel for `status`, the help for
     `help`, as messages."""
     if isinstance(step, ShowStatus):
         session.say(status_text(session))
     elif isinstance(step, ShowHelp):
-        for text in help_lines():
+        for text in session.help_lines():
             session.say(text)
 
 
-def _settle(session: Session, seconds: float) -> None:
+def _settle(session: BaseSession, seconds: float) -> None:
     """Let `seconds` pass, and any parameter query end, reading the link meanwhile."""
     end = time.monotonic() + seconds
     session.tick()
-    while time.monotonic() < end or session.host.state.query is not None:
+    while time.monotonic() < end or session.busy:
         time.sleep(min(REFRESH, max(0.0, end - time.monotonic())) or REFRESH)
         session.tick()

@@ -7,12 +7,10 @@ blocks: parameter reads and sets run as queries whose outcome arrives with `tick
 
 from __future__ import annotations
 
-import contextlib
-import shlex
-from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from typing import ClassVar
 
+from appmode.console.base import SPEED_STEP, BaseSession, CommandSpec, Step
 from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
@@ -20,27 +18,17 @@ from appmode.host.link import LinkLost
 from appmode.host.query import ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
 from appmode.host.tokens import Wait, parse_token
-from appmode.ports.link import is_simulated
-from appmode.ports.sim import sim_directives
 from appmode.protocol import params
 from appmode.protocol.app import HostDecoder, Move, Noise, Stop, SwitchPage
-from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES, STOP_LETTER, Page, letter_name
+from appmode.protocol.directions import (
+    PAGE_LETTERS,
+    PAGE_NAMES,
+    STOP_LETTER,
+    Page,
+    grid_for,
+    letter_name,
+)
 from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
-from appmode.protocol.transcript import Recorder
-
-SPEED_STEP = 100
-MESSAGES = 8
-"""Message lines shown when the terminal's height cannot be known."""
-LOG = 500
-"""Messages kept for scrolling back."""
-
-
-@dataclass(frozen=True, slots=True)
-class CommandSpec:
-    name: str
-    args: str
-    help: str
-
 
 COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("params", "", "read the nine parameters"),
@@ -50,18 +38,9 @@ COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("drive", "A-H", "drive in a direction (latched: until stop)"),
     CommandSpec("stop", "", "stop the car (Z)"),
     CommandSpec("page", "NAME", "switch page: direction, button, gravity (I, J, K)"),
-    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop"),
     CommandSpec("send", "TOKEN...", "send raw tokens: letters, {frames}, \\xNN"),
-    CommandSpec("record", "FILE|stop", "start or stop recording a transcript"),
-    CommandSpec("wait", "SECONDS", "script mode: let time pass"),
-    CommandSpec("status", "", "print the status panel (script mode)"),
-    CommandSpec("help", "", "list the commands and keys"),
-    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)"),
 )
-COMMAND_NAMES = tuple(c.name for c in COMMANDS)
 PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}
-QUIT_WORDS = ("quit", "exit", "q")
-
 
 KEYS_HELP = (
     "arrows, q w e / a s d / z x c drive · space stop · i j k page · l latch\n"
@@ -70,32 +49,22 @@ KEYS_HELP = (
 """The console's keys, as its panel and help show them."""
 
 
-def help_lines() -> list[str]:
-    """The commands, a line each, then the keys."""
-    lines = [f"{spec.name} {spec.args}".strip().ljust(18) + spec.help for spec in COMMANDS]
-    return [*lines, "", *KEYS_HELP.splitlines(), "PgUp/PgDn scroll the messages · ? or Esc close"]
+class Session(BaseSession):
+    """A session on the APP port: pages, letters and the nine parameters."""
 
-
-class Quit(Exception):
-    """The user asked to leave."""
-
-
-class ShowStatus:
-    """`status` was asked for: the view prints the panel (script mode)."""
-
-
-SHOW_STATUS = ShowStatus()
-
-
-class ShowHelp:
-    """`help` was asked for: the view shows `help_lines()`."""
-
-
-SHOW_HELP = ShowHelp()
-
-
-class Session:
-    """A host session with driving state, messages, recording and commands."""
+    commands = COMMANDS
+    keys_help = KEYS_HELP
+    keys: ClassVar[dict[str, str]] = {
+        "i": "page gravity",
+        "j": "page joystick",
+        "k": "page button",
+        "p": "params",
+        "+": f"speed +{SPEED_STEP}",
+        "=": f"speed +{SPEED_STEP}",
+        "-": f"speed -{SPEED_STEP}",
+    }
+    aliases: ClassVar[dict[str, str]] = {"read": "params"}
+    waveforms = True
 
     def __init__(
         self,
@@ -105,12 +74,7 @@ class Session:
         on_message: Callable[[str], None] | None = None,
         layout: ALayout = VELOCITY,
     ) -> None:
-        self.url = url
-        self.simulated = is_simulated(url)
-        self.driving = driving or HoldToDrive()
-        self.messages: deque[str] = deque(maxlen=LOG)
-        self.on_message = on_message
-        self.recorder: Recorder | None = None
+        super().__init__(url, driving, on_message)
         self.host = Host(url, tap=self._tap, layout=layout)
         self.page = Page.DIRECTION
         self.page_letter = "J"
@@ -118,12 +82,19 @@ class Session:
         self._sent = HostDecoder()
         self.baseline: tuple[int, ...] | None = None
         """The parameters as first read, or as last sent to flash: what a quit would keep."""
-        if record:
-            try:
-                self.start_recording(record)
-            except BaseException:
-                self.host.close()
-                raise
+        self.completions = {
+            "set": {p.name: None for p in params.PARAMS},
+            "page": dict.fromkeys(PAGE_WORDS),
+            "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None},
+        }
+        self._open_recording(record)
+
+    def now(self) -> float:
+        return self.host.now()
+
+    @property
+    def busy(self) -> bool:
+        return self.host.state.query is not None
 
     # ------------------------------------------------------------ life cycle
 
@@ -138,26 +109,6 @@ class Session:
             self.host.close()
         finally:
             self._drop_recorder()
-
-    def say(self, text: str) -> None:
-        self.messages.append(text)
-        if self.on_message is not None:
-            self.on_message(text)
-
-    def _tap(self, direction: str, time: float, data: bytes) -> None:
-        if self.recorder is None:
-            return
-        try:
-            self.recorder(direction, time, data)
-        except AppmodeError as exc:
-            self._drop_recorder()
-            self.say(f"{exc}; recording stopped")
-
-    def _drop_recorder(self) -> None:
-        recorder, self.recorder = self.recorder, None
-        if recorder is not None:
-            with contextlib.suppress(AppmodeError):
-                recorder.close()
 
     # ------------------------------------------------------------ time
 
@@ -195,6 +146,9 @@ class Session:
         to_send = self.driving.press(letter, self.host.now())
         if to_send is not None:
             self._send_letter(to_send)
+
+    def grid_key(self, row: int, col: int) -> str:
+        return grid_for(self.page)[row][col]
 
     def stop(self) -> None:
         self.driving.stop()
@@ -290,54 +244,8 @@ class Session:
         changed = params.changes(self.baseline, current.values)
         return f"not saved: {', '.join(changed)}" if changed else None
 
-    # ------------------------------------------------------------ recording
-
-    def start_recording(self, path: str) -> None:
-        try:
-            recorder = Recorder.create(path, self.host.now(), sim_directives(self.url))
-        except AppmodeError as exc:
-            if self.recorder is None:
-                raise
-            raise AppmodeError(f"{exc}; still recording to {self.recorder.name}") from None
-        self._drop_recorder()
-        self.recorder = recorder
-        self.say(f"recording to {path}")
-
-    def stop_recording(self) -> None:
-        if self.recorder is None:
-            self.say("not recording")
-            return
-        self._drop_recorder()
-        self.say("recording stopped")
-
-    # ------------------------------------------------------------ commands
-
-    def run(self, line: str) -> Wait | ShowStatus | ShowHelp | None:
-        """Run one command line; returns a Wait for `wait`, SHOW_STATUS for `status`,
-        SHOW_HELP for `help`.
-        Raises Quit to leave.
-
-        Mistakes are reported as messages, never raised.
-        """
-        try:
-            words = shlex.split(line, comments=True)
-        except ValueError as exc:
-            self.say(f"error: {exc}")
-            return None
-        if not words:
-            return None
-        try:
-            return self._dispatch(words[0].lower(), words[1:])
-        except (AppmodeError, ValueError) as exc:
-            self.say(f"error: {exc}")
-            return None
-
-    def _dispatch(self, name: str, args: list[str]) -> Wait | ShowStatus | ShowHelp | None:
-        if name in QUIT_WORDS:
-            raise Quit
-        if name in ("help", "?"):
-            return SHOW_HELP
-        elif name in ("params", "read"):
+    def _dispatch(self, name: str, args: list[str]) -> Step:
+        if name == "params":
             self.read_params()
         elif name == "set":
             value = params.whole(args[1]) if len(args) == 2 else None
@@ -358,25 +266,8 @@ class Session:
             if len(args) != 1 or args[0].lower() not in PAGE_WORDS:
                 raise AppmodeError("usage: page direction|button|gravity|joystick")
             self.switch_page(PAGE_WORDS[args[0].lower()])
-        elif name == "latch":
-            if args not in (["on"], ["off"]):
-                raise AppmodeError("usage: latch on|off")
-            self.driving.latched = args[0] == "on"
-            self.say(f"latched driving {args[0]}")
         elif name == "send":
             self._send_tokens(args)
-        elif name == "record":
-            if len(args) != 1:
-                raise AppmodeError("usage: record FILE, or record stop")
-            self.stop_recording() if args[0] == "stop" else self.start_recording(args[0])
-        elif name == "wait":
-            step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
-            assert isinstance(step, Wait)
-            return step
-        elif name == "status":
-            return SHOW_STATUS
-        else:
-            raise AppmodeError(f"unknown command {name!r}: type help for the list")
         return None
 
     def _speed(self, args: list[str]) -> None:

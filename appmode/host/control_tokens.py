@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from appmode.errors import AppmodeError
 from appmode.host.tokens import Wait, parse_wait
 from appmode.protocol import control, params, settings
+
+if TYPE_CHECKING:
+    from appmode.host.control_client import ControlHost
 
 HELP = (
     "tokens are velocity:X,Y,Z (diff-gyro: velocity:LEFT,RIGHT), rotate:DEGREES, "
@@ -103,3 +107,34 @@ def _hex(token: str) -> bytes:
     if not data:
         raise AppmodeError(f"token {token!r} is not understood: {HELP}")
     return data
+
+
+def perform(host: ControlHost, step: Step | bytes) -> None:
+    """Send one step (a rotation is only started; a read only sent)."""
+    if isinstance(step, bytes):
+        host.send(step)
+        return
+    kind, values = step.kind, step.values
+    if kind == "velocity":
+        if host.drive is params.DriveType.DIFF_GYRO:
+            if len(values) != 2:
+                raise AppmodeError("velocity: a diff-gyro car takes LEFT,RIGHT duties")
+            host.velocity(left=values[0], right=values[1])
+        elif len(values) != 3:
+            raise AppmodeError(f"velocity: a {host.drive.cli_name} car takes X,Y,Z")
+        else:
+            host.velocity(*values)
+    elif kind == "motors":
+        host.motors(values)
+    elif kind == "position":
+        host.position(*values)
+    elif kind == "read":
+        host.send_frame(control.read(step.name))
+    elif kind == "set":
+        host.send_frame(control.SetSetting(settings.BY_NAME[step.name], values[0]))
+    elif kind == "rotate":
+        host.start_rotation(values[0] / 10)
+    elif kind == "stop":
+        host.stop()
+    else:
+        host.store(kind)

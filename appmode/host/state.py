@@ -11,7 +11,7 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from appmode.host.query import Outcome, ParamQuery, QueryFailed
-from appmode.protocol import app
+from appmode.protocol import app, params
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import motion_text
 
@@ -56,6 +56,8 @@ STILL_MOVING_AFTER = 1.0
 """Seconds after a stop by which the board's A records must show the car (almost) still."""
 STILL = 20
 """The largest velocity component of a car taken as stopped (a decaying ramp, §13)."""
+FOLLOW_AFTER = 1.0
+"""Seconds after a drive letter by which the A records must show the car moving."""
 
 
 @dataclass(slots=True)
@@ -123,6 +125,12 @@ class HostState:
         """When the host last told the car to stop (Z or a page letter), while it has not
         told it to move since."""
         self._warned = False
+        self.moving_since: float | None = None
+        """When the host last sent a drive letter, while it has not stopped the car since."""
+        self.letters_ignored = False
+        """A drive letter was in force for FOLLOW_AFTER s and the car stood still: the
+        control port (UART2, §8.3) drives it. The take-over lasts until the board is
+        reset, so this holds until the link is lost."""
 
     def feed(self, data: bytes, now: float) -> list[app.BoardEvent | Outcome | BoardWarning]:
         """Decode board bytes; returns the events, the outcome of a query they end, and a
@@ -134,8 +142,10 @@ class HostState:
             outcome = self._apply(event, now)
             if outcome is not None:
                 events.append(outcome)
-            if isinstance(event, app.Velocity) and (warning := self._disobeyed(event, now)):
-                events.append(warning)
+            if isinstance(event, app.Velocity):
+                for warning in (self._disobeyed(event, now), self._ignored(event, now)):
+                    if warning is not None:
+                        events.append(warning)
         return events
 
     def sent(self, data: bytes, now: float) -> None:
@@ -143,8 +153,10 @@ class HostState:
         for event in self.end.sent(data):
             if isinstance(event, app.Move):
                 self.stopped_at = None
+                self.moving_since = now
             elif isinstance(event, (app.Stop, app.SwitchPage)):
                 self.stopped_at, self._warned = now, False
+                self.moving_since = None
 
     def _disobeyed(self, velocity: app.Velocity, now: float) -> BoardWarning | None:
         stopped = self.stopped_at
@@ -157,6 +169,22 @@ class HostState:
             f"the car still moves {now - stopped:.1f} s after it was told to stop "
             f"({motion_text(velocity, self.layout)}): another program or port may "
             f"be driving it, or the board is not obeying"
+        )
+
+    def _ignored(self, velocity: app.Velocity, now: float) -> BoardWarning | None:
+        """The first A record showing the car still FOLLOW_AFTER s after a drive letter
+        (with a max_speed that is not 0): the letters are not followed."""
+        since = self.moving_since
+        if self.letters_ignored or since is None or now - since < FOLLOW_AFTER:
+            return None
+        stalled = self.params is not None and self.params.values[params.MAX_SPEED] == 0
+        if stalled or self.layout.speed(app.record_fields(velocity)[1]) > STILL:
+            return None
+        self.letters_ignored = True
+        return BoardWarning(
+            f"the car stands still {now - since:.1f} s after a drive letter: "
+            "the control port (UART2) may have taken over the motion (§8.3); letters on "
+            "this port no longer drive it until the board is reset"
         )
 
     def start_query(self, query: ParamQuery, now: float) -> None:
@@ -192,8 +220,9 @@ class HostState:
         return outcome
 
     def reset_decoder(self) -> None:
-        """Forget a partial record (after the link was lost)."""
+        """Forget a partial record (after the link was lost: the board may restart)."""
         self.decoder = app.BoardDecoder()
+        self.letters_ignored = False
 
     def _apply(self, event: app.BoardEvent, now: float) -> Outcome | None:
         if isinstance(event, app.ERRORS):

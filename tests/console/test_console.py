@@ -132,7 +132,7 @@ def test_a_crash_in_the_console_still_sends_z_last(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls = {"n": 0}
-    real = app.Session.tick
+    real = Session.tick
 
     def failing_tick(self: Session) -> None:
         calls["n"] += 1
@@ -140,7 +140,7 @@ def test_a_crash_in_the_console_still_sends_z_last(
             raise RuntimeError("boom")
         real(self)
 
-    monkeypatch.setattr(app.Session, "tick", failing_tick)
+    monkeypatch.setattr(Session, "tick", failing_tick)
     with pytest.raises(RuntimeError, match="boom"):
         run_console(tmp_path, [("w", 0.0), ("w", 5.0)], latched=True)
     payloads = [p for _, p in sent(tmp_path / "app.transcript")]

@@ -11,8 +11,9 @@ from prompt_toolkit.formatted_text import StyleAndTextTuples
 from prompt_toolkit.utils import get_cwidth
 
 from appmode.console.hold import HoldToDrive
-from appmode.console.panel import BAR, WIDTH, status_fragments
-from appmode.console.session import Session, help_lines
+from appmode.console.panel import status_fragments
+from appmode.console.panel_parts import BAR, WIDTH
+from appmode.console.session import Session
 from appmode.console.waves import LEVELS
 
 
@@ -55,7 +56,7 @@ def test_every_line_fits_80_columns_with_the_grid_the_waveforms_and_the_help() -
         views = {
             "grid": _lines(status_fragments(session)),
             "waves": _lines(status_fragments(session, waveforms=True)),
-            "help": help_lines(),
+            "help": session.help_lines(),
         }
     finally:
         session.close()

@@ -1,0 +1,256 @@
+"""What every driving session shares, whatever port it drives: messages, recording,
+hold-to-drive, and the command line's common commands (help, latch, record, wait,
+status, quit). `session.Session` drives the APP port, `control_session.ControlSession`
+the control port.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import shlex
+from abc import ABC, abstractmethod
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import ClassVar
+
+from appmode.console.hold import HoldToDrive
+from appmode.errors import AppmodeError
+from appmode.host.tokens import Wait, parse_token
+from appmode.ports.link import is_simulated
+from appmode.ports.sim import sim_directives
+from appmode.protocol.transcript import Recorder
+
+SPEED_STEP = 100
+LOG = 500
+"""Messages kept for scrolling back."""
+QUIT_WORDS = ("quit", "exit", "q")
+
+
+@dataclass(frozen=True, slots=True)
+class CommandSpec:
+    name: str
+    args: str
+    help: str
+
+
+COMMON: tuple[CommandSpec, ...] = (
+    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop"),
+    CommandSpec("record", "FILE|stop", "start or stop recording a transcript"),
+    CommandSpec("wait", "SECONDS", "script mode: let time pass"),
+    CommandSpec("status", "", "print the status panel (script mode)"),
+    CommandSpec("help", "", "list the commands and keys"),
+    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)"),
+)
+"""The commands every session takes, listed after its own."""
+
+
+class Quit(Exception):
+    """The user asked to leave."""
+
+
+class ShowStatus:
+    """`status` was asked for: the view prints the panel (script mode)."""
+
+
+SHOW_STATUS = ShowStatus()
+
+
+class ShowHelp:
+    """`help` was asked for: the view shows `help_lines()`."""
+
+
+SHOW_HELP = ShowHelp()
+
+Step = Wait | ShowStatus | ShowHelp | None
+
+
+class BaseSession(ABC):
+    """A console session: what it shows (messages), what it records, how it drives."""
+
+    commands: tuple[CommandSpec, ...] = ()
+    """The session's own commands (COMMON follows them)."""
+    keys_help = ""
+    """Its keys, as the panel and help show them."""
+    keys: ClassVar[dict[str, str]] = {}
+    """Keys that run a command line."""
+    hold_keys: ClassVar[dict[str, str]] = {}
+    """Driving keys besides the grid: what `press` takes for each."""
+    waveforms = False
+    """Whether the panel can show waveforms (key v)."""
+
+    def __init__(
+        self, url: str, driving: HoldToDrive | None, on_message: Callable[[str], None] | None
+    ) -> None:
+        self.url = url
+        self.simulated = is_simulated(url)
+        self.driving = driving or HoldToDrive()
+        self.messages: deque[str] = deque(maxlen=LOG)
+        self.on_message = on_message
+        self.recorder: Recorder | None = None
+        self.completions: dict[str, object] = {}
+        """What the command line completes after a command's name."""
+
+    # ------------------------------------------------------------ what a session is
+
+    @abstractmethod
+    def now(self) -> float:
+        """Seconds since the session started."""
+
+    @abstractmethod
+    def start(self) -> None:
+        """Put the board in a known, stopped state and read its values."""
+
+    @abstractmethod
+    def close(self) -> None:
+        """Stop the car (the protocol's stop is the last thing sent) and close all."""
+
+    @abstractmethod
+    def tick(self) -> bool:
+        """Read what arrived and let time pass; whether anything happened."""
+
+    @abstractmethod
+    def press(self, key: str) -> None:
+        """A held driving key (what it drives, as the session names it)."""
+
+    @abstractmethod
+    def grid_key(self, row: int, col: int) -> str:
+        """What `press` takes for a key of the 3×3 grid (row 0 is the front)."""
+
+    @abstractmethod
+    def stop(self) -> None:
+        """Stop the car now."""
+
+    @property
+    @abstractmethod
+    def busy(self) -> bool:
+        """A read or set is under way (script mode waits for it)."""
+
+    @abstractmethod
+    def unsaved_warning(self) -> str | None:
+        """What was set in this session and not saved since, in a line; None if nothing."""
+
+    @abstractmethod
+    def _dispatch(self, name: str, args: list[str]) -> Step:
+        """Run one of the session's own commands; AppmodeError or ValueError for a
+        mistake."""
+
+    # ------------------------------------------------------------ messages
+
+    def say(self, text: str) -> None:
+        self.messages.append(text)
+        if self.on_message is not None:
+            self.on_message(text)
+
+    def help_lines(self) -> list[str]:
+        """The commands, a line each, then the keys."""
+        lines = [
+            f"{spec.name} {spec.args}".strip().ljust(18) + spec.help
+            for spec in (*self.commands, *COMMON)
+        ]
+        return [
+            *lines,
+            "",
+            *self.keys_help.splitlines(),
+            "PgUp/PgDn scroll the messages · ? or Esc close",
+        ]
+
+    @property
+    def command_names(self) -> tuple[str, ...]:
+        return tuple(spec.name for spec in (*self.commands, *COMMON))
+
+    # ------------------------------------------------------------ recording
+
+    def _open_recording(self, record: str | None) -> None:
+        """Start the recording asked for on the command line; on failure close the
+        session (its stop is sent) and raise."""
+        if not record:
+            return
+        try:
+            self.start_recording(record)
+        except BaseException:
+            self.close()
+            raise
+
+    def _tap(self, direction: str, time: float, data: bytes) -> None:
+        if self.recorder is None:
+            return
+        try:
+            self.recorder(direction, self.now(), data)
+        except AppmodeError as exc:
+            self._drop_recorder()
+            self.say(f"{exc}; recording stopped")
+
+    def _drop_recorder(self) -> None:
+        recorder, self.recorder = self.recorder, None
+        if recorder is not None:
+            with contextlib.suppress(AppmodeError):
+                recorder.close()
+
+    def start_recording(self, path: str) -> None:
+        try:
+            recorder = Recorder.create(path, self.now(), sim_directives(self.url))
+        except AppmodeError as exc:
+            if self.recorder is None:
+                raise
+            raise AppmodeError(f"{exc}; still recording to {self.recorder.name}") from None
+        self._drop_recorder()
+        self.recorder = recorder
+        self.say(f"recording to {path}")
+
+    def stop_recording(self) -> None:
+        if self.recorder is None:
+            self.say("not recording")
+            return
+        self._drop_recorder()
+        self.say("recording stopped")
+
+    # ------------------------------------------------------------ commands
+
+    def run(self, line: str) -> Step:
+        """Run one command line; returns a Wait for `wait`, SHOW_STATUS for `status`,
+        SHOW_HELP for `help`. Raises Quit to leave.
+
+        Mistakes are reported as messages, never raised.
+        """
+        try:
+            words = shlex.split(line, comments=True)
+        except ValueError as exc:
+            self.say(f"error: {exc}")
+            return None
+        if not words:
+            return None
+        try:
+            return self._common(words[0].lower(), words[1:])
+        except (AppmodeError, ValueError) as exc:
+            self.say(f"error: {exc}")
+            return None
+
+    def _common(self, name: str, args: list[str]) -> Step:
+        if name in QUIT_WORDS:
+            raise Quit
+        if name in ("help", "?"):
+            return SHOW_HELP
+        if name == "status":
+            return SHOW_STATUS
+        if name == "wait":
+            step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
+            assert isinstance(step, Wait)
+            return step
+        if name == "latch":
+            if args not in (["on"], ["off"]):
+                raise AppmodeError("usage: latch on|off")
+            self.driving.latched = args[0] == "on"
+            self.say(f"latched driving {args[0]}")
+        elif name == "record":
+            if len(args) != 1:
+                raise AppmodeError("usage: record FILE, or record stop")
+            self.stop_recording() if args[0] == "stop" else self.start_recording(args[0])
+        elif name in self.command_names or name in self.aliases:
+            return self._dispatch(self.aliases.get(name, name), args)
+        else:
+            raise AppmodeError(f"unknown command {name!r}: type help for the list")
+        return None
+
+    aliases: ClassVar[dict[str, str]] = {}
+    """Other names for commands."""

@@ -1,0 +1,434 @@
+"""A driving session on the control port (UART2): velocity frames from held keys, turns
+in angle mode, the ten settings by name, the encoder report; with `app_url`, the APP
+port of the same board alongside (its records shown, both ports recorded).
+
+It never blocks: reads and sets run as queries (`control_query`) whose outcome arrives
+with `tick()`. Closing sends the zero velocity frame last on UART2.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable
+from functools import partial
+from typing import ClassVar
+
+from appmode.console.base import SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.console.hold import HoldToDrive
+from appmode.errors import AppmodeError
+from appmode.host.client import Host
+from appmode.host.control_client import ControlHost
+from appmode.host.control_query import ROTATE_POLL, ReadDone, ReadQuery, rotation_done
+from appmode.host.control_state import TAKEOVER_BYTE
+from appmode.host.control_tokens import parse_token, perform
+from appmode.host.link import LinkLost
+from appmode.host.query import QueryFailed
+from appmode.host.state import BoardWarning, LinkStatus
+from appmode.host.tokens import Wait
+from appmode.protocol import control, params, settings
+from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
+from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.params import DriveType
+
+DEFAULT_SPEED = 300
+"""Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""
+DEFAULT_ANGLE = 90.0
+REPORT_BIT = params.MODE_BIT["encoder_report"]
+SETTING_NAMES = tuple(s.name for s in settings.SETTINGS)
+STOP = "stop"
+
+COMMANDS: tuple[CommandSpec, ...] = (
+    CommandSpec("settings", "", "read the ten settings"),
+    CommandSpec("read", "NAME...", "read values: settings, pending_angle, speed_a, position_a…"),
+    CommandSpec("set", "NAME VALUE", "set a setting, verified by reading back"),
+    CommandSpec("save", "", "save the settings to the board's flash"),
+    CommandSpec("load", "", "load the saved settings into the running copy"),
+    CommandSpec("defaults", "", "load the factory defaults into the running copy"),
+    CommandSpec("speed", "+N|-N|N", f"the speed keys drive at (keys + and - step {SPEED_STEP})"),
+    CommandSpec("angle", "DEGREES", "the turn r and R make"),
+    CommandSpec("rotate", "[DEGREES]", "turn in angle mode (default: the set angle)"),
+    CommandSpec("drive", "MOTION", "drive: forward, right, rotate-cw… (latched: until stop)"),
+    CommandSpec("velocity", "X Y Z|L R", "send a velocity frame (stays until stop)"),
+    CommandSpec("stop", "", "stop the car (the zero velocity frame)"),
+    CommandSpec("send", "TOKEN...", "send frames as `send --uart2` takes them, or raw hex"),
+)
+
+KEYS_HELP = (
+    "arrows, q w e / a s d / z x c drive · , . turn · r R rotate · space stop · l latch\n"
+    "+ - speed · p settings · : command · ? help · Ctrl-Q quit"
+)
+
+
+def velocity_for(motion: Motion, speed: int, drive: DriveType) -> dict[str, int]:
+    """The velocity frame's fields (`ControlHost.velocity` keywords) that drive `motion`
+    at `speed` on `drive`: x, y, z on omni and mecanum, y and z duties on diff, left
+    and right duties on diff-gyro (each within ±MAX_DUTY)."""
+    if not drive.differential:
+        x, y, z = (round(f * speed) for f in motion.holonomic)
+        return {"x": x, "y": y, "z": z}
+    fy, fz = (f * speed for f in motion.differential)
+
+    def duty(value: float) -> int:
+        return max(-control.MAX_DUTY, min(control.MAX_DUTY, round(value)))
+
+    if drive is DriveType.DIFF_GYRO:
+        return {"left": duty(fy + fz), "right": duty(fy - fz)}
+    return {"y": duty(fy), "z": duty(fz)}
+
+
+class ControlSession(BaseSession):
+    """A session on the control port, with the APP port of the same board if given."""
+
+    commands = COMMANDS
+    keys_help = KEYS_HELP
+    keys: ClassVar[dict[str, str]] = {
+        "r": "rotate",
+        "R": "rotate -",
+        "p": "settings",
+        "+": f"speed +{SPEED_STEP}",
+        "=": f"speed +{SPEED_STEP}",
+        "-": f"speed -{SPEED_STEP}",
+    }
+    hold_keys: ClassVar[dict[str, str]] = {",": "rotate-ccw", ".": "rotate-cw"}
+
+    def __init__(
+        self,
+        url: str,
+        driving: HoldToDrive | None = None,
+        record: str | None = None,
+        on_message: Callable[[str], None] | None = None,
+        app_url: str | None = None,
+        layout: ALayout = VELOCITY,
+        drive: DriveType | None = None,
+        takeover_byte: int = TAKEOVER_BYTE,
+    ) -> None:
+        super().__init__(url, driving, on_message)
+        self.host = ControlHost(url, tap=self._tap, drive=drive, takeover_byte=takeover_byte)
+        self.url = self.host.url
+        self.app: Host | None = None
+        if app_url is not None:
+            try:
+                self.app = Host(app_url, tap=self._tap, layout=layout)
+            except BaseException:
+                self.host.close()
+                raise
+        self.speed = DEFAULT_SPEED
+        self.angle = DEFAULT_ANGLE
+        self.in_force = STOP
+        """The motion a key or command is driving, or `stop`."""
+        self.rotation: tuple[float, float] | None = None
+        """A turn under way: (when it started, degrees)."""
+        self._next_angle_read = 0.0
+        self._report_restore: int | None = None
+        """system_mode before this session turned the encoder report on."""
+        self.baseline: dict[str, int] | None = None
+        """The settings as first read, or as last saved: what a quit would keep."""
+        self.completions = {
+            "set": dict.fromkeys(SETTING_NAMES),
+            "read": dict.fromkeys(settings.READ_BY_NAME),
+            "drive": dict.fromkeys(MOTIONS),
+            "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None},
+        }
+        self._open_recording(record)
+
+    def now(self) -> float:
+        return self.host.now()
+
+    @property
+    def busy(self) -> bool:
+        return self.host.state.query is not None
+
+    @property
+    def drive(self) -> DriveType | None:
+        return self.host.known_drive
+
+    # ------------------------------------------------------------ life cycle
+
+    def start(self) -> None:
+        """Take the motion over with the zero velocity frame, then read the settings
+        (the encoder report is turned on for the session once system_mode is known)."""
+        self._send(lambda: self.host.stop())
+        self._query(ReadQuery(SETTING_NAMES, None, self.host.timeout, self.host.tries, self.url))
+
+    def close(self) -> None:
+        """The encoder report as it was, `Z` on the APP port, and the zero velocity
+        frame last on UART2; then the recording."""
+        try:
+            if self._report_restore is not None and self.host.connected:
+                with contextlib.suppress(AppmodeError):
+                    self.host.send_frame(_set("system_mode", self._report_restore))
+            if self.app is not None:
+                self.app.close()
+        finally:
+            try:
+                self.host.close()
+            finally:
+                self._drop_recorder()
+
+    # ------------------------------------------------------------ time
+
+    def tick(self) -> bool:
+        """Read both ports, end queries, follow a turn, stop a held key that timed out."""
+        events: list[object] = list(self.host.poll_nowait())
+        for event in events:
+            if isinstance(event, LinkStatus):
+                self.say(f"UART2: {event.text}")
+                if not event.up:
+                    self._forget_motion()
+            elif isinstance(event, ReadDone):
+                self._done(event)
+            elif isinstance(event, QueryFailed):
+                self.say(f"error: {event.text}")
+                self.rotation = None
+        if self.app is not None:
+            for app_event in self.app.poll_nowait():
+                events.append(app_event)
+                if isinstance(app_event, LinkStatus):
+                    self.say(f"APP port: {app_event.text}")
+                elif isinstance(app_event, BoardWarning):
+                    self.say(f"WARNING: {app_event.text}")
+        self._follow_rotation()
+        if self.driving.release_due(self.now()):
+            self.stop()
+            return True
+        return bool(events)
+
+    def _done(self, outcome: ReadDone) -> None:
+        values = outcome.values
+        if self.rotation is not None and set(values) == {"pending_angle"}:
+            self._rotation_read(values["pending_angle"])
+            return
+        self.say(outcome.text if len(values) < len(SETTING_NAMES) else "settings read")
+        if set(SETTING_NAMES) <= set(values) and self.baseline is None:
+            self.baseline = self._comparable(values)
+            self._report_on(values["system_mode"])
+
+    def _report_on(self, mode: int) -> None:
+        """Turn the encoder report on for the session (put back when it closes)."""
+        if mode & REPORT_BIT:
+            return
+        self._report_restore = mode
+        self.say("turning the encoder report on for this session (system_mode bit 6)")
+        self._query(self._new(change=("system_mode", mode | REPORT_BIT)), quiet=True)
+
+    def _follow_rotation(self) -> None:
+        if self.rotation is None or self.busy or self.now() < self._next_angle_read:
+            return
+        self._next_angle_read = self.now() + ROTATE_POLL
+        self._query(self._new(["pending_angle"]), quiet=True)
+
+    def _rotation_read(self, left: int) -> None:
+        assert self.rotation is not None
+        started, degrees = self.rotation
+        try:
+            done = rotation_done(left, self.now() - started)
+        except AppmodeError as exc:
+            self.say(f"error: {exc}")
+            self.stop()
+            return
+        if done:
+            self.rotation = None
+            self.say(f"rotated {degrees:g}° in {self.now() - started:.2f} s")
+
+    # ------------------------------------------------------------ driving
+
+    def grid_key(self, row: int, col: int) -> str:
+        letter = GRID[row][col]
+        return STOP_LETTER if letter == STOP_LETTER else DIRECTION_PAGE[letter].name
+
+    def press(self, key: str) -> None:
+        """A held key: a motion's name (`forward`, `rotate-cw`…) or STOP_LETTER."""
+        if not self.host.connected:
+            self.say("link is down: not driving")
+            return
+        what = self.driving.press(key, self.now())
+        if what == STOP_LETTER:
+            self.stop()
+        elif what is not None:
+            self._drive(what)
+
+    def _drive(self, name: str) -> None:
+        drive = self.drive
+        if drive is None:
+            self.driving.stop()
+            self.say("the drive type is not known yet: reading system_mode (or use --drive-type)")
+            if not self.busy:
+                self._query(self._new(["system_mode"]))
+            return
+        fields = velocity_for(MOTIONS[name], self.speed, drive)
+        if self._send(lambda: self.host.velocity(**fields)):
+            self.in_force = name
+            self.rotation = None
+
+    def stop(self) -> None:
+        """The zero velocity frame (it also drops a pending turn)."""
+        self.driving.stop()
+        self._send(lambda: self.host.stop())
+        self._forget_motion()
+
+    def _forget_motion(self) -> None:
+        self.driving.stop()
+        self.in_force = STOP
+        self.rotation = None
+
+    def rotate(self, degrees: float) -> None:
+        if self.drive is DriveType.DIFF_GYRO:
+            raise AppmodeError("a diff-gyro car has no angle mode (§9.1): drive with , and .")
+        if self.drive is None:
+            raise AppmodeError("the drive type is not known yet: try again, or use --drive-type")
+        self.driving.stop()
+        if self._send(lambda: self.host.start_rotation(degrees)):
+            self.in_force = STOP
+            self.rotation = (self.now(), degrees)
+            self._next_angle_read = self.now() + ROTATE_POLL
+            self.say(f"rotating {degrees:g}°")
+
+    def _send(self, send: Callable[[], object]) -> bool:
+        """Run a send; a lost link or a value out of range becomes a message."""
+        try:
+            send()
+        except LinkLost as exc:
+            self.say(str(exc))
+            self._forget_motion()
+            return False
+        return True
+
+    # ------------------------------------------------------------ settings
+
+    def _new(
+        self, names: tuple[str, ...] | list[str] = (), change: tuple[str, int] | None = None
+    ) -> ReadQuery:
+        return ReadQuery(names, change, self.host.timeout, self.host.tries, self.url)
+
+    def _query(self, query: ReadQuery, quiet: bool = False) -> None:
+        if self.busy:
+            if not quiet:
+                self.say("busy: a read or set is in progress")
+            return
+        self.host.start_query(query)
+
+    def set_setting(self, name: str, value: int) -> None:
+        self._query(self._new(change=(settings.lookup(name).name, value)))
+
+    def store(self, op: str) -> None:
+        if not self._send(lambda: self.host.store(op)):
+            return
+        meaning = settings.STORE_BY_NAME[op].meaning
+        if op == "save":
+            values = self.host.state.values
+            if set(SETTING_NAMES) <= set(values):
+                self.baseline = self._comparable(values)
+            self.say(f"sent save: {meaning} (the board sends no reply)")
+        else:
+            self.say(f"sent {op}: {meaning}; reading the settings")
+            self._query(self._new(SETTING_NAMES), quiet=True)
+
+    def unsaved_warning(self) -> str | None:
+        if self.baseline is None:
+            return None
+        now = self._comparable(self.host.state.values)
+        changed = [name for name in SETTING_NAMES if now.get(name) != self.baseline.get(name)]
+        return f"not saved: {', '.join(changed)}" if changed else None
+
+    @staticmethod
+    def _comparable(values: dict[str, int]) -> dict[str, int]:
+        """The settings as a save keeps them: system_mode's bits 6 and 7 are not saved."""
+        kept = {name: values[name] for name in SETTING_NAMES if name in values}
+        if "system_mode" in kept:
+            kept["system_mode"] &= ~(REPORT_BIT | params.MODE_BIT["app_mode"])
+        return kept
+
+    # ------------------------------------------------------------ commands
+
+    def _dispatch(self, name: str, args: list[str]) -> Step:
+        if name == "settings":
+            self._query(self._new(SETTING_NAMES))
+        elif name == "read":
+            if not args:
+                raise AppmodeError("usage: read NAME..., e.g. read max_speed pending_angle")
+            self._query(self._new(args))
+        elif name == "set":
+            value = params.whole(args[1]) if len(args) == 2 else None
+            if value is None:
+                raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
+            self.set_setting(args[0], value)
+        elif name in settings.STORE_BY_NAME:
+            self.store(name)
+        elif name == "speed":
+            self._speed(args)
+        elif name == "angle":
+            self.angle = _degrees(args, "usage: angle DEGREES, e.g. angle 45")
+            self.say(f"r and R turn {self.angle:g}°")
+        elif name == "rotate":
+            if args == ["-"]:
+                self.rotate(-self.angle)
+            else:
+                self.rotate(_degrees(args, "usage: rotate [DEGREES]") if args else self.angle)
+        elif name == "drive":
+            if len(args) != 1 or args[0] not in MOTIONS:
+                raise AppmodeError(f"usage: drive MOTION, one of {', '.join(MOTIONS)}")
+            self.press(args[0])
+        elif name == "velocity":
+            self._velocity(args)
+        elif name == "stop":
+            self.stop()
+        elif name == "send":
+            self._send_tokens(args)
+        return None
+
+    def _speed(self, args: list[str]) -> None:
+        number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
+        if number is None:
+            raise AppmodeError("usage: speed +N, speed -N or speed N")
+        wanted = (
+            self.speed + (-number if args[0][0] == "-" else number)
+            if args[0][0] in "+-"
+            else number
+        )
+        top = (
+            control.MAX_DUTY if self.drive is not None and self.drive.differential else control.U16
+        )
+        self.speed = min(top, max(0, wanted))
+        unit = (
+            "‰ duty"
+            if top == control.MAX_DUTY
+            else " (velocity units; the board caps at max_speed)"
+        )
+        self.say(f"speed {self.speed}{unit}")
+
+    def _velocity(self, args: list[str]) -> None:
+        if not args:
+            raise AppmodeError("usage: velocity X Y Z (diff-gyro: velocity LEFT RIGHT)")
+        step = parse_token("velocity:" + ",".join(args))
+        assert not isinstance(step, Wait)
+        self.driving.stop()
+        if self._send(lambda: perform(self.host, step)):
+            self.in_force = "velocity " + " ".join(args)
+            self.rotation = None
+
+    def _send_tokens(self, tokens: list[str]) -> None:
+        if not tokens:
+            raise AppmodeError("usage: send TOKEN..., e.g. send velocity:0,200,0 or send FFFE01…")
+        steps = [parse_token(token) for token in tokens]
+        if any(isinstance(step, Wait) for step in steps):
+            raise AppmodeError("send takes no waits here: use the wait command")
+        self.driving.stop()
+        for step in steps:
+            assert not isinstance(step, Wait)
+            if not self._send(partial(perform, self.host, step)):
+                return
+        self.say(f"sent {' '.join(tokens)}")
+
+
+def _set(name: str, value: int) -> control.SetSetting:
+    return control.SetSetting(settings.BY_NAME[name], value)
+
+
+def _degrees(args: list[str], usage: str) -> float:
+    try:
+        degrees = float(args[0]) if len(args) == 1 else float("nan")
+    except ValueError:
+        degrees = float("nan")
+    if not abs(degrees) <= control.U16 / 10:
+        raise AppmodeError(usage)
+    return degrees
