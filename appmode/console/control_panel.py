@@ -71,7 +71,7 @@ def control_body(session: ControlSession) -> Fragments:
     if session.app is not None:
         app = session.app
         out.append(("bold", " APP port "))
-        out += link_line(app.connected, app.state.stats, app.now())
+        out += link_line(app.connected, app.state.stats, app.now(), brief=True)
         out += telemetry(app.state, app.now())
 
     def cell(r: int, c: int) -> str:

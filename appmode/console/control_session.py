@@ -54,8 +54,8 @@ COMMANDS: tuple[CommandSpec, ...] = (
 )
 
 KEYS_HELP = (
-    "arrows, q w e / a s d / z x c drive · , . turn · r R rotate · space stop · l latch\n"
-    "+ - speed · p settings · : command · ? help · Ctrl-Q quit"
+    "arrows, q w e / a s d / z x c drive · , . turn · space stop · l latch\n"
+    "r R rotate · + - speed · p settings · : command · ? help · Ctrl-Q quit"
 )
 
 

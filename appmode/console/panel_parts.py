@@ -43,19 +43,28 @@ def _bar(percent: int) -> str:
 
 
 def header(session: BaseSession, title: str) -> Fragments:
+    """The title, whether the board is simulated, and its URL (cut to fit WIDTH)."""
+    badge = " SIMULATED BOARD " if session.simulated else " REAL BOARD "
     out: Fragments = [("bold", f" {title}  ")]
-    if session.simulated:
-        out.append(("reverse bold fg:ansiyellow", " SIMULATED BOARD "))
-    else:
-        out.append(("reverse bold fg:ansigreen", " REAL BOARD "))
-    out.append(("", f"  {session.url}\n"))
+    out.append(
+        ("reverse bold fg:ansiyellow" if session.simulated else "reverse bold fg:ansigreen", badge)
+    )
+    room = WIDTH - len(title) - len(badge) - 5
+    url = session.url if len(session.url) <= room else session.url[: room - 1] + "…"
+    out.append(("", f"  {url}\n"))
     return out
 
 
 def link_line(
-    connected: bool, stats: LinkStats, now: float, noun: str = "records", hint: str = SILENT_HINT
+    connected: bool,
+    stats: LinkStats,
+    now: float,
+    noun: str = "records",
+    hint: str = SILENT_HINT,
+    brief: bool = False,
 ) -> Fragments:
-    """Whether the link is up: counters, errors, how fresh what it brings is."""
+    """Whether the link is up: counters (bytes unless `brief`), errors, how fresh what it
+    brings is."""
     age = stats.since_last(now)
     if not connected:
         return [("reverse bold fg:ansired", " LINK LOST — retrying; keys do nothing "), ("", "\n")]
@@ -73,13 +82,8 @@ def link_line(
         ]
     else:
         out = [("fg:ansired bold" if age > 1.0 else "fg:ansigreen", " link up")]
-    out.append(
-        (
-            "",
-            f"  {stats.rate(now):3.0f} {noun}/s · in {_size(stats.bytes_in)} · "
-            f"out {_size(stats.bytes_out)} · errors {stats.errors} · {last}\n",
-        )
-    )
+    sizes = "" if brief else f"in {_size(stats.bytes_in)} · out {_size(stats.bytes_out)} · "
+    out.append(("", f"  {stats.rate(now):3.0f} {noun}/s · {sizes}errors {stats.errors} · {last}\n"))
     return out
 
 

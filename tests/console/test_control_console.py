@@ -1,0 +1,142 @@
+"""`appmode drive --uart2`: the console over the control port, alone and with the APP
+port of the same board; script mode, the panel, and tmux against a board process."""
+
+from __future__ import annotations
+
+import re
+import sys
+import time
+from pathlib import Path
+
+from prompt_toolkit.utils import get_cwidth
+
+from appmode.console.control_session import ControlSession, velocity_for
+from appmode.console.hold import HoldToDrive
+from appmode.console.panel import status_fragments
+from appmode.console.panel_parts import WIDTH
+from appmode.host.state import BoardWarning, HostState
+from appmode.protocol.directions import MOTIONS
+from appmode.protocol.params import DriveType
+from tests.console.test_console_tmux import SESSION, _alive, screen, tmux, wait_screen
+from tests.support.processes import ROOT, board_process, run, wait_for
+
+STOP_FRAME = "FF FE 01 00 00 00 00 00 00 00"
+
+
+def uart2_sent(record: Path) -> list[str]:
+    """The `2>` payloads of a transcript, in order."""
+    lines = record.read_text().splitlines()
+    return [line.split(" ", 2)[2] for line in lines if line.split(" ")[1:2] == ["2>"]]
+
+
+def test_each_motion_becomes_the_velocity_fields_of_each_drive_type() -> None:
+    forward, right, cw = MOTIONS["forward"], MOTIONS["right"], MOTIONS["rotate-cw"]
+    assert velocity_for(forward, 300, DriveType.MECANUM) == {"x": 0, "y": 300, "z": 0}
+    assert velocity_for(right, 300, DriveType.OMNI) == {"x": 300, "y": 0, "z": 0}
+    assert velocity_for(cw, 250, DriveType.MECANUM) == {"x": 0, "y": 0, "z": 250}
+    assert velocity_for(forward, 400, DriveType.DIFF) == {"y": 400, "z": 0}
+    assert velocity_for(cw, 400, DriveType.DIFF_GYRO) == {"left": 400, "right": -400}
+    front_right = MOTIONS["front-right"]  # y + z/2 on a diff car: capped at full duty
+    assert velocity_for(front_right, 800, DriveType.DIFF_GYRO) == {"left": 1000, "right": 400}
+
+
+def test_script_mode_drives_turns_and_sets_over_the_embedded_control_port(tmp_path: Path) -> None:
+    record = tmp_path / "u2.transcript"
+    script = (
+        b"drive forward\nwait 0.8\nstatus\nstop\nset max_speed 800\nread max_speed\n"
+        b"rotate 30\nwait 1.5\nset max_speed 70000\nfly\nquit\n"
+    )
+    done = run("drive", "--uart2", "--record", str(record), stdin=script)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    assert "SIMULATED BOARD" in out and "sim://?port=uart2" in out
+    assert re.search(r"control\s+UART2\s+drives", out) and "drive omni" in out
+    assert re.search(r"in force\s+forward", out)
+    wheel_a = re.search(r"wheels\s+A (-?\d+)/(-?\d+)", out)
+    assert wheel_a and int(wheel_a.group(1)) == 260 and int(wheel_a.group(2)) > 200, out
+    assert "set max_speed = 800 (verified)" in out and "max_speed = 800" in out
+    assert re.search(r"rotated 30° in \d\.\d\d s", out)
+    assert "error: max_speed" in out  # out of range: one message, nothing sent
+    assert "error: unknown command 'fly'" in out
+    assert "not saved: max_speed" in done.stderr
+    sent = uart2_sent(record)
+    assert "FF FE 01 00 00 01 2C 00 00 00" in sent  # forward at 300
+    assert sent[-2:] == ["FF FE 80 80 09 00 00 00 00 00", STOP_FRAME]  # report off, stop
+
+
+def test_both_ports_of_one_board_are_shown_and_recorded(tmp_path: Path) -> None:
+    record = tmp_path / "both.transcript"
+    script = b"drive forward\nwait 1\nstatus\nquit\n"
+    done = run("drive", "sim://", "--uart2-url", "sim://", "--record", str(record), stdin=script)
+    assert done.returncode == 0, done.stderr
+    assert re.search(r"APP port\s+link up", done.stdout)
+    velocity = re.search(r"velocity\s+x\s+0\s+y\s+(\d+)", done.stdout)
+    assert velocity and int(velocity.group(1)) >= 250, done.stdout  # the A record follows
+    lines = record.read_text().splitlines()
+    assert any(" < {A" in line for line in lines) and any(" 2< 24 " in line for line in lines)
+    assert uart2_sent(record)[-1] == STOP_FRAME
+
+
+def test_the_panel_fits_80_columns_with_both_ports() -> None:
+    url = "sim://?share=panel&drive=mecanum"
+    session = ControlSession(url + "&port=uart2", HoldToDrive(latched=True), app_url=url)
+    try:
+        session.start()
+        end = time.monotonic() + 1.5
+        while time.monotonic() < end:
+            if session.drive is not None and session.in_force == "stop":
+                session.press("front-right")
+            session.tick()
+            time.sleep(0.02)
+        lines = "".join(part[1] for part in status_fragments(session)).splitlines()
+        help_lines = session.help_lines()
+    finally:
+        session.close()
+    for line in lines + help_lines:
+        assert sum(get_cwidth(ch) for ch in line) <= WIDTH, line
+    assert len(lines) + 1 + 3 <= 24, lines  # + the rule and three message lines
+    text = "\n".join(lines)
+    assert "drive mecanum" in text and "in force  front-right" in text, text
+    assert re.search(r"wheels\s+A 600/\d+  B 0/\d+  C 600/\d+  D 0/\d+", text), text
+
+
+def test_the_app_console_says_when_its_letters_are_not_followed() -> None:
+    state = HostState()
+    state.sent(b"A", 0.0)
+    still = b"{A0:0:0:0}$"  # the car stands still
+    assert not state.feed(still, 0.5)[1:]
+    warning = state.feed(still, 1.1)[-1]
+    assert state.letters_ignored
+    assert isinstance(warning, BoardWarning) and "UART2" in warning.text
+    assert not state.feed(still, 1.2)[1:]  # said once
+
+
+def test_the_console_over_uart2_in_tmux_leaves_the_stop_frame_last(tmp_path: Path) -> None:
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet", "--drive", "mecanum") as board:
+        command = f"cd {ROOT} && exec {sys.executable} -m appmode drive {board.uart2} --uart2"
+        tmux("new-session", "-d", "-s", SESSION, "-x", "100", "-y", "30", command)
+        try:
+            wait_screen(r"REAL BOARD")
+            wait_screen(r"settings\s+max_speed 500")
+            wait_screen(r"wheels\s+A 0/0")  # the encoder report is on
+            pressed = time.monotonic()
+            while time.monotonic() - pressed < 1.0:  # held: keys repeat every 30 ms
+                tmux("send-keys", "-t", SESSION, "Up")
+                time.sleep(0.03)
+            actual = wait_screen(r"wheels\s+A 300/(\d+)")
+            assert int(actual.group(1)) > 200, screen()
+            wait_screen(r"in force\s+stopped", timeout=2)  # released: the zero frame
+            tmux("send-keys", "-t", SESSION, "-l", "r")
+            wait_screen(r"rotated 90° in", timeout=8)
+            tmux("send-keys", "-t", SESSION, ":")
+            tmux("send-keys", "-t", SESSION, "set max_speed 800", "Enter")
+            wait_screen(r"set max_speed = 800 \(verified\)")
+            tmux("send-keys", "-t", SESSION, "-l", "w")  # hold again, then close the terminal
+            pid = int(tmux("display-message", "-p", "-t", SESSION, "#{pane_pid}").strip())
+        finally:
+            tmux("kill-session", "-t", SESSION)  # a closed terminal: SIGHUP
+        wait_for(lambda: not Path(f"/proc/{pid}").exists())
+        assert not _alive()
+    sent = uart2_sent(record)
+    assert "FF FE 01 00 00 01 2C 00 00 00" in sent and sent[-1] == STOP_FRAME, sent[-4:]
