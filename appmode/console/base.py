@@ -12,7 +12,7 @@ from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
@@ -20,6 +20,10 @@ from appmode.host.tokens import Wait, parse_token
 from appmode.ports.link import is_simulated
 from appmode.ports.sim import sim_directives
 from appmode.protocol.transcript import Recorder
+
+if TYPE_CHECKING:
+    from appmode.host.client import Host
+    from appmode.host.control_client import ControlHost
 
 SPEED_STEP = 100
 LOG = 500
@@ -88,14 +92,24 @@ class BaseSession(ABC):
         self.messages: deque[str] = deque(maxlen=LOG)
         self.on_message = on_message
         self.recorder: Recorder | None = None
-        self.completions: dict[str, object] = {}
+        self.completions: dict[str, object] = {
+            "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None}
+        }
         """What the command line completes after a command's name."""
 
     # ------------------------------------------------------------ what a session is
 
-    @abstractmethod
+    host: Host | ControlHost
+    """The host that drives (its clock is the session's)."""
+
     def now(self) -> float:
         """Seconds since the session started."""
+        return self.host.now()
+
+    @property
+    def busy(self) -> bool:
+        """A read or set is under way (script mode waits for it)."""
+        return self.host.state.query is not None
 
     @abstractmethod
     def start(self) -> None:
@@ -120,11 +134,6 @@ class BaseSession(ABC):
     @abstractmethod
     def stop(self) -> None:
         """Stop the car now."""
-
-    @property
-    @abstractmethod
-    def busy(self) -> bool:
-        """A read or set is under way (script mode waits for it)."""
 
     @abstractmethod
     def unsaved_warning(self) -> str | None:

@@ -79,6 +79,7 @@ def velocity_for(motion: Motion, speed: int, drive: DriveType) -> dict[str, int]
 class ControlSession(BaseSession):
     """A session on the control port, with the APP port of the same board if given."""
 
+    host: ControlHost
     commands = COMMANDS
     keys_help = KEYS_HELP
     keys: ClassVar[dict[str, str]] = {
@@ -123,20 +124,12 @@ class ControlSession(BaseSession):
         """system_mode before this session turned the encoder report on."""
         self.baseline: dict[str, int] | None = None
         """The settings as first read, or as last saved: what a quit would keep."""
-        self.completions = {
+        self.completions |= {
             "set": dict.fromkeys(SETTING_NAMES),
             "read": dict.fromkeys(settings.READ_BY_NAME),
             "drive": dict.fromkeys(MOTIONS),
-            "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None},
         }
         self._open_recording(record)
-
-    def now(self) -> float:
-        return self.host.now()
-
-    @property
-    def busy(self) -> bool:
-        return self.host.state.query is not None
 
     @property
     def drive(self) -> DriveType | None:

@@ -52,6 +52,7 @@ KEYS_HELP = (
 class Session(BaseSession):
     """A session on the APP port: pages, letters and the nine parameters."""
 
+    host: Host
     commands = COMMANDS
     keys_help = KEYS_HELP
     keys: ClassVar[dict[str, str]] = {
@@ -82,19 +83,11 @@ class Session(BaseSession):
         self._sent = HostDecoder()
         self.baseline: tuple[int, ...] | None = None
         """The parameters as first read, or as last sent to flash: what a quit would keep."""
-        self.completions = {
+        self.completions |= {
             "set": {p.name: None for p in params.PARAMS},
             "page": dict.fromkeys(PAGE_WORDS),
-            "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None},
         }
         self._open_recording(record)
-
-    def now(self) -> float:
-        return self.host.now()
-
-    @property
-    def busy(self) -> bool:
-        return self.host.state.query is not None
 
     # ------------------------------------------------------------ life cycle
 
