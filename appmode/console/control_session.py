@@ -320,7 +320,11 @@ class ControlSession(BaseSession):
         if self.baseline is None:
             return None
         now = self._comparable(self.host.state.values)
-        changed = [name for name in SETTING_NAMES if now.get(name) != self.baseline.get(name)]
+        changed = [
+            f"{name} {self.baseline[name]} → {now[name]}"
+            for name in SETTING_NAMES
+            if name in now and name in self.baseline and now[name] != self.baseline[name]
+        ]
         return f"not saved: {', '.join(changed)}" if changed else None
 
     @staticmethod

@@ -45,10 +45,9 @@ def _app_body(session: Session, waveforms: bool) -> Fragments:
     out.append(("reverse bold" if moving else "", f" {session.in_force_text} "))
     out.append(("", f"   {hold_mode(session.driving)}\n"))
     if state.letters_ignored:
-        out.append(
-            ("reverse bold fg:ansiyellow", " control  the car does not follow the letters: ")
-        )
-        out.append(("", " UART2 may have taken over (§8.3)\n"))
+        out.append(("bold", " control  "))
+        out.append(("reverse bold fg:ansiyellow", " the car does not follow the letters "))
+        out.append(("", "  UART2 may have taken over (§8.3)\n"))
 
     out.append(("bold", " params   "))
     record = state.params

@@ -58,7 +58,7 @@ def test_script_mode_drives_turns_and_sets_over_the_embedded_control_port(tmp_pa
     assert re.search(r"rotated 30° in \d\.\d\d s", out)
     assert "error: max_speed" in out  # out of range: one message, nothing sent
     assert "error: unknown command 'fly'" in out
-    assert "not saved: max_speed" in done.stderr
+    assert "not saved: max_speed 500 → 800" in done.stderr
     sent = uart2_sent(record)
     assert "FF FE 01 00 00 01 2C 00 00 00" in sent  # forward at 300
     assert sent[-2:] == ["FF FE 80 80 09 00 00 00 00 00", STOP_FRAME]  # report off, stop
@@ -140,3 +140,13 @@ def test_the_console_over_uart2_in_tmux_leaves_the_stop_frame_last(tmp_path: Pat
         assert not _alive()
     sent = uart2_sent(record)
     assert "FF FE 01 00 00 01 2C 00 00 00" in sent and sent[-1] == STOP_FRAME, sent[-4:]
+
+
+def test_the_app_console_shows_a_take_over_by_another_program() -> None:
+    with board_process("--pty", "--quiet") as board:
+        taken = run("send", board.uart2, "--uart2", "--no-report", "stop")
+        assert taken.returncode == 0, taken.stderr
+        done = run("drive", board.url, stdin=b"drive A\nwait 1.6\nstatus\nquit\n")
+    assert done.returncode == 0, done.stderr
+    assert "WARNING: the car stands still" in done.stdout
+    assert re.search(r"control\s+the car does not follow the letters\s+UART2", done.stdout)
