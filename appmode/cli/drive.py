@@ -6,6 +6,8 @@ import argparse
 import os
 import sys
 
+from serial import SerialException
+
 from appmode.cli.options import (
     Subparsers,
     add_profile,
@@ -18,6 +20,7 @@ from appmode.cli.options import (
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from appmode.errors import AppmodeError
 from appmode.ports.link import is_simulated
+from appmode.ports.sim import parse_sim_url
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 
 
@@ -116,8 +119,7 @@ def run(args: argparse.Namespace) -> int:
     if uart2_url is not None:
         app_url, url = url, _with_profile(uart2_url, args.profile)
         if is_simulated(app_url) and is_simulated(url):
-            app_url = _shared(app_url)  # a bare sim:// is the same board's other port:
-            url = _shared(url) if "?" in url else app_url + "&port=uart2"
+            app_url, url = _one_board(app_url, url)
     session = ControlSession(
         url,
         driving,
@@ -138,11 +140,24 @@ def _with_profile(url: str, profile: str | None) -> str:
     return url
 
 
-def _shared(url: str) -> str:
-    """A sim:// URL that names its board, so that both ports open one board."""
-    if "share=" in url.lower():
-        return url
-    return url + f"{'&' if '?' in url else '?'}share=drive-{os.getpid()}"
+def _one_board(app_url: str, uart2_url: str) -> tuple[str, str]:
+    """Two sim:// URLs as the two ports of one simulated board (its options given on
+    the first, or the same on both)."""
+    try:
+        app_options, uart2_options = (
+            {k: v for k, v in parse_sim_url(u).items() if k not in ("port", "share")}
+            for u in (app_url, uart2_url)
+        )
+    except SerialException:
+        return app_url, uart2_url  # opening them says what is wrong
+    if uart2_options and uart2_options != app_options:
+        raise AppmodeError(
+            f"{app_url} and {uart2_url} are one simulated board: give its options once, on "
+            f"the first URL (appmode drive '{uart2_url}' sim://)"
+        )
+    if "share=" not in app_url.lower():
+        app_url += f"{'&' if '?' in app_url else '?'}share=drive-{os.getpid()}"
+    return app_url, app_url + "&port=uart2"
 
 
 def _print_message(text: str) -> None:
