@@ -26,6 +26,8 @@ if TYPE_CHECKING:
     from appmode.host.control_client import ControlHost
 
 SPEED_STEP = 100
+SPEED_KEYS = {"+": f"speed +{SPEED_STEP}", "=": f"speed +{SPEED_STEP}", "-": f"speed -{SPEED_STEP}"}
+"""The keys that change the speed, as command lines."""
 LOG = 500
 """Messages kept for scrolling back."""
 QUIT_WORDS = ("quit", "exit", "q")

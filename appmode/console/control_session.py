@@ -13,7 +13,7 @@ from collections.abc import Callable
 from functools import partial
 from typing import ClassVar
 
-from appmode.console.base import SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.console.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
 from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
@@ -86,9 +86,7 @@ class ControlSession(BaseSession):
         "r": "rotate",
         "R": "rotate -",
         "p": "settings",
-        "+": f"speed +{SPEED_STEP}",
-        "=": f"speed +{SPEED_STEP}",
-        "-": f"speed -{SPEED_STEP}",
+        **SPEED_KEYS,
     }
     hold_keys: ClassVar[dict[str, str]] = {",": "rotate-ccw", ".": "rotate-cw"}
 

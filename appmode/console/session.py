@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import ClassVar
 
-from appmode.console.base import SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.console.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
 from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
@@ -60,9 +60,7 @@ class Session(BaseSession):
         "j": "page joystick",
         "k": "page button",
         "p": "params",
-        "+": f"speed +{SPEED_STEP}",
-        "=": f"speed +{SPEED_STEP}",
-        "-": f"speed -{SPEED_STEP}",
+        **SPEED_KEYS,
     }
     aliases: ClassVar[dict[str, str]] = {"read": "params"}
     waveforms = True
