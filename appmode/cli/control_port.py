@@ -6,11 +6,10 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Iterable
-from contextlib import ExitStack, suppress
+from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.cli.hostio import with_recording
-from appmode.errors import AppmodeError
 from appmode.host.control_client import ControlHost, Event
 from appmode.host.control_tokens import Step, parse_setting, parse_token, perform
 from appmode.host.state import LinkStatus
@@ -111,20 +110,19 @@ def run_send(
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         report_bit = params.MODE_BIT["encoder_report"]
         mode = host.read("system_mode") if report else report_bit
-        with ExitStack() as session:
-            if not mode & report_bit:  # on for the session, then as it was (before the stop)
-                host.send_frame(_set("system_mode", mode | report_bit))
-                session.callback(_restore, host, _set("system_mode", mode))
-            for step in steps:
-                if isinstance(step, Wait):
-                    _drain(host.events(step.seconds))
-                elif isinstance(step, Step) and step.kind == "rotate":
-                    host.start_rotation(step.values[0] / 10)
-                    host.wait_rotation()
-                else:
-                    perform(host, step)
-                _drain(host.poll(0))
-            _drain(host.events(listen))
+        if not mode & report_bit:  # on for the session, then as it was (before the stop)
+            host.send_frame(control.setting("system_mode", mode | report_bit))
+            host.put_back_on_close("system_mode", mode)
+        for step in steps:
+            if isinstance(step, Wait):
+                _drain(host.events(step.seconds))
+            elif isinstance(step, Step) and step.kind == "rotate":
+                host.start_rotation(step.values[0] / 10)
+                host.wait_rotation()
+            else:
+                perform(host, step)
+            _drain(host.poll(0))
+        _drain(host.events(listen))
         if host.close() is None:
             print("appmode: the link is down: the final stop frame was not sent", file=sys.stderr)
             return 1
@@ -135,16 +133,6 @@ def _drain(events: Iterable[Event]) -> None:
     """Read on (the session is printed as it is decoded: `host.watch`)."""
     for _ in events:
         pass
-
-
-def _restore(host: ControlHost, frame: control.SetSetting) -> None:
-    """Put a setting back as the session ends, if the link still lets it."""
-    with suppress(AppmodeError):
-        host.send_frame(frame)
-
-
-def _set(name: str, value: int) -> control.SetSetting:
-    return control.SetSetting(settings.BY_NAME[name], value)
 
 
 # ---------------------------------------------------------------- monitor --uart2

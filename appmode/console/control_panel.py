@@ -16,6 +16,7 @@ from appmode.console.panel_parts import (
     telemetry,
 )
 from appmode.protocol import settings
+from appmode.protocol.control_view import describe
 from appmode.protocol.directions import STOP_LETTER
 
 SILENT_HINT = (
@@ -43,10 +44,12 @@ def control_body(session: ControlSession) -> Fragments:
         left = state.values.get("pending_angle")
         to_go = "" if left is None else f", {left / 10:g}° to go"
         out.append(("reverse bold", f" turning {session.rotation[1]:g}°{to_go} "))
-    elif session.in_force == STOP:
-        out.append(("", " stopped"))
-    else:
+    elif session.in_force != STOP:
         out.append(("reverse bold", f" {session.in_force} "))
+    elif state.in_force is not None:
+        out.append(("reverse bold", f" {describe(state.in_force)} "))
+    else:
+        out.append(("", " stopped"))
     out.append(
         ("", f"   speed {session.speed} · r/R {session.angle:g}° · {hold_mode(session.driving)}\n")
     )

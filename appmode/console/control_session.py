@@ -8,7 +8,6 @@ with `tick()`. Closing sends the zero velocity frame last on UART2.
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable
 from functools import partial
 from typing import ClassVar
@@ -114,12 +113,11 @@ class ControlSession(BaseSession):
         self.speed = DEFAULT_SPEED
         self.angle = DEFAULT_ANGLE
         self.in_force = STOP
-        """The motion a key or command is driving, or `stop`."""
+        """The motion a key or `drive` is driving, or `stop` (frames sent otherwise show
+        as the host's frame in force)."""
         self.rotation: tuple[float, float] | None = None
         """A turn under way: (when it started, degrees)."""
         self._next_angle_read = 0.0
-        self._report_restore: int | None = None
-        """system_mode before this session turned the encoder report on."""
         self.baseline: dict[str, int] | None = None
         """The settings as first read, or as last saved: what a quit would keep."""
         self.completions |= {
@@ -142,12 +140,9 @@ class ControlSession(BaseSession):
         self._query(ReadQuery(SETTING_NAMES, None, self.host.timeout, self.host.tries, self.url))
 
     def close(self) -> None:
-        """The encoder report as it was, `Z` on the APP port, and the zero velocity
-        frame last on UART2; then the recording."""
+        """`Z` on the APP port, then on UART2 the encoder report as it was and the zero
+        velocity frame last; then the recording."""
         try:
-            if self._report_restore is not None and self.host.connected:
-                with contextlib.suppress(AppmodeError):
-                    self.host.send_frame(_set("system_mode", self._report_restore))
             if self.app is not None:
                 self.app.close()
         finally:
@@ -198,7 +193,7 @@ class ControlSession(BaseSession):
         """Turn the encoder report on for the session (put back when it closes)."""
         if mode & REPORT_BIT:
             return
-        self._report_restore = mode
+        self.host.put_back_on_close("system_mode", mode)
         self.say("turning the encoder report on for this session (system_mode bit 6)")
         self._query(self._new(change=("system_mode", mode | REPORT_BIT)), quiet=True)
 
@@ -394,12 +389,7 @@ class ControlSession(BaseSession):
     def _velocity(self, args: list[str]) -> None:
         if not args:
             raise AppmodeError("usage: velocity X Y Z (diff-gyro: velocity LEFT RIGHT)")
-        step = parse_token("velocity:" + ",".join(args))
-        assert not isinstance(step, Wait)
-        self.driving.stop()
-        if self._send(lambda: perform(self.host, step)):
-            self.in_force = "velocity " + " ".join(args)
-            self.rotation = None
+        self._send_tokens(["velocity:" + ",".join(args)])
 
     def _send_tokens(self, tokens: list[str]) -> None:
         if not tokens:
@@ -407,16 +397,12 @@ class ControlSession(BaseSession):
         steps = [parse_token(token) for token in tokens]
         if any(isinstance(step, Wait) for step in steps):
             raise AppmodeError("send takes no waits here: use the wait command")
-        self.driving.stop()
+        self._forget_motion()  # what the frames do shows as the frame in force
         for step in steps:
             assert not isinstance(step, Wait)
             if not self._send(partial(perform, self.host, step)):
                 return
         self.say(f"sent {' '.join(tokens)}")
-
-
-def _set(name: str, value: int) -> control.SetSetting:
-    return control.SetSetting(settings.BY_NAME[name], value)
 
 
 def _degrees(args: list[str], usage: str) -> float:

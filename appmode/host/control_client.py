@@ -82,6 +82,7 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
         self.tries = tries
         self.state = ControlState(drive, takeover_byte)
         self._held: list[Event] = []
+        self._put_back: control.SetSetting | None = None
         self.watch: Callable[[str, reader.Event | LinkStatus], None] | None = None
         """Called with each frame sent (`2>`) and each event received (`2<`) as it is
         decoded: a session printing as it goes."""
@@ -299,5 +300,13 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
             return b"{}Z" if sent.buffered else b"Z"
         return sent.rest() + control.STOP
 
+    def put_back_on_close(self, name: str, value: int) -> None:
+        """Set `name` back to `value` when the session closes, just before its stop
+        (a setting changed for the session only: the encoder report)."""
+        self._put_back = control.setting(name, value)
+
     def _stop(self) -> bytes:
-        return self.stop_bytes
+        if self._put_back is None or self.state.app_mode:
+            return self.stop_bytes
+        sent = self.state.sent_decoder
+        return sent.rest() + control.encode(self._put_back) + control.STOP

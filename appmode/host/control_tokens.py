@@ -131,7 +131,7 @@ def perform(host: ControlHost, step: Step | bytes) -> None:
     elif kind == "read":
         host.send_frame(control.read(step.name))
     elif kind == "set":
-        host.send_frame(control.SetSetting(settings.BY_NAME[step.name], values[0]))
+        host.send_frame(control.setting(step.name, values[0]))
     elif kind == "rotate":
         host.start_rotation(values[0] / 10)
     elif kind == "stop":

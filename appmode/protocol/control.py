@@ -276,6 +276,12 @@ def _settings_frame(ss: int, value: int) -> bytes:
     return HEADER + bytes([SETTINGS, 0x80, ss]) + value.to_bytes(4, "big") + b"\0"
 
 
+def setting(name: str, value: int) -> SetSetting:
+    """The frame that sets a setting by name (settings.lookup); the caller checks the
+    value's range."""
+    return SetSetting(settings.lookup(name), value)
+
+
 def read(name: str) -> ReadFrame:
     """The read frame of a setting or value by name (settings.read_named)."""
     return ReadFrame(settings.read_named(name))

@@ -150,3 +150,10 @@ def test_the_app_console_shows_a_take_over_by_another_program() -> None:
     assert done.returncode == 0, done.stderr
     assert "WARNING: the car stands still" in done.stdout
     assert re.search(r"control\s+the car does not follow the letters\s+UART2", done.stdout)
+
+
+def test_frames_sent_by_command_show_as_the_frame_in_force() -> None:
+    done = run("drive", "--uart2", stdin=b"send velocity:0,300,0\nstatus\nstop\nstatus\n")
+    assert done.returncode == 0, done.stderr
+    forces = re.findall(r"in force\s+(\w[\w ]*?)\s{2,}", done.stdout)
+    assert forces == ["velocity 0 300 0", "stopped"], done.stdout
