@@ -8,7 +8,7 @@ with `tick()`. Closing sends the zero velocity frame last on UART2.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import partial
 from typing import ClassVar
 
@@ -17,7 +17,7 @@ from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.control_client import ControlHost
-from appmode.host.control_query import ROTATE_POLL, ReadDone, ReadQuery, rotation_done
+from appmode.host.control_query import ROTATE_POLL, ReadDone, rotation_done
 from appmode.host.control_state import TAKEOVER_BYTE
 from appmode.host.control_tokens import parse_token, perform
 from appmode.host.link import LinkLost
@@ -137,7 +137,7 @@ class ControlSession(BaseSession):
         """Take the motion over with the zero velocity frame, then read the settings
         (the encoder report is turned on for the session once system_mode is known)."""
         self._send(lambda: self.host.stop())
-        self._query(ReadQuery(SETTING_NAMES, None, self.host.timeout, self.host.tries, self.url))
+        self._query(SETTING_NAMES)
 
     def close(self) -> None:
         """`Z` on the APP port, then on UART2 the encoder report as it was and the zero
@@ -195,13 +195,13 @@ class ControlSession(BaseSession):
             return
         self.host.put_back_on_close("system_mode", mode)
         self.say("turning the encoder report on for this session (system_mode bit 6)")
-        self._query(self._new(change=("system_mode", mode | REPORT_BIT)), quiet=True)
+        self._query(change=("system_mode", mode | REPORT_BIT), quiet=True)
 
     def _follow_rotation(self) -> None:
         if self.rotation is None or self.busy or self.now() < self._next_angle_read:
             return
         self._next_angle_read = self.now() + ROTATE_POLL
-        self._query(self._new(["pending_angle"]), quiet=True)
+        self._query(["pending_angle"], quiet=True)
 
     def _rotation_read(self, left: int) -> None:
         assert self.rotation is not None
@@ -239,7 +239,7 @@ class ControlSession(BaseSession):
             self.driving.stop()
             self.say("the drive type is not known yet: reading system_mode (or use --drive-type)")
             if not self.busy:
-                self._query(self._new(["system_mode"]))
+                self._query(["system_mode"])
             return
         fields = velocity_for(MOTIONS[name], self.speed, drive)
         if self._send(lambda: self.host.velocity(**fields)):
@@ -281,20 +281,21 @@ class ControlSession(BaseSession):
 
     # ------------------------------------------------------------ settings
 
-    def _new(
-        self, names: tuple[str, ...] | list[str] = (), change: tuple[str, int] | None = None
-    ) -> ReadQuery:
-        return ReadQuery(names, change, self.host.timeout, self.host.tries, self.url)
-
-    def _query(self, query: ReadQuery, quiet: bool = False) -> None:
+    def _query(
+        self,
+        names: Iterable[str] = (),
+        change: tuple[str, int] | None = None,
+        quiet: bool = False,
+    ) -> None:
+        """Start a read or a verified set (`ControlHost.new_query`) unless one runs."""
         if self.busy:
             if not quiet:
                 self.say("busy: a read or set is in progress")
             return
-        self.host.start_query(query)
+        self.host.start_query(self.host.new_query(names, change))
 
     def set_setting(self, name: str, value: int) -> None:
-        self._query(self._new(change=(settings.lookup(name).name, value)))
+        self._query(change=(name, value))
 
     def store(self, op: str) -> None:
         if not self._send(lambda: self.host.store(op)):
@@ -307,7 +308,7 @@ class ControlSession(BaseSession):
             self.say(f"sent save: {meaning} (the board sends no reply)")
         else:
             self.say(f"sent {op}: {meaning}; reading the settings")
-            self._query(self._new(SETTING_NAMES), quiet=True)
+            self._query(SETTING_NAMES, quiet=True)
 
     def unsaved_warning(self) -> str | None:
         if self.baseline is None:
@@ -332,11 +333,11 @@ class ControlSession(BaseSession):
 
     def _dispatch(self, name: str, args: list[str]) -> Step:
         if name == "settings":
-            self._query(self._new(SETTING_NAMES))
+            self._query(SETTING_NAMES)
         elif name == "read":
             if not args:
                 raise AppmodeError("usage: read NAME..., e.g. read max_speed pending_angle")
-            self._query(self._new(args))
+            self._query(args)
         elif name == "set":
             value = params.whole(args[1]) if len(args) == 2 else None
             if value is None:

@@ -168,7 +168,7 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
         """Read values by name (settings, `pending_angle`, `speed_a`…, `position_a`…),
         each reported only when its replies agree (control_query); AppmodeError after
         `tries` rounds."""
-        return self.query(self._query(names, None))
+        return self.query(self.new_query(names, None))
 
     def read(self, name: str) -> int:
         return self.read_values([name])[settings.read_named(name).name]
@@ -212,10 +212,10 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
     def set(self, name: str, value: int) -> int:
         """Set a setting and verify it by reading back (the set is sent again while the
         board shows another value); returns the value read."""
-        query = self._query((), (name, value))
+        query = self.new_query((), (name, value))
         return self.query(query)[query.names[0]]
 
-    def _query(self, names: Iterable[str], change: tuple[str, int] | None) -> ReadQuery:
+    def new_query(self, names: Iterable[str], change: tuple[str, int] | None) -> ReadQuery:
         """A read or set with this host's timeout and tries; AppmodeError for an
         unknown name or a value out of range."""
         try:
