@@ -19,7 +19,7 @@ def test_api_examples_run() -> None:
 def test_protocol_reference_is_in_the_repository() -> None:
     texts = [ROOT / "README.md", *ROOT.joinpath("docs").glob("*.md")]
     package = ROOT / "appmode"
-    texts += [*package.rglob("*.py"), *package.rglob("*.transcript")]
+    texts += [*package.rglob("*.py"), *ROOT.joinpath("transcripts").rglob("*.transcript")]
     for path in texts:
         text = path.read_text(encoding="utf-8")
         assert "shared/" not in text, f"{path} points outside the repository"

@@ -182,7 +182,15 @@ def run_live(
     return _result(transcript, check, now, time.perf_counter() - started)
 
 
-SUITE = Path(__file__).with_name("suite")
+def _suite() -> Path:
+    """The conformance suite: `appmode/suite` in an installed wheel (the build maps the
+    repository's `transcripts/suite` there), else `transcripts/suite` of a checkout."""
+    package = Path(__file__).parents[1]
+    installed = package / "suite"
+    return installed if installed.is_dir() else package.parent / "transcripts" / "suite"
+
+
+SUITE = _suite()
 """The conformance suite shipped with appmode: `appmode conform` with no path runs it."""
 
 

@@ -14,7 +14,7 @@ from appmode.protocol.transcript import read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, BoardProcess, board_process, run
 
-MINIBALANCE_SUITE = sorted((ROOT / "appmode" / "transcript" / "suite" / "minibalance").glob("*"))
+MINIBALANCE_SUITE = sorted((ROOT / "transcripts" / "suite" / "minibalance").glob("*"))
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +34,7 @@ def test_s13_suite_passes_on_virtual_time(path: Path) -> None:
     ["s13_set_value_arithmetic", "s13_telemetry_period", "s13_frame_stops_the_car"],
 )
 def test_s13_suite_passes_in_real_time_over_a_pty(board: BoardProcess, name: str) -> None:
-    path = ROOT / "appmode" / "transcript" / "suite" / "minibalance" / f"{name}.transcript"
+    path = ROOT / "transcripts" / "suite" / "minibalance" / f"{name}.transcript"
     result = run_live(read_transcript(path), board.url)
     assert result.passed, result.failure
 

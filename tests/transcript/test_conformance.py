@@ -13,7 +13,7 @@ from appmode.protocol.transcript import parse_transcript, read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, board_process, board_state, run
 
-SUITE_DIR = ROOT / "appmode" / "transcript" / "suite"
+SUITE_DIR = ROOT / "transcripts" / "suite"
 SUITE = sorted([*SUITE_DIR.glob("*.transcript"), *SUITE_DIR.glob("uart2/*.transcript")])
 """The sheet profile's transcripts: the APP port's, and UART2's."""
 
@@ -40,7 +40,7 @@ def test_suite_passes_against_the_simulated_board(path: Path) -> None:
 
 
 def test_whole_suite_runs_in_well_under_a_second() -> None:
-    done = run("conform", "appmode/transcript/suite")
+    done = run("conform", "transcripts/suite")
     assert done.returncode == 0, done.stdout
     assert done.stdout.count("PASS") == len(SUITE)
     walls = [float(m) for m in re.findall(r"virtual time in ([\d.]+) s", done.stdout)]
@@ -162,7 +162,7 @@ def test_recorded_console_session_conforms_and_an_edit_fails(tmp_path: Path) -> 
 
 def test_junit_report(tmp_path: Path) -> None:
     report = tmp_path / "junit.xml"
-    run("conform", "appmode/transcript/suite/s2_2_read_params.transcript", "--junit", str(report))
+    run("conform", "transcripts/suite/s2_2_read_params.transcript", "--junit", str(report))
     suite = ET.parse(report).getroot()
     assert suite.get("tests") == "1" and suite.get("failures") == "0"
 
@@ -184,7 +184,7 @@ def test_the_suite_passes_in_real_time_against_a_board_process() -> None:
             "--board2",
             board.uart2,
             "--yes",
-            "appmode/transcript/suite",
+            "transcripts/suite",
             timeout=500,
         )
         assert done.returncode == 0, done.stdout
@@ -202,5 +202,5 @@ def test_a_real_board_is_driven_only_when_the_user_agrees() -> None:
         refused = run("conform", "--board", board.url, timeout=30)
     assert refused.returncode == 2 and "PASS" not in refused.stdout
     assert "the car moves" in refused.stderr and "Add --yes" in refused.stderr
-    simulated = run("conform", "--board", "sim://", "appmode/transcript/suite/s5_save.transcript")
+    simulated = run("conform", "--board", "sim://", "transcripts/suite/s5_save.transcript")
     assert simulated.returncode == 0, simulated.stderr

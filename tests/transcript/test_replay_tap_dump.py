@@ -215,7 +215,7 @@ def test_plot_without_records_is_a_clear_error(tmp_path: Path) -> None:
 
 
 def test_read_transcript_of_the_suite_is_consistent() -> None:
-    for path in (ROOT / "appmode" / "transcript" / "suite").glob("*.transcript"):
+    for path in (ROOT / "transcripts" / "suite").glob("*.transcript"):
         assert read_transcript(path).entries
 
 

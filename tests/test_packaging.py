@@ -1,0 +1,72 @@
+"""What `pip install .` puts on a machine: the wheel ships the conformance suite (kept in
+the repository's transcripts/suite, mapped into the package at build time) and the pytest
+plugin's entry point, and an installed `appmode conform` runs that suite."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from tests.support.processes import ROOT
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("wheel")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(out), str(ROOT)],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    (found,) = out.glob("appmode-*.whl")
+    return found
+
+
+def test_the_wheel_ships_the_suite_from_transcripts(wheel: Path) -> None:
+    names = set(zipfile.ZipFile(wheel).namelist())
+    suite = sorted(
+        p.relative_to(ROOT / "transcripts").as_posix()
+        for p in (ROOT / "transcripts" / "suite").rglob("*.transcript")
+    )
+    assert len(suite) > 40
+    assert {f"appmode/{name}" for name in suite} <= names
+    assert not [n for n in names if n.startswith(("transcripts/", "tests/", "examples/"))]
+    entry_points = next(n for n in names if n.endswith(".dist-info/entry_points.txt"))
+    text = zipfile.ZipFile(wheel).read(entry_points).decode()
+    assert "[pytest11]\nappmode = appmode.testing.plugin" in text
+
+
+def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(site), wheel],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from appmode.cli.main import main; sys.exit(main())",
+            "conform",
+        ],
+        cwd=elsewhere,
+        env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"},
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert f"the shipped suite: {site / 'appmode' / 'suite'}" in done.stdout
+    sheet = len(list((ROOT / "transcripts" / "suite").glob("*.transcript")))
+    sheet += len(list((ROOT / "transcripts" / "suite" / "uart2").glob("*.transcript")))
+    assert f"{sheet} passed, 0 failed" in done.stdout
