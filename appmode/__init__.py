@@ -7,25 +7,72 @@ The public API (docs/api.md):
 - `Host`: the host side over any URL; `ControlHost`: the same over the control port;
 - `open_link`: open a board by URL (importing appmode registers `sim://` with pyserial,
   so `serial.serial_for_url("sim://")` opens the simulated board in any program);
-- `read_transcript`, `parse_transcript` and `Recorder`: the transcript reader and writer.
+- `read_transcript`, `parse_transcript` and `Recorder`: the transcript reader and writer;
+- `AppmodeError` (what went wrong, where, how to fix it) and its `TranscriptError`.
+
+Each name is imported when first used, so `import appmode` (and the pytest plugin that
+pytest loads wherever appmode is installed) costs only pyserial's import.
 """
 
-from appmode.board.firmware import Board
-from appmode.host.client import Host
-from appmode.host.control_client import ControlHost
-from appmode.ports.link import open_link
-from appmode.protocol.app import BoardDecoder, HostDecoder, encode
-from appmode.protocol.transcript import Recorder, parse_transcript, read_transcript
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+import serial
+
+from appmode.errors import AppmodeError
+
+if "appmode.ports" not in serial.protocol_handler_packages:
+    serial.protocol_handler_packages.append("appmode.ports")  # sim:// (ports/protocol_sim.py)
+
+if TYPE_CHECKING:
+    from appmode.board.firmware import Board
+    from appmode.host.client import Host
+    from appmode.host.control_client import ControlHost
+    from appmode.ports.link import open_link
+    from appmode.protocol.app import BoardDecoder, HostDecoder, encode
+    from appmode.protocol.transcript import (
+        Recorder,
+        TranscriptError,
+        parse_transcript,
+        read_transcript,
+    )
 
 __version__ = "0.1.0"
 
+_WHERE = {
+    "Board": "appmode.board.firmware",
+    "Host": "appmode.host.client",
+    "ControlHost": "appmode.host.control_client",
+    "open_link": "appmode.ports.link",
+    "BoardDecoder": "appmode.protocol.app",
+    "HostDecoder": "appmode.protocol.app",
+    "encode": "appmode.protocol.app",
+    "Recorder": "appmode.protocol.transcript",
+    "TranscriptError": "appmode.protocol.transcript",
+    "parse_transcript": "appmode.protocol.transcript",
+    "read_transcript": "appmode.protocol.transcript",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module 'appmode' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name]), name)
+    globals()[name] = value
+    return value
+
+
 __all__ = [
+    "AppmodeError",
     "Board",
     "BoardDecoder",
     "ControlHost",
     "Host",
     "HostDecoder",
     "Recorder",
+    "TranscriptError",
     "__version__",
     "encode",
     "open_link",

@@ -8,10 +8,11 @@ saved: a file written before it existed holds nine.
 
 from __future__ import annotations
 
-import fcntl
+import contextlib
 import json
 import os
 import stat
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Protocol
@@ -26,6 +27,24 @@ GYRO_CALIBRATION = "gyro_calibration"
 """The key of the tenth setting, beside `params`."""
 MAX_SIZE = 64 * 1024
 """Bytes read at most: a flash file is a few hundred."""
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none (and no fork to leak into)
+
+
+def _try_lock(fd: int) -> bool:
+    """Lock the open file `fd` for this process without waiting; False when another
+    process holds it. The lock goes with the process: a killed board leaves none."""
+    try:
+        if sys.platform == "win32":
+            import msvcrt
+
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+        else:
+            import fcntl
+
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        return False
+    return True
 
 
 class Store(Protocol):
@@ -88,17 +107,19 @@ class JsonFileStore:
             )
         while True:
             try:
-                fd = os.open(self._lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+                fd = os.open(self._lock_path, os.O_RDWR | os.O_CREAT | _CLOEXEC, 0o666)
             except OSError as exc:
                 raise AppmodeError(
                     f"cannot use flash file {self.path}: cannot create its lock "
                     f"{self._lock_path}: {exc.strerror}"
                 ) from None
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                holder = os.read(fd, 32).decode(errors="replace").strip() or "another process"
+            if not _try_lock(fd):
+                try:
+                    holder = os.read(fd, 32).decode(errors="replace").strip()
+                except OSError:  # Windows: the holder's lock keeps others from reading
+                    holder = ""
                 os.close(fd)
+                holder = holder or "another process"
                 raise AppmodeError(
                     f"flash file {self.path} is in use by another board (pid {holder}): give "
                     f"each board its own --flash file, or stop the other one"
@@ -113,9 +134,13 @@ class JsonFileStore:
 
     def close(self) -> None:
         if self._lock is not None:
-            self._lock_path.unlink(missing_ok=True)
+            with contextlib.suppress(OSError):  # Windows: not while open (removed below)
+                self._lock_path.unlink(missing_ok=True)
             os.close(self._lock)
             self._lock = None
+            if sys.platform == "win32":  # elsewhere a new holder's lock may be there now
+                with contextlib.suppress(OSError):
+                    self._lock_path.unlink(missing_ok=True)
 
     def load(self) -> tuple[tuple[int, ...] | None, str | None]:
         try:

@@ -13,12 +13,18 @@ from __future__ import annotations
 
 import errno
 import os
+from typing import TYPE_CHECKING
 from urllib.parse import parse_qs, urlsplit
 
 import serial
 
 from appmode.errors import AppmodeError
 from appmode.protocol import params
+
+if TYPE_CHECKING:
+    from appmode.ports.newpty import PtyPort
+
+NO_PTY = "this system has no pseudo-terminals (Windows)"
 
 if "appmode.ports" not in serial.protocol_handler_packages:
     serial.protocol_handler_packages.append("appmode.ports")  # sim:// (protocol_sim.py)
@@ -106,3 +112,14 @@ def explain_open_error(where: str, exc: Exception) -> str:
     if "Name or service not known" in text or "nodename nor servname" in text:
         return f"unknown host in {where}: check the address"
     return f"cannot open {where}: {text}"
+
+
+def new_pty() -> PtyPort:
+    """A new pseudo-terminal for another program to open as its serial port (POSIX)."""
+    try:
+        from appmode.ports.newpty import PtyPort
+    except ImportError:
+        raise AppmodeError(
+            f"{NO_PTY}: name a port (COM3, socket://HOST:PORT) instead of pty"
+        ) from None
+    return PtyPort()

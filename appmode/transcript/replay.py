@@ -10,16 +10,19 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import serial
 
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
-from appmode.ports.link import open_link
-from appmode.ports.newpty import PtyPort
+from appmode.ports.link import new_pty, open_link
 from appmode.protocol.app import BoardDecoder, HostDecoder
 from appmode.protocol.render import describe, line
 from appmode.protocol.transcript import read_transcript
+
+if TYPE_CHECKING:
+    from appmode.ports.newpty import PtyPort
 
 Item = tuple[float, bytes]
 
@@ -158,7 +161,7 @@ def _open_for_app(url: str) -> serial.SerialBase | PtyPort:
     waits until the app has opened it and sent something (an app asks first)."""
     if url != "pty":
         return open_link(url)
-    port = PtyPort()
+    port = new_pty()
     print(f"port: {port.path}", flush=True)
     print(
         f"waiting for an app to open {port.path} and send something (Ctrl-C to give up)",

@@ -15,8 +15,7 @@ from typing import Protocol
 
 import serial
 
-from appmode.ports.link import open_link
-from appmode.ports.newpty import PtyPort
+from appmode.ports.link import new_pty, open_link
 from appmode.protocol.app import SessionEnd
 from appmode.protocol.transcript import Recorder
 
@@ -42,7 +41,7 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
     """Forward until interrupted, recording both directions."""
     app: Port
     if app_url == "pty":
-        pty_port = PtyPort()
+        pty_port = new_pty()
         app = pty_port
         print(f"port: {pty_port.path}", flush=True)
     else:
