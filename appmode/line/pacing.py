@@ -22,6 +22,7 @@ class Line:
     """Bytes pushed at a time, delivered at the line's rate, in order."""
 
     def __init__(self, baud: int | None) -> None:
+        self.baud = baud
         self.byte_time = byte_time(baud)
         self._bursts: deque[tuple[float, bytes]] = deque()  # (first byte's start, data)
         self._taken = 0  # bytes of the first burst already delivered

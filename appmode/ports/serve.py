@@ -7,19 +7,21 @@ client does: a pty's other end closing, a TCP client leaving, nobody listening.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import math
 import os
-import pty
+import random
 import selectors
 import socket
 import sys
+import threading
 import time
-import tty
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
+from typing import TypeVar
 
 import serial
 
@@ -28,13 +30,15 @@ from appmode.board.profiles import SHEET, profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
+from appmode.line.faults import Faults, FaultSpec
 from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
-from appmode.ports.link import BAUD, explain_open_error, parse_device
+from appmode.ports.link import BAUD, NO_PTY, explain_open_error, parse_device
 from appmode.protocol import params
 from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder
 
 Log = Callable[[str], None]
+T = TypeVar("T")
 OUTBOX = 4096
 RETRY_WRITE = 0.002
 """Seconds before writing again what the OS would not take."""
@@ -82,6 +86,14 @@ class PtyEndpoint:
     """
 
     def __init__(self, sel: selectors.BaseSelector, log: Log, link: str | None = None) -> None:
+        try:  # POSIX only: imported where a pty is made, so Windows can serve on TCP
+            import pty
+            import tty
+        except ImportError:
+            raise AppmodeError(
+                f"{NO_PTY}: serve on TCP with --listen HOST:PORT and --listen2 HOST:PORT"
+            ) from None
+
         try:
             self._master, self._slave = pty.openpty()
         except OSError as exc:
@@ -288,6 +300,8 @@ class Served:
     wire: Wire
     paused: dict[str, bool]
     last_write: float = float("-inf")
+    faults: tuple[Faults, Faults] | None = None
+    """A faulty link: (to the board, to the host), applied to every port's bytes."""
 
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
@@ -322,12 +336,16 @@ class Served:
         self.wire.run(now)
         for name, endpoint in self.endpoints.items():
             out = self.wire.ports[name].to_host.take(now)
+            if out and self.faults is not None:
+                out = self.faults[1].apply(out)
             if out or endpoint.backlog:
                 endpoint.write(out)
                 self.last_write = now
 
     def receive(self, data: bytes, now: float, port: str) -> None:
         self.pump(now)  # what was due before these bytes came
+        if self.faults is not None:
+            data = self.faults[0].apply(data)
         self.wire.write(data, now, port)
 
     def throttle(self) -> None:
@@ -340,6 +358,180 @@ class Served:
 
 
 MakeEndpoint = Callable[[selectors.BaseSelector, Log], Endpoint]
+
+
+class BoardServer:
+    """Serves boards from one thread and one selector: `run` until `stop` is called (from
+    any thread) or KeyboardInterrupt. `lock` is held while a board runs, so another
+    thread may look at a board, or `restart` it, between two steps.
+
+    The recording (`record`) is created once every port is open: a port that cannot be
+    opened leaves an existing file untouched."""
+
+    def __init__(
+        self,
+        make_endpoints: list[MakeEndpoint],
+        boards: list[Board],
+        *,
+        pace: bool,
+        log: Log,
+        record: str | None = None,
+        directives: tuple[str, ...] = (),
+        make_uart2: list[MakeEndpoint] | None = None,
+        faults: FaultSpec | None = None,
+    ) -> None:
+        self.log = log
+        self._faults = faults
+        self.lock = threading.Lock()
+        self._sel = selectors.DefaultSelector()
+        self._endpoints: list[Endpoint] = []
+        self._served: list[Served] = []
+        self._by_endpoint: dict[int, tuple[Served, str]] = {}
+        self._recorder: Recorder | None = None
+        self._stopped = False
+        self._wake_read, self._wake_write = socket.socketpair()
+        self._wake_read.setblocking(False)
+        self._sel.register(self._wake_read, selectors.EVENT_READ, self._woken)
+        self._origin = time.monotonic()
+        try:
+            self._open(make_endpoints, boards, pace, record, directives, make_uart2)
+        except BaseException:
+            self.close()
+            raise
+
+    def _open(
+        self,
+        make_endpoints: list[MakeEndpoint],
+        boards: list[Board],
+        pace: bool,
+        record: str | None,
+        directives: tuple[str, ...],
+        make_uart2: list[MakeEndpoint] | None,
+    ) -> None:
+        pairs: list[dict[str, Endpoint]] = []
+        for i, make in enumerate(make_endpoints):
+            pair = {APP: make(self._sel, self.log)}
+            self._endpoints.append(pair[APP])
+            if make_uart2 is not None:
+                pair[UART2] = make_uart2[i](self._sel, self.log)
+                self._endpoints.append(pair[UART2])
+            pairs.append(pair)
+        self._recorder = Recorder.create(record, 0.0, directives) if record else None
+        for pair, board in zip(pairs, boards, strict=True):
+            if self._recorder is not None:
+                self._recorder.follow(int(board.params[SYSTEM_MODE]), 0.0)
+            bauds = {
+                name: getattr(endpoint, "baud", BAUD if name == APP else UART2_BAUD)
+                for name, endpoint in pair.items()
+            }
+            wire = Wire(
+                board,
+                bauds[APP] if pace else None,
+                self._recorder,
+                bauds.get(UART2, UART2_BAUD) if pace else None,
+            )
+            one = Served(pair, wire, dict.fromkeys(pair, False), faults=self._faulty())
+            self._served.append(one)
+            for name, endpoint in pair.items():
+                self._by_endpoint[id(endpoint)] = (one, name)
+
+    def _faulty(self) -> tuple[Faults, Faults] | None:
+        spec = self._faults
+        if spec is None or not spec.active:
+            return None
+        if spec.delay or spec.split:
+            raise AppmodeError(
+                "a served board's link takes drop, dup, corrupt and chatter faults; delay "
+                "and split are sim:// only (a pty or socket already splits what it carries)"
+            )
+        rng = random.Random(spec.seed)
+        return Faults(spec, rng), Faults(spec, rng)
+
+    def urls(self, index: int = 0) -> dict[str, str]:
+        """The URLs of board `index`'s ports, by port name (`app`, `uart2`)."""
+        return {name: e.url for name, e in self._served[index].endpoints.items()}
+
+    def look(self, index: int, see: Callable[[Board], T]) -> T:
+        """`see(board)` for board `index` run to now, between two steps of the server."""
+        with self.lock:
+            wire = self._served[index].wire
+            wire.run(self.now())
+            return see(wire.board)
+
+    def now(self) -> float:
+        """The boards' clock: seconds since the server started."""
+        return time.monotonic() - self._origin
+
+    def restart(self, index: int, make: Callable[[Board, float], Board]) -> None:
+        """Power-cycle board `index`: `make(old_board, now)` builds the new board, which
+        replaces the old one on the same ports; what was on its lines is lost, as in a
+        power cut."""
+        with self.lock:
+            one = self._served[index]
+            old = one.wire
+            one.wire = Wire(
+                make(old.board, self.now()),
+                old.ports[APP].to_host.baud,
+                old.tap,
+                old.ports[UART2].to_host.baud,
+            )
+        self._wake()
+
+    def stop(self) -> None:
+        """End `run` (from any thread)."""
+        self._stopped = True
+        self._wake()
+
+    def _wake(self) -> None:
+        with contextlib.suppress(OSError):
+            self._wake_write.send(b"\0")
+
+    def _woken(self, size: int) -> bytes:
+        with contextlib.suppress(OSError):
+            self._wake_read.recv(4096)
+        return b""
+
+    def run(self) -> None:
+        while not self._stopped:
+            with self.lock:
+                wake = self._step()
+            timeout = max(0.0, wake - self.now())
+            for key, _ in self._sel.select(timeout):
+                reader = key.data
+                if reader == self._woken:
+                    reader(0)
+                    continue
+                with self.lock:
+                    one, name = self._by_endpoint[id(reader.__self__)]
+                    data = reader(max(1, INPUT_BACKLOG - len(one.wire.ports[name].to_board)))
+                    if data:
+                        one.receive(data, self.now(), name)
+                        one.throttle()
+
+    def _step(self) -> float:
+        """Run every board that is due; when the next one is."""
+        now = self.now()
+        wake = math.inf
+        for one in self._served:
+            due = one.wakeup()
+            if due <= now:
+                one.pump(now)
+                for note in one.wire.board.take_notes():
+                    self.log(f"{note.time:10.3f}  {note.port} {note.level:<8} {note.text}")
+                one.throttle()
+                due = one.wakeup()
+            wake = min(wake, due)
+        return wake
+
+    def close(self) -> None:
+        """Close every port, then the recording (what its decoders hold is written)."""
+        for endpoint in self._endpoints:
+            endpoint.close()
+        self._sel.close()
+        self._wake_read.close()
+        self._wake_write.close()
+        if self._recorder is not None:
+            self._recorder.close()
 
 
 def serve(
@@ -355,73 +547,27 @@ def serve(
     make_uart2: list[MakeEndpoint] | None = None,
 ) -> None:
     """Serve boards until interrupted (KeyboardInterrupt); `announce` gets each port line
-    (`port: …`, then `uart2: …` when `make_uart2` serves the board's control port).
-
-    The recording (`record`) is created once every port is open: a port that cannot be
-    opened leaves an existing file untouched."""
-    sel = selectors.DefaultSelector()
-    endpoints: list[Endpoint] = []
-    served: list[Served] = []
-    by_endpoint: dict[int, tuple[Served, str]] = {}
-    recorder: Recorder | None = None
+    (`port: …`, then `uart2: …` when `make_uart2` serves the board's control port)."""
+    server = BoardServer(
+        make_endpoints,
+        boards,
+        pace=pace,
+        log=log,
+        record=record,
+        directives=directives,
+        make_uart2=make_uart2,
+    )
     try:
-        pairs: list[dict[str, Endpoint]] = []
-        for i, make in enumerate(make_endpoints):
-            pair = {APP: make(sel, log)}
-            if make_uart2 is not None:
-                pair[UART2] = make_uart2[i](sel, log)
-            endpoints += pair.values()
-            pairs.append(pair)
-        recorder = Recorder.create(record, 0.0, directives) if record else None
-        for pair, board in zip(pairs, boards, strict=True):
-            if recorder is not None:
-                recorder.follow(int(board.params[SYSTEM_MODE]), 0.0)
-            bauds = {
-                name: getattr(endpoint, "baud", BAUD if name == APP else UART2_BAUD)
-                for name, endpoint in pair.items()
-            }
-            wire = Wire(
-                board,
-                bauds[APP] if pace else None,
-                recorder,
-                bauds.get(UART2, UART2_BAUD) if pace else None,
-            )
-            one = Served(pair, wire, dict.fromkeys(pair, False))
-            served.append(one)
-            for name, endpoint in pair.items():
-                by_endpoint[id(endpoint)] = (one, name)
-            announce(f"port: {pair[APP].url}")
-            if UART2 in pair:
-                announce(f"uart2: {pair[UART2].url}")
+        for i in range(len(boards)):
+            urls = server.urls(i)
+            announce(f"port: {urls[APP]}")
+            if UART2 in urls:
+                announce(f"uart2: {urls[UART2]}")
         if banner:
             log(banner)
-        origin = time.monotonic()
-        while True:
-            now = time.monotonic() - origin
-            wake = float("inf")
-            for one in served:
-                due = one.wakeup()
-                if due <= now:
-                    one.pump(now)
-                    for note in one.wire.board.take_notes():
-                        log(f"{note.time:10.3f}  {note.port} {note.level:<8} {note.text}")
-                    one.throttle()
-                    due = one.wakeup()
-                wake = min(wake, due)
-            timeout = max(0.0, wake - (time.monotonic() - origin))
-            for key, _ in sel.select(timeout):
-                reader = key.data
-                one, name = by_endpoint[id(reader.__self__)]
-                data = reader(max(1, INPUT_BACKLOG - len(one.wire.ports[name].to_board)))
-                if data:
-                    one.receive(data, time.monotonic() - origin, name)
-                    one.throttle()
+        server.run()
     finally:
-        for endpoint in endpoints:
-            endpoint.close()
-        sel.close()
-        if recorder is not None:
-            recorder.close()
+        server.close()
 
 
 def run_board(
