@@ -259,6 +259,12 @@ class Check:
         """When the expectation is due: its time, shifted by the last @align match."""
         return exp.entry.time + (0.0 if exp.align else self.offset)
 
+    def active(self) -> bool:
+        """An expectation is waiting and every `>` line before it has been sent."""
+        return self.matched < len(self.expectations) and self._active(
+            self.expectations[self.matched]
+        )
+
     def _active(self, exp: Expectation) -> bool:
         """Every `>` line before the expectation has been sent."""
         return self.sent == len(self.sends) or self.sends[self.sent].time > exp.after
