@@ -1,0 +1,189 @@
+"""The pytest plugin (entry point `pytest11`, loaded wherever appmode is installed).
+
+Fixtures:
+
+- `appmode_board`: a simulated board served on two pseudo-terminals for the test
+  (options from `@pytest.mark.appmode_board(profile=…, drive=…, faults=…, pace=…,
+  flash=…)`), stopped after it;
+- `appmode_board_factory`: `appmode_board_factory(**options)` makes more;
+- `appmode_sim_url`: an in-process `sim://` URL (same options), for code that takes a
+  pyserial URL.
+
+`--appmode-board URL` (and `--appmode-board2 URL` for its control port) runs the same
+tests against a real car: the fixtures give its URLs, and a test that needs what only
+the simulated board has (its state, its recording, a restart, faults) is skipped saying
+so. Nothing heavy is imported until a fixture is used.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+from urllib.parse import urlencode
+
+import pytest
+
+if TYPE_CHECKING:
+    from appmode.protocol.transcript import Transcript
+    from appmode.testing.served import BoardState, ServedBoard
+
+OPTIONS = ("profile", "drive", "faults", "pace", "flash")
+"""What the `appmode_board` marker and the factory take."""
+MARKER = (
+    "appmode_board(profile='sheet', drive=None, faults='', pace=True, flash=None): the "
+    "simulated board of the appmode_board and appmode_sim_url fixtures — its profile "
+    "(sheet or minibalance), drive type (omni, mecanum, diff, diff-gyro), a faulty link "
+    "('drop:0.01,corrupt:0.01'), pacing at the real line rates, and a flash file"
+)
+_SHARES = itertools.count(1)
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("appmode", "appmode's simulated robot-car board")
+    group.addoption(
+        "--appmode-board",
+        metavar="URL",
+        help="run the appmode_board tests against this real board's APP port (a device "
+        "such as /dev/rfcomm0, or a pyserial URL) instead of the simulated board",
+    )
+    group.addoption(
+        "--appmode-board2",
+        metavar="URL",
+        help="with --appmode-board: the real board's control port (UART2)",
+    )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", MARKER)
+
+
+def _options(request: pytest.FixtureRequest) -> dict[str, Any]:
+    marker = request.node.get_closest_marker("appmode_board")
+    if marker is None:
+        return {}
+    if marker.args:
+        pytest.fail(
+            f"@pytest.mark.appmode_board takes names ({', '.join(OPTIONS)}), not {marker.args!r}",
+            pytrace=False,
+        )
+    return dict(marker.kwargs)
+
+
+def _check_options(options: dict[str, Any]) -> None:
+    unknown = sorted(set(options) - set(OPTIONS))
+    if unknown:
+        pytest.fail(
+            f"appmode_board: unknown option {', '.join(unknown)} (it takes {', '.join(OPTIONS)})",
+            pytrace=False,
+        )
+
+
+class RealBoard:
+    """A real board given by --appmode-board: its URLs; the rest skips the test."""
+
+    def __init__(self, port: str, uart2: str | None) -> None:
+        self.port = port
+        self._uart2 = uart2
+
+    @property
+    def uart2(self) -> str:
+        if self._uart2 is None:
+            pytest.skip("the test uses the control port (UART2): give --appmode-board2 URL")
+        return self._uart2
+
+    @staticmethod
+    def _only_simulated(what: str) -> Any:
+        pytest.skip(f"{what} is known only of the simulated board, not of --appmode-board")
+
+    @property
+    def state(self) -> BoardState:
+        return self._only_simulated("the board's state")  # type: ignore[no-any-return]
+
+    def wait_until(self, *args: Any, **kwargs: Any) -> BoardState:
+        return self._only_simulated("the board's state")  # type: ignore[no-any-return]
+
+    def recording(self) -> Transcript:
+        return self._only_simulated("the board's recording")  # type: ignore[no-any-return]
+
+    def restart(self) -> None:
+        self._only_simulated("a restart (power cycle)")
+
+    def assert_conforms(self, expected: str | Path) -> None:
+        self._only_simulated("the board's recording")
+
+
+def _real(config: pytest.Config, options: dict[str, Any]) -> RealBoard | None:
+    url = config.getoption("--appmode-board")
+    if url is None:
+        return None
+    for name in ("faults", "flash", "drive"):
+        if options.get(name):
+            pytest.skip(f"{name}= is for the simulated board; --appmode-board is a real one")
+    return RealBoard(url, config.getoption("--appmode-board2"))
+
+
+@pytest.fixture
+def appmode_board_factory(
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[Callable[..., ServedBoard | RealBoard]]:
+    """`make(profile=…, drive=…, faults=…, pace=…, flash=…)`: a new simulated board on two
+    ptys, stopped when the test ends."""
+    boards: list[ServedBoard] = []
+    home = Path(request.path).parent
+
+    def make(**options: Any) -> ServedBoard | RealBoard:
+        _check_options(options)
+        real = _real(request.config, options)
+        if real is not None:
+            return real
+        from appmode.errors import AppmodeError
+        from appmode.testing.served import ServedBoard
+
+        folder = tmp_path_factory.mktemp("appmode_board")
+        try:
+            board = ServedBoard(folder, home=home, **options)
+        except AppmodeError as exc:
+            pytest.fail(f"appmode_board: {exc}", pytrace=False)
+        boards.append(board)
+        return board
+
+    yield make
+    failures = []
+    for board in boards:
+        try:
+            board.close()
+        except Exception as exc:  # a board that failed while serving fails the test
+            failures.append(str(exc))
+    if failures:
+        pytest.fail("; ".join(failures), pytrace=False)
+
+
+@pytest.fixture
+def appmode_board(
+    request: pytest.FixtureRequest, appmode_board_factory: Callable[..., ServedBoard | RealBoard]
+) -> ServedBoard | RealBoard:
+    """A simulated board served on two ptys for this test: `.port` (APP port, 9600 bps),
+    `.uart2` (control port, 115200 bps), `.recording()`, `.state`, `.wait_until(…)`,
+    `.restart()`, `.assert_conforms(path)`; options by `@pytest.mark.appmode_board`."""
+    return appmode_board_factory(**_options(request))
+
+
+@pytest.fixture
+def appmode_sim_url(request: pytest.FixtureRequest) -> str:
+    """`sim://?…&share=NAME`: the simulated board in-process, for code that opens a pyserial
+    URL (`serial.serial_for_url`); add `&port=uart2` for the same board's control port.
+    Options by `@pytest.mark.appmode_board`; with --appmode-board, that board's URL."""
+    options = _options(request)
+    _check_options(options)
+    real = _real(request.config, options)
+    if real is not None:
+        return real.port
+    import appmode.ports.link  # noqa: F401 - registers sim:// with pyserial
+
+    query = {k: v for k, v in options.items() if v not in (None, "")}
+    if "pace" in query:
+        query["pace"] = int(bool(query["pace"]))
+    query["share"] = f"pytest-{next(_SHARES)}"
+    return f"sim://?{urlencode(query)}"
