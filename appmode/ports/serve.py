@@ -203,7 +203,8 @@ class TcpEndpoint:
         return b""
 
     def _read(self, size: int) -> bytes:
-        assert self._client is not None
+        if self._client is None:  # dropped earlier in this pass (a write to it failed)
+            return b""
         try:
             data = self._client.recv(size)
         except (BlockingIOError, InterruptedError):

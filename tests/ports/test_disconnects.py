@@ -13,7 +13,7 @@ from pathlib import Path
 from appmode.host.client import Host
 from appmode.host.state import LinkStatus
 from appmode.protocol.app import Velocity
-from tests.support.processes import ROOT, BoardProcess, board_process, wait_for
+from tests.support.processes import ROOT, BoardProcess, board_process, board_state, wait_for
 
 
 def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> None:
@@ -121,3 +121,29 @@ def test_board_keeps_serving_after_clients_are_killed() -> None:
             with Host(board.url) as host:
                 assert host.read_params()[0] == 500
             assert board.proc.poll() is None
+
+
+def test_a_board_survives_an_app_client_reset_while_uart2_data_arrives() -> None:
+    """A client that resets (SO_LINGER 0) while the other port's bytes arrive: the write
+    to the gone client and its pending read come in one pass of the server (issue 22.5)."""
+    with board_process("--listen", "127.0.0.1:0", "--listen2", "127.0.0.1:0", "--quiet") as b:
+        app_host, app_port = b.url.removeprefix("socket://").rsplit(":", 1)
+        uart2_host, uart2_port = b.uart2.removeprefix("socket://").rsplit(":", 1)
+        uart2 = socket.create_connection((uart2_host, int(uart2_port)))
+        try:
+            for _ in range(8):
+                app = socket.create_connection((app_host, int(app_port)))
+                app.sendall(b"JA")
+                time.sleep(0.05)  # records are on their way to it
+                app.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+                uart2.sendall(bytes.fromhex("FF FE 80 80 11 00 00 00 00 00") * 20)
+                app.close()  # RST
+                uart2.sendall(bytes.fromhex("FF FE 80 80 11 00 00 00 00 00") * 20)
+                time.sleep(0.05)
+            assert b.proc.poll() is None, b.stop()
+            _, values = board_state(b.url)
+            assert len(values) == 9
+        finally:
+            uart2.close()
+        err = b.stop()
+    assert "Traceback" not in err and "AssertionError" not in err
