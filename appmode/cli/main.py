@@ -6,7 +6,6 @@ import argparse
 import contextlib
 import errno
 import os
-import signal
 import sys
 from collections.abc import Callable, Sequence
 from types import ModuleType
@@ -29,7 +28,7 @@ from appmode.cli import (
     tap,
 )
 from appmode.errors import AppmodeError
-from appmode.host.signals import ENDING_SIGNALS
+from appmode.host import signals
 
 COMMANDS: tuple[ModuleType, ...] = (
     drive,
@@ -84,8 +83,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handler: Handler = args.handler
-    for signum in ENDING_SIGNALS:
-        signal.signal(signum, _interrupt)
+    signals.install()
     try:
         status = handler(args)
         sys.stdout.flush()  # here, where a full disk or a closed pipe can be reported
@@ -107,11 +105,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         with contextlib.suppress(OSError):
             print(f"appmode: error: {what}: {exc.strerror or exc}", file=sys.stderr)
         return 2
-
-
-def _interrupt(signum: int, frame: object) -> None:
-    """SIGTERM and SIGHUP end a command the way Ctrl-C does: cleanly, the car stopped."""
-    raise KeyboardInterrupt
+    finally:
+        signals.finish()
 
 
 if __name__ == "__main__":

@@ -40,7 +40,7 @@ from appmode.console.base import QUIT_WORDS, BaseSession, Quit, ShowHelp, ShowSt
 from appmode.console.panel import status_fragments, status_text
 from appmode.console.panel_parts import ARROWS, KEY_GRID, WIDTH, Fragments
 from appmode.files import data_folder
-from appmode.host.signals import ENDING_SIGNALS
+from appmode.host import signals
 from appmode.host.tokens import Wait
 
 REFRESH = 0.02
@@ -270,14 +270,19 @@ async def run_app(app: Application[None], session: BaseSession) -> None:
     def start_ticker() -> None:
         app.create_background_task(ticker())
 
+    def quit_app() -> None:
+        if app.is_running and app.future is not None and not app.future.done():
+            app.exit()
+
+    # An ending signal asks the loop to quit (run_drive then stops the car); the loop's
+    # own signal handlers are not used: removing them restores the default action (a
+    # SIGHUP would then kill the process before its `Z`), and Windows has none.
     loop = asyncio.get_running_loop()
-    for signum in ENDING_SIGNALS:
-        loop.add_signal_handler(signum, app.exit)
-    try:
-        await app.run_async(pre_run=start_ticker)
-    finally:
-        for signum in ENDING_SIGNALS:
-            loop.remove_signal_handler(signum)
+    def on_signal() -> None:
+        loop.call_soon_threadsafe(quit_app)
+
+    with signals.diverted(on_signal):
+        await app.run_async(pre_run=start_ticker, handle_sigint=False)
 
 
 def run_drive(

@@ -50,9 +50,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
     def _on_lost(self) -> None:
         self.state.reset_decoder()
 
-    def send(self, data: bytes) -> None:
-        """Write bytes to the board; LinkLost if the link is down."""
-        self._write(data)
+    def _sent(self, data: bytes) -> None:
         self.state.sent(data, self.now())
 
     def send_command(self, command: app.Command) -> None:

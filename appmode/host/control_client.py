@@ -92,9 +92,7 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
     def _on_lost(self) -> None:
         self.state.reset_decoder()
 
-    def send(self, data: bytes) -> None:
-        """Write bytes to the control port; LinkLost if the link is down."""
-        self._write(data)
+    def _sent(self, data: bytes) -> None:
         events, reread = self.state.sent(data, self.now())
         self._watch(self.sent, events)
         self._watch(self.received, reread)

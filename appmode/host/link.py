@@ -16,10 +16,14 @@ from typing import Any, Generic, TypeVar
 import serial
 
 from appmode.errors import AppmodeError
+from appmode.host import signals
 from appmode.host.state import LinkStatus
+from appmode.line.pacing import Ahead
 from appmode.line.wire import Tap
 
 RETRY = 0.5
+CHUNK = 64
+"""Bytes written at once: 67 ms at 9600 bps, the longest an ending signal waits."""
 STEP = 0.001
 """Seconds between looks at the port while waiting less than its read timeout."""
 
@@ -53,6 +57,7 @@ class Link(Generic[E]):
         self._port: serial.SerialBase | None = opener(url)
         self._origin = clock()  # after opening: an in-process sim:// board booted just now
         self._lost_at = 0.0
+        self._ahead: Ahead | None = None  # the line's rate, known once the port is open
         self._pending: list[E | LinkStatus] = []
 
     def now(self) -> float:
@@ -91,18 +96,43 @@ class Link(Generic[E]):
         self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
 
     def _write(self, data: bytes) -> None:
-        """Write bytes to the board and tap them; LinkLost if the link is down."""
+        """Write bytes to the board, CHUNK at a time, each tapped and followed (`_sent`)
+        as it leaves; LinkLost if the link is down. An ending signal waits for the chunk
+        under way: what the session end knows is what really left."""
         if self._port is None:
             self._reconnect()
         if self._port is None:
             raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
-        try:
-            self._port.write(data)
-        except (serial.SerialException, OSError) as exc:
-            self._lost(exc)
-            raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
-        if self.tap is not None:
-            self.tap(self.sent, self.now(), data)
+        for start in range(0, len(data), CHUNK):
+            chunk = data[start : start + CHUNK]
+            self._pace(len(chunk))
+            with signals.atomic():
+                port = self._port
+                if port is None:  # lost at the last chunk
+                    raise LinkLost(f"link to {self.url} lost while sending")
+                try:
+                    port.write(chunk)
+                except (serial.SerialException, OSError) as exc:
+                    self._lost(exc)
+                    raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
+                if self.tap is not None:
+                    self.tap(self.sent, self.now(), chunk)
+                self._sent(chunk)
+
+    def _pace(self, size: int) -> None:
+        """Hand the OS no more than a chunk ahead of the line's rate: what it holds would
+        reach the board before the stop that ends the session (a pty takes kilobytes:
+        seconds of driving at 9600 bps)."""
+        if self._ahead is None:
+            baud = getattr(self._port, "baudrate", None)
+            self._ahead = Ahead(baud if isinstance(baud, int) else None, CHUNK)
+        wait = self._ahead.delay(self.now())
+        if wait:
+            time.sleep(wait)
+        self._ahead.wrote(size, self.now())
+
+    def _sent(self, data: bytes) -> None:
+        """Follow bytes that have left (the protocol's session end, its counters)."""
 
     def _read_bytes(self, block: bool) -> bytes:
         """What the port has (waiting for the first byte up to its timeout if `block`),
@@ -176,17 +206,19 @@ class Link(Generic[E]):
     def close(self) -> bytes | None:
         """Stop the car (`_stop()` is the last thing sent), then close the port. Returns
         the bytes of that stop, or None if the link was down. A passive host
-        (`stop_on_close` False, a monitor) sends nothing."""
-        if self._port is None:
-            return None
-        stop = self._stop() if self.stop_on_close else b""
-        try:
-            if stop:
-                self.send(stop)
-        except LinkLost:
-            return self.close()  # the port is gone: nothing was sent
-        except AppmodeError:
-            pass  # written; only its recording failed, which must not keep the port open
+        (`stop_on_close` False, a monitor) sends nothing. An ending signal waits until
+        the stop has been written."""
+        with signals.atomic():
+            if self._port is None:
+                return None
+            stop = self._stop() if self.stop_on_close else b""
+            try:
+                if stop:
+                    self.send(stop)
+            except LinkLost:
+                return self.close()  # the port is gone: nothing was sent
+            except AppmodeError:
+                pass  # written; only its recording failed, which must not keep it open
         if self._port is not None:
             with contextlib.suppress(serial.SerialException, OSError):
                 self._port.flush()

@@ -1,12 +1,88 @@
 """The signals that end a host session the way Ctrl-C does, the car stopped.
 
-SIGTERM is a polite kill; SIGHUP is a closed terminal or a dropped SSH connection.
+SIGTERM is a polite kill; SIGHUP is a closed terminal or a dropped SSH connection; SIGINT
+is Ctrl-C. `install()` gives all three one handler, which:
+
+- raises KeyboardInterrupt once: a session that has begun to end is not interrupted
+  again (systemd sends SIGTERM and SIGHUP together), so its stop goes out;
+- waits while an `atomic()` step runs — a write and the bookkeeping of what it sent —
+  so that what the session end knows is what really left;
+- calls the action of `diverted()` instead, where raising would land in the wrong place
+  (the console's event loop: the action asks it to quit).
 """
 
 from __future__ import annotations
 
 import signal
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 
 ENDING_SIGNALS: tuple[signal.Signals, ...] = tuple(
     getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
 )
+
+
+class _Ending:
+    def __init__(self) -> None:
+        self.ended = False  # an ending signal has been acted on
+        self.depth = 0  # atomic steps under way
+        self.pending = False  # a signal came during one
+        self.action: Callable[[], None] | None = None
+
+
+_ending = _Ending()
+
+
+def install() -> None:
+    """Handle SIGINT, SIGTERM and SIGHUP as above (in the main thread), from now: an
+    ending acted on before is forgotten."""
+    _ending.ended = _ending.pending = False
+    for signum in (signal.SIGINT, *ENDING_SIGNALS):
+        signal.signal(signum, _handle)
+
+
+def finish() -> None:
+    """The command is over: after an ending, further signals are ignored to the end
+    (the interpreter's shutdown would otherwise meet them with the default action)."""
+    if _ending.ended:
+        for signum in (signal.SIGINT, *ENDING_SIGNALS):
+            signal.signal(signum, signal.SIG_IGN)
+
+
+def _handle(signum: int, frame: object) -> None:
+    if _ending.ended:
+        return
+    if _ending.depth:
+        _ending.pending = True
+        return
+    _ending.ended = True
+    if _ending.action is not None:
+        _ending.action()
+        return
+    raise KeyboardInterrupt
+
+
+@contextmanager
+def atomic() -> Iterator[None]:
+    """A step that an ending signal must not cut in two: the signal takes effect when
+    the step is done."""
+    _ending.depth += 1
+    try:
+        yield
+    finally:
+        _ending.depth -= 1
+        if not _ending.depth and _ending.pending:
+            _ending.pending = False
+            _handle(0, None)
+
+
+@contextmanager
+def diverted(action: Callable[[], None]) -> Iterator[None]:
+    """While inside, an ending signal calls `action` (which must be safe to call from a
+    signal handler) instead of raising KeyboardInterrupt."""
+    before = _ending.action
+    _ending.action = action
+    try:
+        yield
+    finally:
+        _ending.action = before

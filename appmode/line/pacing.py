@@ -18,6 +18,24 @@ def byte_time(baud: int | None) -> float:
     return BITS_PER_BYTE / baud if baud else 0.0
 
 
+class Ahead:
+    """A writer's side of a line of `baud`: how long to wait before handing the OS more,
+    so that it never holds more than `limit` bytes the wire has not carried. What an OS
+    holds reaches the other end before anything written after it — a stop, say."""
+
+    def __init__(self, baud: int | None, limit: int) -> None:
+        self.byte_time = byte_time(baud)
+        self.limit = limit
+        self._free_at = float("-inf")  # when the wire will have carried what was written
+
+    def delay(self, now: float) -> float:
+        """Seconds to wait, from `now`, before writing more."""
+        return max(0.0, self._free_at - now - self.limit * self.byte_time)
+
+    def wrote(self, size: int, now: float) -> None:
+        self._free_at = max(self._free_at, now) + size * self.byte_time
+
+
 class Line:
     """Bytes pushed at a time, delivered at the line's rate, in order."""
 
@@ -26,10 +44,11 @@ class Line:
         self.byte_time = byte_time(baud)
         self._bursts: deque[tuple[float, bytes]] = deque()  # (first byte's start, data)
         self._taken = 0  # bytes of the first burst already delivered
+        self._queued = 0  # bytes of every burst, the first's delivered ones included
         self._free_at = float("-inf")
 
     def __len__(self) -> int:
-        return sum(len(d) for _, d in self._bursts) - self._taken
+        return self._queued - self._taken
 
     def push(self, data: bytes, now: float) -> None:
         """Queue `data`, sent from `now` or when the line is free, whichever is later."""
@@ -37,6 +56,7 @@ class Line:
             return
         start = max(now, self._free_at)
         self._bursts.append((start, bytes(data)))
+        self._queued += len(data)
         self._free_at = start + len(data) * self.byte_time
 
     def next_due(self) -> float | None:
@@ -68,6 +88,7 @@ class Line:
                     break
                 out.append((start, data[self._taken :]))
                 self._bursts.popleft()
+                self._queued -= len(data)
                 self._taken = 0
                 continue
             due = min(len(data), int((now - start) / step + 1e-9))
@@ -77,5 +98,6 @@ class Line:
                 self._taken = max(self._taken, due)
                 break
             self._bursts.popleft()
+            self._queued -= len(data)
             self._taken = 0
         return out

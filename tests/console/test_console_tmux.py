@@ -173,3 +173,24 @@ def test_at_80x24_help_waveforms_and_the_message_log(tmp_path: Path) -> None:
     finally:
         if _alive():
             tmux("kill-session", "-t", SESSION)
+
+
+def test_two_ending_signals_end_the_console_with_z_last(tmp_path: Path) -> None:
+    """Issue 22.2: SIGTERM and SIGHUP together. The console used to give the signals
+    back to their default action before its final `Z`: a SIGHUP then killed it."""
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        for trial in range(6):  # the second signal at several points of the ending
+            try:
+                pid = _drive_forward(board.url)
+                os.kill(pid, signal.SIGTERM)
+                time.sleep((0, 0.01, 0.02, 0.04, 0.08, 0.12)[trial])
+                os.kill(pid, signal.SIGHUP)
+                wait_for(lambda p=pid: not Path(f"/proc/{p}").exists())
+            finally:
+                subprocess.run(
+                    ["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False
+                )
+            sent = sent_lines(record)
+            assert sent[-1] == "Z", f"trial {trial}: {sent[-5:]}"
+        assert board_state(board.url) == ((0, 0, 0), tuple(params.DEFAULTS))
