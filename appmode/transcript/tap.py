@@ -15,11 +15,16 @@ from typing import Protocol
 
 import serial
 
+from appmode.line.pacing import Ahead
 from appmode.ports.link import new_pty, open_link
 from appmode.protocol.app import SessionEnd
 from appmode.protocol.transcript import Recorder
 
 READ_TIMEOUT = 0.05
+CHUNK = 64
+"""Bytes forwarded at once: the longest a stop waits behind them (67 ms at 9600 bps)."""
+JOIN = 5.0
+"""Seconds a forwarding thread has to finish its chunk once the tap stops."""
 
 
 class Port(Protocol):
@@ -60,25 +65,35 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
     errors: list[str] = []
 
     def forward(src: Port, dst: Port, direction: str, name: str) -> None:
-        while not stop.is_set():
-            try:
+        """Copy src to dst, a chunk at a time and no faster than dst's line carries
+        it, until stopped: at the end nothing is still on its way to the board."""
+        ahead = Ahead(getattr(dst, "baudrate", None), CHUNK)
+        try:
+            while not stop.is_set():
                 data = _read(src)
-                if data:
-                    dst.write(data)
-            except (serial.SerialException, OSError) as exc:
-                errors.append(f"{name}: {exc}")
-                stop.set()
-                return
-            if data:
-                with lock:
-                    counts[direction] += len(data)
-                    if direction == ">":
-                        end.sent(data)
-                    recorder(direction, time.monotonic() - origin, data)
+                for start in range(0, len(data), CHUNK):
+                    stop.wait(ahead.delay(time.monotonic()))
+                    if stop.is_set():
+                        return  # the rest of what the app sent is not forwarded
+                    chunk = data[start : start + CHUNK]
+                    dst.write(chunk)
+                    ahead.wrote(len(chunk), time.monotonic())
+                    with lock:
+                        counts[direction] += len(chunk)
+                        if direction == ">":
+                            end.sent(chunk)
+                        recorder(direction, time.monotonic() - origin, chunk)
+        except Exception as exc:  # a lost port, a failed recording: end the tap, say why
+            errors.append(f"{name}: {exc}")
+            stop.set()
 
     threads = [
-        threading.Thread(target=forward, args=(app, board, ">", "app side"), daemon=True),
-        threading.Thread(target=forward, args=(board, app, "<", "board side"), daemon=True),
+        threading.Thread(
+            target=forward, args=(app, board, ">", "app side"), name="app side", daemon=True
+        ),
+        threading.Thread(
+            target=forward, args=(board, app, "<", "board side"), name="board side", daemon=True
+        ),
     ]
     if not quiet:
         print(
@@ -95,11 +110,14 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
         pass
     finally:
         stop.set()
-        for thread in threads:  # stop the readers before closing their ports
-            thread.join(2)
+        for thread in threads:  # forwarding ends first: the stop is the last on the wire
+            thread.join(JOIN)
+        stuck = [t.name for t in threads if t.is_alive()]
         with contextlib.suppress(serial.SerialException, OSError):
             board.write(end.stop)  # the app can no longer stop the car
             recorder(">", time.monotonic() - origin, end.stop)
+        if stuck:
+            errors.append(f"{', '.join(stuck)} still writing after {JOIN:g} s: its port is stuck")
         board.close()
         app.close()
         recorder.close()

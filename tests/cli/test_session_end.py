@@ -7,6 +7,7 @@ frame would otherwise swallow. Each test checks the board's own state afterwards
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import subprocess
 import time
@@ -168,3 +169,72 @@ def test_host_close_ends_an_open_frame_then_stops() -> None:
     board = ports[0].board
     assert board.direction == 0
     assert board.params == list(DEFAULTS)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_in_the_middle_of_a_long_write_still_stops_the_car(
+    sig: int, tmp_path: Path
+) -> None:
+    """Issue 22.1: a frame of 120,000 bytes is still being written (at 9600 bps) when the
+    signal comes: the stop must close the part of it that did leave."""
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        proc = _start(["send", "--raw", board.url, "J", "A", "{0:" + "1" * 120_000])
+        try:
+            wait_for(lambda: record.exists() and "A" in sent_lines(record))
+            time.sleep(1.5)  # well into the frame
+            proc.send_signal(sig)
+            proc.communicate(timeout=10)
+        finally:
+            proc.kill()
+        assert proc.returncode == 130
+        # the host wrote no more than a chunk ahead of the line: the stop comes at once
+        wait_for(lambda: sent_lines(record)[-1] in ("{}Z", "Z"), timeout=3.0)
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_two_ending_signals_at_once_still_stop_the_car(tmp_path: Path) -> None:
+    """Issue 22.2: SIGTERM and SIGHUP together (as systemd sends them), the second while
+    the first unwinds: every session still ends with its stop."""
+    record = tmp_path / "board.transcript"
+    trials = 12
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        for trial in range(trials):
+            proc = _start(["send", board.url, "J", "A", "wait:5"])
+            try:
+                wait_for(lambda n=trial: sent_lines(record).count("A") > n)
+                proc.send_signal(signal.SIGTERM)
+                if trial % 2:
+                    time.sleep(0.001 * trial)  # the second lands at different points
+                proc.send_signal(signal.SIGHUP)
+                proc.communicate(timeout=10)
+            finally:
+                proc.kill()
+            assert sent_lines(record)[-1] == "Z", f"trial {trial}: the car was left moving"
+            assert proc.returncode == 130, f"trial {trial}: exit {proc.returncode}"
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+    assert sent_lines(record).count("Z") >= trials
+
+
+def test_tap_stopped_during_a_burst_from_the_app_leaves_the_stop_last(tmp_path: Path) -> None:
+    """Issue 22.3: an app writes J and 30,000 A through tap; SIGTERM. Forwarding ends
+    first: nothing the app sent reaches the board after the tap's Z."""
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        proc = _start(["tap", "pty", board.url, "--record", str(tmp_path / "tap.transcript")])
+        try:
+            assert proc.stdout is not None
+            app_side = proc.stdout.readline().decode().removeprefix("port: ").strip()
+            with serial.Serial(app_side, 9600, timeout=0.1, write_timeout=0) as app:
+                with contextlib.suppress(serial.SerialTimeoutException):
+                    app.write(b"J" + b"A" * 30_000)
+                wait_for(lambda: sent_lines(record).count("A") > 200)
+                proc.send_signal(signal.SIGTERM)
+                _, err = proc.communicate(timeout=10)
+        finally:
+            proc.kill()
+        assert "Traceback" not in err.decode()
+        wait_for(lambda: sent_lines(record)[-1] == "Z", timeout=3)
+        time.sleep(0.5)
+        assert sent_lines(record)[-1] == "Z", "bytes reached the board after the stop"
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
