@@ -135,6 +135,7 @@ class Check:
     matched: int = 0
     closest: dict[str, tuple[float, str]] = field(default_factory=dict)
     """Per letter, the unmatched record nearest the expectation's time: what came instead."""
+    _end: float | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         tolerance, strict, last_send, align = TOLERANCE, False, 0.0, False
@@ -190,9 +191,11 @@ class Check:
 
     @property
     def end(self) -> float:
-        """When the run is over at the latest."""
-        last = max((e.entry.time + e.tolerance for e in self.expectations), default=0.0)
-        return max(last, self.transcript.duration)
+        """When the run is over at the latest (worked out once: runners ask each step)."""
+        if self._end is None:
+            last = max((e.entry.time + e.tolerance for e in self.expectations), default=0.0)
+            self._end = max(last, self.transcript.duration)
+        return self._end
 
     def due(self, now: float) -> list[tuple[str, bytes]]:
         """The `>` and `2>` payloads to send by `now`, each with its port."""

@@ -44,3 +44,18 @@ def test_coalescing_a_long_run_is_linear() -> None:
     assert [type(e) for e in merged] == [Garbage, Noise]
     assert merged[0].raw == b"x" * (2 * SIZE) and merged[1].raw == b"q" * 1000
     assert elapsed < BOUND
+
+
+def test_conform_on_virtual_time_is_linear_in_what_the_transcript_sends() -> None:
+    """Issue 22.7: 25,000 `>` lines sent faster than 9600 bps carries them took 26 s
+    (every step re-read every line); a linear run takes well under a second."""
+    from appmode.protocol.transcript import parse_transcript
+    from appmode.transcript.runner import run_virtual
+
+    lines = [f"{i * 0.0001:.4f} > AAAAAAAA" for i in range(25_000)]
+    text = "\n".join(["# appmode transcript v1", *lines, "30.000 < {A*:*:*:*}$", ""])
+    start = time.perf_counter()
+    result = run_virtual(parse_transcript(text))
+    elapsed = time.perf_counter() - start
+    assert result.passed, result.failure
+    assert elapsed < BOUND / 2, f"{elapsed:.1f} s for 25,000 lines"
