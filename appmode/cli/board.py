@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import Subparsers, add_profile, add_record, number_type
+from appmode.cli.options import Subparsers, add_profile, add_record, file_name, number_type
 from appmode.protocol.params import DRIVE_NAMES
 
 
@@ -53,6 +53,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     board.add_argument(
         "--link",
+        type=file_name,
         metavar="PATH",
         help="with --pty: keep a symlink PATH to the pty, so clients find a restarted board "
         "at the same path",
@@ -67,6 +68,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     board.add_argument(
         "--flash",
+        type=file_name,
         metavar="FILE",
         help="keep saved parameters in this JSON file (default: in memory)",
     )

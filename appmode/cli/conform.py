@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.cli.options import Subparsers, add_profile
+from appmode.cli.options import Subparsers, add_profile, file_name
 from appmode.errors import AppmodeError
 
 
@@ -40,7 +40,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "run the transcripts written for this board profile (@board profile=…); "
         "without --board, on a simulated board of that profile",
     )
-    conform.add_argument("--junit", metavar="FILE", help="also write a JUnit XML report")
+    conform.add_argument(
+        "--junit", type=file_name, metavar="FILE", help="also write a JUnit XML report"
+    )
     conform.add_argument(
         "--yes",
         action="store_true",

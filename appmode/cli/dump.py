@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.cli.options import Subparsers, add_profile
+from appmode.cli.options import Subparsers, add_profile, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -14,7 +14,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="decode a transcript",
         description="Decode every command and record of a transcript: text, JSON Lines or CSV.",
     )
-    dump.add_argument("file", metavar="FILE", help="the transcript")
+    dump.add_argument("file", type=file_name, metavar="FILE", help="the transcript")
     fmt = dump.add_mutually_exclusive_group()
     fmt.add_argument("--json", action="store_true", help="JSON Lines")
     fmt.add_argument("--csv", action="store_true", help="CSV with a header row")

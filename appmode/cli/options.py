@@ -36,9 +36,19 @@ def add_uart2(parser: argparse.ArgumentParser, what: str) -> None:
     )
 
 
+def file_name(text: str) -> str:
+    """A file argument: an empty one would be taken for none, and nothing written."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty file name: name a file")
+    return text
+
+
 def add_record(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--record", metavar="FILE", help="record the session as a transcript (flushed line by line)"
+        "--record",
+        type=file_name,
+        metavar="FILE",
+        help="record the session as a transcript (flushed line by line)",
     )
 
 

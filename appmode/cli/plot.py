@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -15,8 +15,10 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         description="Draw velocities, attitude and battery over time, with the commands "
         "marked, to a PNG. Needs matplotlib: pip install matplotlib.",
     )
-    plot.add_argument("file", metavar="FILE", help="the transcript")
-    plot.add_argument("-o", "--output", required=True, metavar="PNG", help="the image to write")
+    plot.add_argument("file", type=file_name, metavar="FILE", help="the transcript")
+    plot.add_argument(
+        "-o", "--output", required=True, type=file_name, metavar="PNG", help="the image to write"
+    )
     return plot
 
 

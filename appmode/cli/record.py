@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from appmode.cli.monitor import add_limits, run_monitor
-from appmode.cli.options import Subparsers, add_url
+from appmode.cli.options import Subparsers, add_url, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -18,7 +18,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "with appmode dump or plot.",
     )
     add_url(rec)
-    rec.add_argument("file", metavar="FILE", help="the transcript to write")
+    rec.add_argument("file", type=file_name, metavar="FILE", help="the transcript to write")
     add_limits(rec, "count only these (the transcript holds everything)")
     return rec
 

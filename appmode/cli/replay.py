@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import DAY, Subparsers, number_type
+from appmode.cli.options import DAY, Subparsers, file_name, number_type
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -15,7 +15,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "feeding an app) to a port, each at its time from the start. As the host the replay "
         "ends with Z.",
     )
-    replay.add_argument("file", metavar="FILE", help="the transcript")
+    replay.add_argument("file", type=file_name, metavar="FILE", help="the transcript")
     replay.add_argument(
         "--to",
         required=True,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -17,7 +17,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     tap.add_argument("app", metavar="URL_APP", help="the app's side (or 'pty')")
     tap.add_argument("board", metavar="URL_BOARD", help="the board's side")
-    tap.add_argument("--record", required=True, metavar="FILE", help="the transcript to write")
+    tap.add_argument(
+        "--record", required=True, type=file_name, metavar="FILE", help="the transcript to write"
+    )
     tap.add_argument("--quiet", "-q", action="store_true", help="no status lines")
     return tap
 

@@ -117,3 +117,25 @@ def test_running_out_of_ptys_is_one_line() -> None:
     assert done.returncode == 2
     assert done.stderr.startswith("appmode: error: cannot open another pseudo-terminal")
     assert done.stderr.count("\n") == 1 and "--count" in done.stderr
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("record", "sim://", "", "--count", "3"),
+        ("send", "sim://", "J", "--record", ""),
+        ("drive", "--record", " "),
+        ("board", "--flash", ""),
+        ("conform", "--junit", ""),
+        ("tap", "pty", "sim://", "--record", ""),
+        ("dump", ""),
+        ("plot", "x.transcript", "-o", ""),
+    ],
+    ids=lambda a: " ".join(a[:2]),
+)
+def test_an_empty_file_name_is_refused_not_taken_for_none(args: tuple[str, ...]) -> None:
+    """Issue 22.11: `record sim:// ''` used to say it recorded and write nothing."""
+    done = run(*args, timeout=20)
+    assert done.returncode == 2
+    assert "an empty file name: name a file" in done.stderr
+    assert "Traceback" not in done.stderr
