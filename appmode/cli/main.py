@@ -91,9 +91,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except AppmodeError as exc:
         print(f"appmode: error: {exc}", file=sys.stderr)
         return 2
-    except ValueError as exc:
-        print(f"appmode: error: {exc}", file=sys.stderr)
-        return 2
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:  # the reader left (`| head`): end quietly, as cat does

@@ -16,6 +16,7 @@ from __future__ import annotations
 import signal
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from typing import Any
 
 ENDING_SIGNALS: tuple[signal.Signals, ...] = tuple(
     getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
@@ -28,6 +29,7 @@ class _Ending:
         self.depth = 0  # atomic steps under way
         self.pending = False  # a signal came during one
         self.action: Callable[[], None] | None = None
+        self.before: dict[int, Any] = {}  # the handlers install() replaced
 
 
 _ending = _Ending()
@@ -38,15 +40,16 @@ def install() -> None:
     ending acted on before is forgotten."""
     _ending.ended = _ending.pending = False
     for signum in (signal.SIGINT, *ENDING_SIGNALS):
-        signal.signal(signum, _handle)
+        _ending.before[signum] = signal.signal(signum, _handle)
 
 
 def finish() -> None:
     """The command is over: after an ending, further signals are ignored to the end
-    (the interpreter's shutdown would otherwise meet them with the default action)."""
-    if _ending.ended:
-        for signum in (signal.SIGINT, *ENDING_SIGNALS):
-            signal.signal(signum, signal.SIG_IGN)
+    (the interpreter's shutdown would otherwise meet them with the default action);
+    else the handlers `install` found are put back."""
+    for signum, before in _ending.before.items():
+        signal.signal(signum, signal.SIG_IGN if _ending.ended else before)
+    _ending.before.clear()
 
 
 def _handle(signum: int, frame: object) -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from appmode.errors import InvalidValue
 from appmode.protocol import app, params, settings
 from appmode.protocol.params import DriveType
 from appmode.protocol.settings import Read, Setting, StoreOp
@@ -178,7 +179,7 @@ def system_mode_set(event: object) -> int | None:
 
 def _check(name: str, value: int, maximum: int) -> None:
     if not -maximum <= value <= maximum:
-        raise ValueError(f"{name} must be in −{maximum}…{maximum}, not {value}")
+        raise InvalidValue(f"{name} must be in −{maximum}…{maximum}, not {value}")
 
 
 def _signs(values: tuple[int, ...], bits: tuple[int, ...]) -> int:
@@ -204,20 +205,22 @@ def velocity(
     diff-gyro; `angle` (0.1°, signed) instead of z on all but diff-gyro."""
     if drive is DriveType.DIFF_GYRO:
         if x or y or z or angle is not None:
-            raise ValueError("a diff-gyro car takes left and right duties, not x, y, z or an angle")
+            raise InvalidValue(
+                "a diff-gyro car takes left and right duties, not x, y, z or an angle"
+            )
         _check("left", left, MAX_DUTY)
         _check("right", right, MAX_DUTY)
         return VelocityFrame(left, right, 0)
     if left or right:
-        raise ValueError(f"a {drive.cli_name} car takes x, y, z, not left and right")
+        raise InvalidValue(f"a {drive.cli_name} car takes x, y, z, not left and right")
     limit = MAX_DUTY if drive.differential else U16
     if drive.differential and x:
-        raise ValueError("a diff car has no x: its TX[3..4] is reserved")
+        raise InvalidValue("a diff car has no x: its TX[3..4] is reserved")
     _check("x", x, limit)
     _check("y", y, limit)
     if angle is not None:
         if z:
-            raise ValueError("give z or an angle, not both")
+            raise InvalidValue("give z or an angle, not both")
         _check("angle", angle, U16)
         return VelocityFrame(x, y, angle, angle=True)
     _check("z", z, limit)
@@ -235,7 +238,7 @@ def encode(item: HostFrame | Reply | EncoderReport, motor_width: int = 2) -> byt
     if isinstance(item, MotorFrame):
         count = len(item.speeds)
         if count not in _MOTOR_BITS:
-            raise ValueError(f"a motor frame has 3 or 4 speeds, not {count}")
+            raise InvalidValue(f"a motor frame has 3 or 4 speeds, not {count}")
         top = 0xFF if motor_width == 1 else U16
         for i, speed in enumerate(item.speeds):
             _check(f"motor {i + 1}", speed, top)
@@ -252,7 +255,7 @@ def encode(item: HostFrame | Reply | EncoderReport, motor_width: int = 2) -> byt
     if isinstance(item, SetSetting):
         error = settings.value_error(item.setting, item.value)
         if error is not None:
-            raise ValueError(error)
+            raise InvalidValue(error)
         return _settings_frame(item.setting.id, item.value)
     if isinstance(item, StoreFrame):
         return _settings_frame(settings.STORE_ID, settings.STORE_PREFIX << 16 | item.op.code)
@@ -292,7 +295,7 @@ def store(name: str) -> StoreFrame:
     try:
         return StoreFrame(settings.STORE_BY_NAME[name])
     except KeyError:
-        raise ValueError(
+        raise InvalidValue(
             f"unknown store operation {name!r}: use {', '.join(settings.STORE_BY_NAME)}"
         ) from None
 

@@ -10,6 +10,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import IntEnum
 
+from appmode.errors import InvalidValue
+
 U16 = 0xFFFF
 U32 = 0xFFFF_FFFF
 
@@ -70,7 +72,7 @@ class DriveType(IntEnum):
             if text == name:
                 return drive
         choices = ", ".join(_DRIVE_CLI_NAMES.values())
-        raise ValueError(f"unknown drive type {name!r}: choose one of {choices}")
+        raise InvalidValue(f"unknown drive type {name!r}: choose one of {choices}")
 
 
 _DRIVE_CLI_NAMES = {
@@ -137,7 +139,7 @@ def check_value(index: int, value: int) -> None:
     """Raise ValueError naming the parameter and its range when `value` is not allowed."""
     error = value_error(index, value)
     if error is not None:
-        raise ValueError(error)
+        raise InvalidValue(error)
 
 
 def whole(text: str) -> int | None:
@@ -158,7 +160,7 @@ def lookup(key: str | int) -> Param:
     elif key in BY_NAME:
         return BY_NAME[key]
     names = ", ".join(p.name for p in PARAMS)
-    raise ValueError(f"unknown parameter {key!r}: use 0–{PARAM_COUNT - 1} or one of {names}")
+    raise InvalidValue(f"unknown parameter {key!r}: use 0–{PARAM_COUNT - 1} or one of {names}")
 
 
 _BOUNDS = tuple((p.minimum, p.maximum) for p in PARAMS)

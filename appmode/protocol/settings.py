@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from appmode.errors import InvalidValue
 from appmode.protocol import params
 
 
@@ -78,7 +79,7 @@ def lookup(key: str) -> Setting:
     if text in BY_NAME:
         return BY_NAME[text]
     names = ", ".join(s.name for s in SETTINGS)
-    raise ValueError(f"unknown setting {key!r}: use 1–{len(SETTINGS)} or one of {names}")
+    raise InvalidValue(f"unknown setting {key!r}: use 1–{len(SETTINGS)} or one of {names}")
 
 
 # ---------------------------------------------------------------- load and save (SS 00)
@@ -160,4 +161,4 @@ def read_named(key: str) -> Read:
         if ss in READ_BY_SS:
             return READ_BY_SS[ss]
     names = ", ".join(READ_BY_NAME)
-    raise ValueError(f"unknown read {key!r}: use one of {names}")
+    raise InvalidValue(f"unknown read {key!r}: use one of {names}")

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 
 def appmode(*args: str, stdin: bytes = b"") -> subprocess.CompletedProcess[bytes]:
     return subprocess.run(
@@ -61,3 +63,31 @@ def test_demo_prints_the_route_and_records() -> None:
     assert "< {C800:" in text, "the route's set is read back"
     assert "velocity x=0 y=500 z=0" in text, "forward at max speed on a differential drive"
     assert text.count("< {A") > 20 and text.count("< {B") > 20
+
+
+def test_only_our_own_errors_become_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 22.14: a ValueError from a bug is not dressed up as a user's mistake; a value
+    out of range (InvalidValue, a ValueError too) is one line, as before."""
+    from appmode.cli import main as cli_main
+    from appmode.cli import ports
+    from appmode.errors import InvalidValue
+
+    def buggy(args: object) -> int:
+        raise ValueError("a bug")
+
+    monkeypatch.setattr(ports, "run", buggy)
+    with pytest.raises(ValueError, match="a bug"):
+        cli_main.main(["ports"])
+
+    def refused(args: object) -> int:
+        raise InvalidValue("max_speed (parameter 0) must be in 0–65535, not 70000")
+
+    monkeypatch.setattr(ports, "run", refused)
+    assert cli_main.main(["ports"]) == 2
+
+
+def test_the_errors_the_docs_name_are_importable_from_appmode() -> None:
+    import appmode
+
+    assert issubclass(appmode.TranscriptError, appmode.AppmodeError)
+    assert {"AppmodeError", "TranscriptError"} <= set(appmode.__all__)
