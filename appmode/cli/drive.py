@@ -16,6 +16,7 @@ from appmode.cli.options import (
     layout_for,
     number_type,
     profile_for,
+    stop_again_for,
 )
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from appmode.errors import AppmodeError
@@ -110,7 +111,9 @@ def run(args: argparse.Namespace) -> int:
         if args.drive_type:
             raise AppmodeError("--drive-type is for the control port: add --uart2")
         return run_drive(
-            Session(url, driving, args.record, on_message, layout),
+            Session(
+                url, driving, args.record, on_message, layout, stop_again_for(url, args.profile)
+            ),
             interactive,
             sys.stdin,
             sys.stdout,

@@ -26,9 +26,18 @@ def open_host(
     record: str | None,
     stop_on_close: bool = True,
     layout: ALayout = VELOCITY,
+    stop_again: bytes | None = None,
 ) -> Host:
-    """The APP host, then its recording (`with_recording`)."""
-    return with_recording(stack, Host(url, stop_on_close=stop_on_close, layout=layout), record)
+    """The APP host, then its recording (`with_recording`). With `stop_again` it confirms
+    its stop on the board's A records, sending those bytes while the car still moves."""
+    host = Host(
+        url,
+        stop_on_close=stop_on_close,
+        layout=layout,
+        confirm_stop=stop_again is not None,
+        stop_again=stop_again or b"",
+    )
+    return with_recording(stack, host, record)
 
 
 def with_recording(stack: ExitStack, host: H, record: str | None) -> H:

@@ -12,6 +12,7 @@ from serial import SerialException
 
 from appmode.board.profiles import PROFILE_NAMES, PROFILES, SHEET, Profile
 from appmode.ports.sim import parse_sim_url
+from appmode.protocol.app import stop_again
 from appmode.protocol.layouts import ALayout
 
 URL_FORMS = (
@@ -81,6 +82,11 @@ def profile_for(url: str | None, name: str | None) -> Profile:
         with contextlib.suppress(SerialException):
             name = parse_sim_url(url).get("profile")
     return PROFILES.get(name or "sheet", SHEET)
+
+
+def stop_again_for(url: str | None, name: str | None) -> bytes:
+    """What a host sends when its stop did not take, on `profile_for(url, name)`."""
+    return stop_again(frames_take_letters=not profile_for(url, name).steer_in_frames)
 
 
 def layout_for(url: str | None, name: str | None) -> ALayout:

@@ -18,6 +18,7 @@ from appmode.cli.options import (
     add_url,
     layout_for,
     number_type,
+    stop_again_for,
 )
 from appmode.host import control_tokens
 from appmode.host.tokens import Wait, parse_token
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
         record=args.record,
         out=sys.stdout,
         layout=layout_for(args.url, args.profile),
+        stop_again=stop_again_for(args.url, args.profile),
     )
 
 
@@ -92,11 +94,13 @@ def run_send(
     record: str | None,
     out: TextIO,
     layout: ALayout = VELOCITY,
+    stop_again: bytes | None = None,
 ) -> int:
-    """Send the tokens in order, printing what comes back; `Z` is always sent last."""
+    """Send the tokens in order, printing what comes back; `Z` is always sent last (and
+    with `stop_again`, confirmed on the board's A records)."""
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:
-        host = open_host(stack, url, record, layout=layout)
+        host = open_host(stack, url, record, layout=layout, stop_again=stop_again)
         for step in steps:
             if isinstance(step, Wait):
                 for event in host.events(step.seconds):
@@ -112,6 +116,8 @@ def run_send(
             show(host, event, out, as_json)
         stop_text = host.state.end.stop_text  # what the stop below will do
         stop = host.close()
+        for note in host.notes:
+            print(f"appmode: WARNING: {note}", file=sys.stderr)
         if stop is None:
             print("appmode: the link is down: the final Z was not sent", file=sys.stderr)
             return 1

@@ -278,6 +278,7 @@ async def run_app(app: Application[None], session: BaseSession) -> None:
     # own signal handlers are not used: removing them restores the default action (a
     # SIGHUP would then kill the process before its `Z`), and Windows has none.
     loop = asyncio.get_running_loop()
+
     def on_signal() -> None:
         loop.call_soon_threadsafe(quit_app)
 
@@ -304,12 +305,16 @@ def run_drive(
             run_script(session, script, out)
     finally:
         warning = session.unsaved_warning()
-        session.close()
-        if warning is not None:
-            print(
-                f"appmode: {warning}: the board keeps it until it is switched off",
-                file=sys.stderr,
-            )
+        try:
+            session.close()
+        finally:
+            for note in session.closing_notes:
+                print(f"appmode: WARNING: {note}", file=sys.stderr)
+            if warning is not None:
+                print(
+                    f"appmode: {warning}: the board keeps it until it is switched off",
+                    file=sys.stderr,
+                )
     return 0
 
 

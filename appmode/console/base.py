@@ -98,6 +98,8 @@ class BaseSession(ABC):
             "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None}
         }
         """What the command line completes after a command's name."""
+        self.closing_notes: list[str] = []
+        """What closing had to do beyond its stop, for people (shown after the console)."""
 
     # ------------------------------------------------------------ what a session is
 

@@ -72,9 +72,16 @@ class Session(BaseSession):
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
         layout: ALayout = VELOCITY,
+        stop_again: bytes | None = None,
     ) -> None:
         super().__init__(url, driving, on_message)
-        self.host = Host(url, tap=self._tap, layout=layout)
+        self.host = Host(
+            url,
+            tap=self._tap,
+            layout=layout,
+            confirm_stop=stop_again is not None,
+            stop_again=stop_again or b"",
+        )
         self.page = Page.DIRECTION
         self.page_letter = "J"
         self.in_force = STOP_LETTER
@@ -95,11 +102,13 @@ class Session(BaseSession):
         self.host.start_query(ParamQuery(where=self.url))
 
     def close(self) -> None:
-        """Stop the car — `Z` is the last byte sent — and close everything."""
+        """Stop the car — `Z` is the last byte sent, and with `stop_again` confirmed on
+        the board's A records — and close everything."""
         try:
             self.host.close()
         finally:
             self._drop_recorder()
+            self.closing_notes += self.host.notes
 
     # ------------------------------------------------------------ time
 

@@ -17,11 +17,17 @@ from appmode.errors import AppmodeError
 from appmode.host.link import Link, LinkLost
 from appmode.host.query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
+from appmode.host.stop_check import SETTLE, StopCheck
 from appmode.line.wire import UART2, Tap
 from appmode.ports.link import is_simulated, open_link
 from appmode.ports.sim import sim_side
 from appmode.protocol import app, params
+from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.render import motion_text
+
+CONFIRM_STEP = 0.05
+"""Seconds between looks at the clock while a stop is being confirmed."""
 
 Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning
 
@@ -37,6 +43,8 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         opener: Callable[[str], serial.SerialBase] = open_link,
         stop_on_close: bool = True,
         layout: ALayout = VELOCITY,
+        confirm_stop: bool = False,
+        stop_again: bytes = app.stop_again(frames_take_letters=True),
     ) -> None:
         if is_simulated(url) and sim_side(url) == UART2:
             raise AppmodeError(
@@ -46,6 +54,12 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         super().__init__(url, tap, clock, opener)
         self.stop_on_close = stop_on_close
         self.state = HostState(layout)
+        self.confirm_stop = confirm_stop
+        """Check on the board's A records that the final stop took (`_confirm`)."""
+        self.stop_again = stop_again
+        """What to send when it did not (`app.stop_again` for the board's profile)."""
+        self.notes: list[str] = []
+        """What closing had to do beyond its stop, for people."""
 
     def _on_lost(self) -> None:
         self.state.reset_decoder()
@@ -108,3 +122,37 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
 
     def _stop(self) -> bytes:
         return self.state.end.stop
+
+    def _before_stop(self) -> None:
+        if self.confirm_stop:
+            self.poll_nowait()  # records from before the stop must not confirm it
+
+    def _confirm(self) -> None:
+        """With `confirm_stop`, once the board has sent A records: wait for one showing
+        the car at rest; send `stop_again` while none does (`stop_check`)."""
+        if not self.confirm_stop or self.state.velocity is None:
+            return
+        check = StopCheck(self.state.layout, self.stop_again, self.now())
+        while True:
+            for event in self.poll(CONFIRM_STEP):
+                if isinstance(event, app.Velocity) and check.at_rest(event):
+                    return
+            again = check.on_time(self.now())
+            if again is None:
+                shown = (
+                    ""
+                    if check.moving is None
+                    else f" ({motion_text(check.moving, self.state.layout)})"
+                )
+                raise AppmodeError(
+                    f"the car may still be moving: it did not stop{shown} after {check.tries} "
+                    f"stops, the last {escape(self.stop_again)}; the control port (UART2) may "
+                    "have taken over, or the board does not obey this port: stop it by hand "
+                    f"(its A records were read as the {self.state.layout.name} layout: if "
+                    "that is not this board's, give its --profile)"
+                )
+            if again:
+                self.notes.append(
+                    f"the car still moved {SETTLE:g} s after the stop: sent {escape(again)}"
+                )
+                self.send(again)

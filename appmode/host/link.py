@@ -204,8 +204,9 @@ class Link(Generic[E]):
         raise NotImplementedError
 
     def close(self) -> bytes | None:
-        """Stop the car (`_stop()` is the last thing sent), then close the port. Returns
-        the bytes of that stop, or None if the link was down. A passive host
+        """Stop the car (`_stop()` is the last thing sent), check that it took where the
+        protocol can (`_confirm`: AppmodeError if it did not), then close the port.
+        Returns the bytes of that stop, or None if the link was down. A passive host
         (`stop_on_close` False, a monitor) sends nothing. An ending signal waits until
         the stop has been written."""
         with signals.atomic():
@@ -214,17 +215,29 @@ class Link(Generic[E]):
             stop = self._stop() if self.stop_on_close else b""
             try:
                 if stop:
+                    self._before_stop()
+                    stop = self._stop()  # what was read may change it
                     self.send(stop)
             except LinkLost:
                 return self.close()  # the port is gone: nothing was sent
             except AppmodeError:
                 pass  # written; only its recording failed, which must not keep it open
-        if self._port is not None:
-            with contextlib.suppress(serial.SerialException, OSError):
-                self._port.flush()
-            self._port.close()
-            self._port = None
+        try:
+            if stop:
+                self._confirm()
+        finally:
+            if self._port is not None:
+                with contextlib.suppress(serial.SerialException, OSError):
+                    self._port.flush()
+                self._port.close()
+                self._port = None
         return stop
+
+    def _before_stop(self) -> None:
+        """Just before the stop is sent (a host that checks it reads what is waiting)."""
+
+    def _confirm(self) -> None:
+        """After the stop: AppmodeError if the board shows it did not take."""
 
     def __enter__(self: L) -> L:
         return self

@@ -406,6 +406,16 @@ ABANDON_FRAME = b"{}"
 an empty frame, which changes nothing."""
 
 
+def stop_again(frames_take_letters: bool) -> bytes:
+    """What to send when a stop did not take (the car still moves): where a frame takes
+    letters (the sheet, §2.2) a frame another program left open may have swallowed the
+    `Z`: `{` drops it unapplied and `}` closes the empty frame; `K` ends a button-page
+    rotation left by `I`/`J` (§13) and `J` goes back to the direction page; then `Z`.
+    Where every byte steers even inside a frame (the reference firmware, §13) no brace is
+    sent: there a `}` would apply a half-sent set."""
+    return (ABANDON_FRAME if frames_take_letters else b"") + b"KJ" + encode(Stop())
+
+
 class SessionEnd:
     """Follows what a host sends, so that its last bytes stop the car (§2.1).
 

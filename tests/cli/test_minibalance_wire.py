@@ -60,7 +60,7 @@ def test_s13_a_set_the_board_changes_or_ignores_fails_saying_what_it_did(
 
 
 def test_s13_an_out_of_range_value_is_shown_and_repaired(board: BoardProcess) -> None:
-    done = run("send", board.url, "--raw", "{0:75207}")
+    done = run("send", board.url, "--raw", "{0:75207}", "--profile", "minibalance")
     assert done.returncode == 0, done.stderr
     shown = run("params", board.url)
     assert shown.returncode == 0, "the read worked: the board holds that value"

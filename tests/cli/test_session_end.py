@@ -238,3 +238,34 @@ def test_tap_stopped_during_a_burst_from_the_app_leaves_the_stop_last(tmp_path: 
         time.sleep(0.5)
         assert sent_lines(record)[-1] == "Z", "bytes reached the board after the stop"
         assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_a_stop_swallowed_by_a_frame_another_program_left_open_is_sent_again() -> None:
+    """Issue 22.4: `printf 'JA{Q:P'` from another program leaves a frame open, which
+    swallows the session's Z: the host sees the car still moving on its A records,
+    drops that frame unapplied, and stops again."""
+    with board_process("--pty", "--quiet") as board:
+        with serial.Serial(board.url, 9600) as other:
+            other.write(b"JA{Q:P")
+        time.sleep(0.5)
+        done = run("send", board.url, "Z", "--listen", "0.3")
+        assert done.returncode == 0, done.stderr
+        assert "WARNING: the car still moved 1.5 s after the stop: sent {}KJZ" in done.stderr
+        assert board_state(board.url) == (STOPPED, DEFAULTS)
+
+
+def test_a_car_that_never_stops_is_said_to_be_maybe_moving(tmp_path: Path) -> None:
+    """Issue 22.4: UART2 has taken over and drives; the APP port's stops cannot take.
+    After a bounded number of tries: one line, exit 2."""
+    with (
+        board_process("--pty", "--quiet") as board,
+        serial.Serial(board.uart2, 115200) as control,
+    ):
+        control.write(bytes.fromhex("FF FE 01 00 00 01 2C 00 00 00"))  # y = 300
+        time.sleep(0.5)
+        done = run("send", board.url, "J", "--listen", "0.2")
+        control.write(bytes.fromhex("FF FE 01 00 00 00 00 00 00 00"))
+    assert done.returncode == 2
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("appmode: error: the car may still be moving: it did not stop")
+    assert "after 3 stops" in last and "UART2" in last
