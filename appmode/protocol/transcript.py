@@ -7,7 +7,7 @@ import contextlib
 import itertools
 import os
 import re
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import BinaryIO, TextIO
 
@@ -73,6 +73,7 @@ class Recorder:
     def create(
         cls, path: str | os.PathLike[str], origin: float = 0.0, directives: tuple[str, ...] = ()
     ) -> Recorder:
+        new = not os.path.lexists(path)
         try:
             out = open(path, "w", encoding="utf-8")  # noqa: SIM115 - owned by the recorder
         except OSError as exc:
@@ -81,9 +82,12 @@ class Recorder:
             ) from None
         try:
             recorder = cls(out, origin, directives)
-        except AppmodeError:
+        except AppmodeError:  # not even the header fits (a full disk): leave nothing
             with contextlib.suppress(OSError):
                 out.close()
+            if new:
+                with contextlib.suppress(OSError):
+                    os.unlink(path)
             raise
         recorder._owned = True
         return recorder
@@ -171,6 +175,8 @@ class Transcript:
     items: tuple[Entry | Directive, ...]
     title: str = ""
     """The first comment after the header: what the transcript checks."""
+    warnings: tuple[str, ...] = ()
+    """What was left out: a last line cut short."""
 
     @property
     def entries(self) -> list[Entry]:
@@ -186,16 +192,21 @@ class TranscriptError(AppmodeError):
 
 
 def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
-    """Read transcript text; TranscriptError names the file, the line and what is wrong."""
+    """Read transcript text; TranscriptError names the file, the line and what is wrong.
+    A last line with no newline that cannot be read is left out, with a warning."""
     # lines end at \n only: form feeds and U+2028 in comments do not shift line numbers
     lines = text.removeprefix("\ufeff").split("\n")  # a BOM some editors write
-    return _parse(enumerate(lines, start=1), path)
+    last = len(lines)
+    numbered = ((n, line.encode(), n < last) for n, line in enumerate(lines, start=1))
+    return _parse(numbered, path)
 
 
 def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
     """Read a transcript file; TranscriptError (file:line, with `name` in place of the
     path if given) or AppmodeError if unreadable. Read a line at a time, each at most
-    MAX_LINE bytes: a file that is no transcript (/dev/zero, a binary) fails at once."""
+    MAX_LINE bytes: a file that is no transcript (/dev/zero, a binary) fails at once. A
+    last line cut short (a recording stopped by a full disk) is left out, with a warning
+    in `warnings`."""
     name = name or os.fspath(path)
     try:
         with open(path, "rb") as handle:
@@ -204,7 +215,27 @@ def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Tr
         raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
 
 
-def _file_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, str]]:
+def iter_transcript(
+    path: str | os.PathLike[str], warn: Callable[[str], None], directives_only: bool = False
+) -> Iterator[Entry | Directive]:
+    """The lines of a transcript file one at a time, in constant memory, as
+    `read_transcript` reads them; `warn` hears of a last line cut short. With
+    `directives_only`, only the `@` lines are read (a quick first pass)."""
+    name = os.fspath(path)
+    try:
+        with open(path, "rb") as handle:
+            lines = _file_lines(handle, name)
+            if directives_only:
+                lines = (line for line in lines if line[1].lstrip().startswith(b"@"))
+            for item in _items(lines, name, warn):
+                if not isinstance(item, str):
+                    yield item
+    except OSError as exc:
+        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
+
+
+def _file_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, bytes, bool]]:
+    """(line number, bytes, whether a newline ended it)."""
     for lineno in itertools.count(1):
         raw = handle.readline(MAX_LINE + 1)
         if not raw:
@@ -215,40 +246,61 @@ def _file_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, str]]:
             )
         if lineno == 1:
             raw = raw.removeprefix(codecs.BOM_UTF8)
-        try:
-            yield lineno, raw.decode("utf-8").removesuffix("\n")
-        except UnicodeDecodeError as exc:
-            raise TranscriptError(
-                f"{name}:{lineno}: not UTF-8 text (byte {exc.start + 1} of the line)"
-            ) from None
+        yield lineno, raw.removesuffix(b"\n"), raw.endswith(b"\n")
 
 
-def _parse(lines: Iterable[tuple[int, str]], path: str) -> Transcript:
+def _parse(lines: Iterable[tuple[int, bytes, bool]], path: str) -> Transcript:
     items: list[Entry | Directive] = []
+    warnings: list[str] = []
     title = ""
-    for lineno, line in lines:
-        line = line.removesuffix("\r")
-        where = f"{path}:{lineno}"
-        stripped = line.strip()
-        if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
-            raise TranscriptError(
-                f"{where}: {_cut(stripped[2:])!r} is not a version this appmode reads (it reads v1)"
-            )
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            if not title and stripped != HEADER:
-                title = stripped.lstrip("# ").strip()
-            continue
-        if stripped.startswith("@"):
-            name, *args = stripped[1:].split() or [""]
-            if name not in DIRECTIVES:
-                known = ", ".join(f"@{d}" for d in DIRECTIVES)
-                raise TranscriptError(f"{where}: unknown directive @{_cut(name)} (known: {known})")
-            items.append(Directive(lineno, name, tuple(args)))
-            continue
-        items.append(_entry(line.rstrip("\r\n"), lineno, where))
-    return Transcript(path, tuple(items), title)
+    for item in _items(lines, path, warnings.append):
+        if isinstance(item, str):
+            title = title or item
+        else:
+            items.append(item)
+    return Transcript(path, tuple(items), title, tuple(warnings))
+
+
+def _items(
+    lines: Iterable[tuple[int, bytes, bool]], path: str, warn: Callable[[str], None]
+) -> Iterator[Entry | Directive | str]:
+    """Each line's item; a comment as its text (the first one is the title)."""
+    for lineno, raw, ended in lines:
+        try:
+            item = _item(raw, lineno, path)
+        except TranscriptError as exc:
+            if ended:
+                raise
+            warn(f"{exc}; it is the last line and has no end: cut short, left out")
+            return
+        if item is not None:
+            yield item
+
+
+def _item(raw: bytes, lineno: int, path: str) -> Entry | Directive | str | None:
+    where = f"{path}:{lineno}"
+    try:
+        line = raw.decode("utf-8").removesuffix("\r")
+    except UnicodeDecodeError as exc:
+        raise TranscriptError(
+            f"{where}: not UTF-8 text (byte {exc.start + 1} of the line)"
+        ) from None
+    stripped = line.strip()
+    if lineno == 1 and stripped.startswith("# appmode transcript") and stripped != HEADER:
+        raise TranscriptError(
+            f"{where}: {_cut(stripped[2:])!r} is not a version this appmode reads (it reads v1)"
+        )
+    if not stripped:
+        return None
+    if stripped.startswith("#"):
+        return None if stripped == HEADER else stripped.lstrip("# ").strip()
+    if stripped.startswith("@"):
+        name, *args = stripped[1:].split() or [""]
+        if name not in DIRECTIVES:
+            known = ", ".join(f"@{d}" for d in DIRECTIVES)
+            raise TranscriptError(f"{where}: unknown directive @{_cut(name)} (known: {known})")
+        return Directive(lineno, name, tuple(args))
+    return _entry(line.rstrip("\r\n"), lineno, where)
 
 
 def _cut(text: str, limit: int = 60) -> str:

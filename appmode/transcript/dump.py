@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import csv
 import json
-from collections.abc import Iterator
+import sys
+from collections.abc import Callable, Iterable, Iterator
 from io import BytesIO
 from pathlib import Path
 from typing import Any, TextIO
@@ -14,10 +15,24 @@ from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.protocol import app, control
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.params import DriveType
 from appmode.protocol.reader import RECEIVED, RECEIVED2, PortsReader
 from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, line, view
-from appmode.protocol.transcript import DIRECTIONS, Transcript, read_transcript
-from appmode.transcript.matcher import BytesPattern, Check, Pattern, parse_pattern
+from appmode.protocol.transcript import (
+    DIRECTIONS,
+    Directive,
+    Entry,
+    iter_transcript,
+    read_transcript,
+)
+from appmode.transcript.matcher import (
+    BoardNeeds,
+    BytesPattern,
+    Check,
+    Pattern,
+    board_needs,
+    parse_pattern,
+)
 
 CSV_FIELDS = ("t", "dir", *JSON_KEYS)
 
@@ -25,14 +40,18 @@ CSV_FIELDS = ("t", "dir", *JSON_KEYS)
 Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent
 
 
-def decoded(transcript: Transcript) -> Iterator[tuple[float, str, Decoded]]:
-    """(time, direction, event) for every command, record, frame and reply of the
-    transcript; a `<` line with `*` or `LO..HI` fields (a `2<` line with `??`) is an
-    expectation, not bytes. UART2 lines are read as the board the transcript describes
+def decoded(
+    items: Iterable[Entry | Directive], drive: DriveType | None
+) -> Iterator[tuple[float, str, Decoded]]:
+    """(time, direction, event) for every command, record, frame and reply of a
+    transcript's lines; a `<` line with `*` or `LO..HI` fields (a `2<` line with `??`) is
+    an expectation, not bytes. UART2 lines are read as the board the transcript describes
     reads them (`PortsReader`: its drive type, APP text while system_mode bit 7 is set)."""
-    reader = PortsReader(drive=Check(transcript).needs.drive)
+    reader = PortsReader(drive=drive)
     last = dict.fromkeys(DIRECTIONS, 0.0)
-    for entry in transcript.entries:
+    for entry in items:
+        if not isinstance(entry, Entry):
+            continue
         last[entry.direction] = entry.time
         if entry.direction == RECEIVED2 and "??" in entry.text:
             yield entry.time, RECEIVED2, BytesPattern(entry.data, b"", entry.text)
@@ -45,6 +64,16 @@ def decoded(transcript: Transcript) -> Iterator[tuple[float, str, Decoded]]:
             yield entry.time, direction, event
     for direction, event in reader.flush():
         yield last[direction], direction, event
+
+
+def needs_of(path: str, warn: Callable[[str], None]) -> BoardNeeds:
+    """The board a transcript file names (`@board`, the last one), read from its `@`
+    lines alone."""
+    needs = BoardNeeds()
+    for item in iter_transcript(path, warn, directives_only=True):
+        if isinstance(item, Directive) and item.name == "board":
+            needs = board_needs(item.args, f"{path}:{item.lineno}")
+    return needs
 
 
 def expectation_json(pattern: Pattern, layout: ALayout = VELOCITY) -> dict[str, Any]:
@@ -65,12 +94,13 @@ def expectation_json(pattern: Pattern, layout: ALayout = VELOCITY) -> dict[str, 
 def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> int:
     """Print every event; A records named as `profile` lays them out (default: the
     transcript's `@board profile=…`, else the sheet's)."""
-    transcript = read_transcript(path)
-    layout = (PROFILES[profile] if profile else Check(transcript).needs.profile).a_layout
+    needs = needs_of(path, lambda text: None)  # the second pass warns
+    layout = (PROFILES[profile] if profile else needs.profile).a_layout
     if fmt == "csv":
         writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
         writer.writeheader()
-    for t, direction, event in decoded(transcript):
+    items = iter_transcript(path, lambda text: print(f"appmode: WARNING: {text}", file=sys.stderr))
+    for t, direction, event in decoded(items, needs.drive):
         shown = None
         if isinstance(event, BytesPattern):
             body = {"kind": "expectation", "raw": event.text}
@@ -133,11 +163,14 @@ def run_plot(path: str, output: str) -> int:
             "appmode, pip install '.[plot]')"
         ) from None
     transcript = read_transcript(path)
-    layout = Check(transcript).needs.profile.a_layout
+    for warning in transcript.warnings:
+        print(f"appmode: WARNING: {warning}", file=sys.stderr)
+    needs = Check(transcript).needs
+    layout = needs.profile.a_layout
     motion: dict[int, list[int]] = {i: [] for i in layout.motion}
     series: dict[str, list[Any]] = {k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")}
     commands: list[tuple[float, str]] = []
-    for t, direction, event in decoded(transcript):
+    for t, direction, event in decoded(transcript.items, needs.drive):
         if isinstance(event, app.Velocity):
             series["tA"].append(t)
             values = app.record_fields(event)[1]

@@ -178,7 +178,7 @@ class Check:
                 raise AppmodeError(f"{where}: @strict takes on or off")
             strict = item.args[0] == "on"
         else:
-            self.needs = _board_needs(item.args, where)
+            self.needs = board_needs(item.args, where)
         return tolerance, strict
 
     # ------------------------------------------------------------ driving it
@@ -301,7 +301,7 @@ def _expected(entry: Entry) -> Pattern | BytesPattern | None:
     return parse_pattern(entry.text)
 
 
-def _board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:
+def board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:
     """`@board profile=minibalance drive=omni start=power-up` (each part optional)."""
     found: dict[str, str] = {}
     for arg in args:

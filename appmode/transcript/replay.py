@@ -99,6 +99,8 @@ def run_replay(
             "a board on a pty, serve it with appmode board and replay to its port)"
         )
     transcript = read_transcript(path)
+    for warning in transcript.warnings:
+        print(f"appmode: WARNING: {warning}", file=sys.stderr)
     entries = [(e.time, e.direction, e.data) for e in transcript.entries]
     items = retime(plan(entries, side), gap, skip)
     mark = ">" if side == "host" else "<"

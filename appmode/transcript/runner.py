@@ -258,6 +258,8 @@ def run_conform(
             for path in collect([str(SUITE)])
         ]  # all readable before any runs
     for transcript in transcripts:
+        for warning in transcript.warnings:
+            print(f"appmode: WARNING: {warning}", file=sys.stderr)
         if not transcript.entries:
             raise AppmodeError(f"{transcript.path} has no '>' or '<' lines: nothing to check")
     transcripts = _for_profile(transcripts, profile_named(profile), out)
