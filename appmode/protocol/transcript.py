@@ -5,21 +5,26 @@ from __future__ import annotations
 import codecs
 import contextlib
 import itertools
+import math
 import os
 import re
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
 from appmode.protocol.escaping import escape, unescape
-from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2, PortsReader
+from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2, Event, PortsReader
 
 HEADER = "# appmode transcript v1"
 SUFFIX = ".transcript"
 MAX_TIME = 86400.0
 """The latest time a line may have: a day. Later is surely a mistake, and a run to it
 could not finish."""
+HOLD = 0.5
+"""Seconds a recorder waits for a unit to end before writing it as far as it goes (the
+lines after it wait too: the file stays in time order)."""
 MAX_LINE = 64 * 1024
 """Bytes a line may have: a recorded line is one command or record, well under this."""
 DIRECTIONS = (SENT, RECEIVED, SENT2, RECEIVED2)
@@ -52,11 +57,58 @@ def uart2_bytes(payload: str) -> tuple[bytes, bytes] | None:
     return data, mask
 
 
+class _Held:
+    """One direction's bytes fed to its decoder and not yet in a unit, with the time each
+    arrived, and how many of them a line already shows (a unit cut by other lines)."""
+
+    def __init__(self) -> None:
+        self.data = bytearray()
+        self.times: deque[list[float | int]] = deque()  # [time, count] runs of `data`
+        self.written = 0
+
+    def add(self, data: bytes, time: float) -> None:
+        self.data += data
+        self.times.append([time, len(data)])
+
+    def time_at(self, offset: int) -> float:
+        """When the held byte at `offset` arrived."""
+        for when, count in self.times:
+            if offset < count:
+                return float(when)
+            offset -= int(count)
+        return float(self.times[-1][0]) if self.times else 0.0
+
+    def take(self, count: int) -> tuple[float, bytes]:
+        """A unit of `count` bytes leaves: (the time of its first byte no line shows, those
+        bytes)."""
+        shown = min(self.written, count)
+        rest = (self.time_at(shown), bytes(self.data[shown:count]))
+        del self.data[:count]
+        self.written -= shown
+        while count and self.times:
+            run = self.times[0]
+            used = min(count, int(run[1]))
+            run[1] = int(run[1]) - used
+            count -= used
+            if not run[1]:
+                self.times.popleft()
+        return rest
+
+    def unshown(self) -> tuple[float, bytes]:
+        """The bytes no line shows yet, from the time of the first; they are shown now."""
+        rest = (self.time_at(self.written), bytes(self.data[self.written :]))
+        self.written = len(self.data)
+        return rest
+
+
 class Recorder:
     """Writes a session as it happens: each direction split into commands and records.
 
     Call it as a tap: `recorder(direction, time, data)` with `>` for host→board bytes and
-    `<` for board→host bytes. Every line is flushed as it is written.
+    `<` for board→host bytes. Every line is flushed as it is written, and lines stay in
+    time order: a unit still incomplete when another direction's bytes come (a frame
+    whose end is still to come) is written as far as it goes, at its own time, and the
+    rest when it ends. Each line carries the arrival time of its first byte.
     """
 
     def __init__(self, out: TextIO, origin: float = 0.0, directives: tuple[str, ...] = ()) -> None:
@@ -66,7 +118,9 @@ class Recorder:
         self._failed = False
         self._origin = origin
         self._reader = PortsReader()
-        self._last = dict.fromkeys(DIRECTIONS, origin)
+        self._held = {direction: _Held() for direction in DIRECTIONS}
+        self._queue: list[tuple[float, int, bytes, str]] = []  # lines not yet written
+        self._order = itertools.count()  # keeps lines of one time in the order they came
         self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
 
     @classmethod
@@ -93,16 +147,40 @@ class Recorder:
         return recorder
 
     def __call__(self, direction: str, time: float, data: bytes) -> None:
-        self._last[direction] = time
-        for shown, event in self._reader.feed(direction, data):
-            self._line(time, shown, event.raw)
+        self._held[direction].add(data, time)
+        self._units(self._reader.feed(direction, data))
+        self._release(time)
 
     def follow(self, system_mode: int, time: float) -> None:
         """Read UART2 as a board with this system_mode does (`PortsReader.follow`)."""
-        for shown, event in self._reader.follow(system_mode):
-            self._line(time, shown, event.raw)
+        self._units(self._reader.follow(system_mode))
+        self._release(time)
 
-    def _line(self, time: float, direction: str, raw: bytes) -> None:
+    def _units(self, events: list[tuple[str, Event]]) -> None:
+        for shown, event in events:
+            when, raw = self._held[shown].take(len(event.raw))
+            if raw:
+                self._queue.append((when, next(self._order), raw, shown))
+
+    def _release(self, now: float) -> None:
+        """Write, in time order, the lines that no incomplete unit came before; a unit
+        incomplete for HOLD seconds is written as far as it goes."""
+        first = math.inf
+        for direction, held in self._held.items():
+            if len(held.data) > held.written:
+                start = held.time_at(held.written)
+                if start <= now - HOLD:
+                    when, raw = held.unshown()
+                    self._queue.append((when, next(self._order), raw, direction))
+                else:
+                    first = min(first, start)
+        self._queue.sort()
+        ready = [line for line in self._queue if line[0] < first]
+        del self._queue[: len(ready)]
+        for when, _, raw, direction in ready:
+            self._line(when, raw, direction)
+
+    def _line(self, time: float, raw: bytes, direction: str) -> None:
         if direction in UART2_DIRECTIONS:
             payload = uart2_payload(raw, self._reader.app_mode)
         else:
@@ -129,8 +207,8 @@ class Recorder:
                 with contextlib.suppress(OSError):
                     self._out.close()
             return
-        for direction, event in self._reader.flush():
-            self._line(self._last[direction], direction, event.raw)
+        self._units(self._reader.flush())
+        self._release(math.inf)
         if self._owned:
             try:
                 self._out.close()

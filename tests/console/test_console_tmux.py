@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import re
+import shlex
 import shutil
 import signal
 import subprocess
@@ -15,10 +16,20 @@ from appmode.protocol import params
 from tests.support.processes import ROOT, board_process, board_state, sent_lines, wait_for
 
 SESSION = "appmode-test"
+TMUX = ["tmux", "-L", "appmode-tests"]
+"""A tmux server of the tests' own: the user's server, and its environment, stay apart."""
 
 
 def tmux(*args: str) -> str:
-    return subprocess.run(["tmux", *args], capture_output=True, text=True, check=True).stdout
+    assert shutil.which("tmux"), "these tests drive the console in tmux: apt-get install tmux"
+    return subprocess.run([*TMUX, *args], capture_output=True, text=True, check=True).stdout
+
+
+def appmode_in_tmux(args: str) -> str:
+    """The shell command that runs `appmode ARGS` in a tmux pane with this test's data
+    folder (a tmux server keeps the environment it started with: it is given here)."""
+    data = shlex.quote(os.environ["XDG_DATA_HOME"])
+    return f"cd {ROOT} && exec env XDG_DATA_HOME={data} {sys.executable} -m appmode {args}"
 
 
 def screen() -> str:
@@ -36,7 +47,7 @@ def wait_screen(pattern: str, timeout: float = 10.0) -> re.Match[str]:
 
 
 def _alive() -> bool:
-    done = subprocess.run(["tmux", "has-session", "-t", SESSION], capture_output=True, check=False)
+    done = subprocess.run([*TMUX, "has-session", "-t", SESSION], capture_output=True, check=False)
     return done.returncode == 0
 
 
@@ -48,7 +59,7 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
     assert shutil.which("tmux"), "tmux is required (.ci/run installs it)"
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet") as board:
-        command = f"cd {ROOT} && {sys.executable} -m appmode drive {board.url}"
+        command = appmode_in_tmux(f"drive {board.url}")
         tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
         try:
             wait_screen(r"REAL BOARD")
@@ -75,9 +86,7 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
                 time.sleep(0.05)
             assert not _alive(), "Ctrl-C ends the console"
         finally:
-            subprocess.run(
-                ["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False
-            )
+            subprocess.run([*TMUX, "kill-session", "-t", SESSION], capture_output=True, check=False)
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
     assert "A" in sent and "{0:800}" in sent
     assert sent[-1] == "Z", sent[-5:]
@@ -85,7 +94,7 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
 
 def _drive_forward(args: str) -> int:
     """`appmode drive --latched ARGS` in a new tmux session, driving forward: its pid."""
-    command = f"cd {ROOT} && exec {sys.executable} -m appmode drive --latched {args}"
+    command = appmode_in_tmux(f"drive --latched {args}")
     tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
     wait_screen(r"params\s+max_speed 500")
     tmux("send-keys", "-t", SESSION, "w")
@@ -103,7 +112,7 @@ def test_sigterm_ends_the_console_with_z_last(tmp_path: Path) -> None:
             time.sleep(0.05)
         assert not _alive()
     finally:
-        subprocess.run(["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False)
+        subprocess.run([*TMUX, "kill-session", "-t", SESSION], capture_output=True, check=False)
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
     assert "A" in sent and sent[-1] == "Z"
 
@@ -189,8 +198,36 @@ def test_two_ending_signals_end_the_console_with_z_last(tmp_path: Path) -> None:
                 wait_for(lambda p=pid: not Path(f"/proc/{p}").exists())
             finally:
                 subprocess.run(
-                    ["tmux", "kill-session", "-t", SESSION], capture_output=True, check=False
+                    [*TMUX, "kill-session", "-t", SESSION], capture_output=True, check=False
                 )
             sent = sent_lines(record)
             assert sent[-1] == "Z", f"trial {trial}: {sent[-5:]}"
         assert board_state(board.url) == ((0, 0, 0), tuple(params.DEFAULTS))
+
+
+def test_the_console_keeps_its_history_in_the_tests_folder_whatever_tmux_holds(
+    tmp_path: Path,
+) -> None:
+    """Issue 22.16: a tmux server started elsewhere keeps its own XDG_DATA_HOME; the
+    console started in it must still write this test's data folder, not the user's."""
+    decoy = tmp_path / "decoy"
+    subprocess.run(  # the server starts with the decoy folder in its environment
+        [*TMUX, "new-session", "-d", "-s", "decoy", "sleep 30"],
+        env={**os.environ, "XDG_DATA_HOME": str(decoy)},
+        check=True,
+    )
+    try:
+        tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", appmode_in_tmux("drive"))
+        wait_screen(r"params\s+max_speed 500")
+        tmux("send-keys", "-t", SESSION, ":")
+        tmux("send-keys", "-t", SESSION, "speed 600", "Enter")
+        wait_screen(r"max_speed 600")
+        tmux("send-keys", "-t", SESSION, "C-q")
+        tmux("send-keys", "-t", SESSION, "C-q")
+        wait_for(lambda: not _alive())
+    finally:
+        for name in (SESSION, "decoy"):
+            subprocess.run([*TMUX, "kill-session", "-t", name], capture_output=True, check=False)
+    history = Path(os.environ["XDG_DATA_HOME"]) / "appmode" / "history"
+    assert "speed 600" in history.read_text()
+    assert not decoy.exists()

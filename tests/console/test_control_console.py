@@ -4,7 +4,6 @@ port of the same board; script mode, the panel, and tmux against a board process
 from __future__ import annotations
 
 import re
-import sys
 import time
 from pathlib import Path
 
@@ -17,8 +16,15 @@ from appmode.console.panel_parts import WIDTH
 from appmode.host.state import BoardWarning, HostState
 from appmode.protocol.directions import MOTIONS
 from appmode.protocol.params import DriveType
-from tests.console.test_console_tmux import SESSION, _alive, screen, tmux, wait_screen
-from tests.support.processes import ROOT, board_process, run, wait_for
+from tests.console.test_console_tmux import (
+    SESSION,
+    _alive,
+    appmode_in_tmux,
+    screen,
+    tmux,
+    wait_screen,
+)
+from tests.support.processes import board_process, run, wait_for
 
 STOP_FRAME = "FF FE 01 00 00 00 00 00 00 00"
 
@@ -114,7 +120,7 @@ def test_the_app_console_says_when_its_letters_are_not_followed() -> None:
 def test_the_console_over_uart2_in_tmux_leaves_the_stop_frame_last(tmp_path: Path) -> None:
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet", "--drive", "mecanum") as board:
-        command = f"cd {ROOT} && exec {sys.executable} -m appmode drive {board.uart2} --uart2"
+        command = appmode_in_tmux(f"drive {board.uart2} --uart2")
         tmux("new-session", "-d", "-s", SESSION, "-x", "100", "-y", "30", command)
         try:
             wait_screen(r"REAL BOARD")

@@ -34,11 +34,11 @@ def test_recorder_writes_one_unit_a_line_and_escapes_bytes() -> None:
         "@board drive=diff",
         "0.0000 > J",
         "0.0000 > A",
-        "0.0100 > {Q:P}",
+        "0.0000 > {Q:P}",  # a line carries the time of its first byte (issue 22.12)
         "0.0100 > \\x0d",
         "0.0100 > \\x0a",
         "0.0500 < {A0:0:0:0}$",
-        "0.0600 < {B0:0:0:100}$",
+        "0.0500 < {B0:0:0:100}$",
         "0.0600 < xx\\\\",
     ]
 
@@ -146,3 +146,30 @@ def test_property_record_then_read_round_trip(chunks: list[tuple[str, bytes]]) -
     for direction in "<>":
         sent = b"".join(d for dr, d in chunks if dr == direction)
         assert b"".join(e.data for e in entries if e.direction == direction) == sent
+
+
+def _recorded(calls: list[tuple[str, float, bytes]]) -> list[str]:
+    out = io.StringIO()
+    recorder = Recorder(out)
+    for direction, time, data in calls:
+        recorder(direction, time, data)
+    recorder.close()
+    return out.getvalue().splitlines()[1:]
+
+
+def test_a_recording_stays_in_time_order_when_a_frame_never_ends() -> None:
+    """Issue 22.12: `{Q:Z` left open was written, at its own time, after every later
+    record. Its bytes are written as far as they go, in their place."""
+    calls = [(">", 18.0575, b"{Q:Z")]
+    calls += [("<", 18.1 + 0.05 * i, b"{A0:0:0:0}$") for i in range(20)]
+    lines = _recorded(calls)
+    times = [float(line.split(" ", 1)[0]) for line in lines]
+    assert times == sorted(times)
+    assert lines[0] == "18.0575 > {Q:Z"
+
+
+def test_a_unit_that_ends_soon_stays_whole_and_in_its_place() -> None:
+    lines = _recorded(
+        [(">", 1.0, b"{Q:"), ("<", 1.01, b"{A0:0:0:0}$"), (">", 1.02, b"P}"), ("<", 1.06, b"{B")]
+    )
+    assert lines == ["1.0000 > {Q:P}", "1.0100 < {A0:0:0:0}$", "1.0600 < {B"]

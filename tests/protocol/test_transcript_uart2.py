@@ -40,8 +40,8 @@ def test_uart2_lines_are_one_frame_or_reply_a_line_in_hex() -> None:
             ("2<", 0.02, b"#\x01\x00\x00\x01\xf4"),
         ]
     )
-    assert lines == [
-        "0.0100 2> FF FE 80 80 11 00 00 00 00 00",
+    assert lines == [  # each line at the time of its first byte (issue 22.12)
+        "0.0000 2> FF FE 80 80 11 00 00 00 00 00",
         "0.0100 2> FF FE 80 80 11 00 00 00 00 00",
         "0.0200 2< 23 01 00 00 01 F4",
     ]
