@@ -16,6 +16,12 @@ pytest loads wherever appmode is installed) costs only pyserial's import.
 
 from __future__ import annotations
 
+# isort: off
+# First, before anything else loads: started as the `appmode` program, a Ctrl-C from now
+# on ends it quietly (appmode.cli.entry), never with a traceback.
+import appmode.cli.entry  # noqa: F401 - for its effect
+# isort: on
+
 import importlib
 from typing import TYPE_CHECKING, Any
 

@@ -1,5 +1,5 @@
 import sys
 
-from appmode.cli.main import main
+from appmode.cli.entry import main
 
 sys.exit(main())

@@ -9,6 +9,7 @@ its mode. Temporary files carry a name that only appmode uses (`LEFTOVER`).
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import secrets
@@ -60,9 +61,12 @@ def data_folder() -> Path:
 
 def check_writable(path: str | os.PathLike[str], what: str) -> None:
     """Before long work whose result goes to `path`: AppmodeError if it could not be
-    written (no folder, no permission, a folder in its place)."""
+    written (no folder, no permission, a folder in its place, a FIFO nobody reads)."""
     shown = os.fspath(path)
     target = Path(os.path.realpath(path))
+    if _is_fifo(target):
+        check_fifo_read(path, what)
+        return
     if target.is_dir():
         raise AppmodeError(f"cannot write {what} {shown}: it is a folder; name a file")
     if not target.parent.is_dir():
@@ -131,3 +135,37 @@ def _fsync_directory(directory: Path) -> None:
         pass
     finally:
         os.close(fd)
+
+
+def check_fifo_read(path: str | os.PathLike[str], what: str) -> None:
+    """AppmodeError if `path` is a FIFO that no program reads: opening it to write would
+    wait for ever."""
+    if not _is_fifo(path):
+        return
+    try:
+        os.close(os.open(path, os.O_WRONLY | getattr(os, "O_NONBLOCK", 0)))
+    except OSError as exc:
+        if exc.errno == errno.ENXIO:
+            raise AppmodeError(
+                f"cannot write {what} {os.fspath(path)}: it is a FIFO and no program reads "
+                "it; start its reader first"
+            ) from None
+
+
+def _is_fifo(path: str | os.PathLike[str]) -> bool:
+    try:
+        return stat.S_ISFIFO(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def say_if_fifo(path: str | os.PathLike[str]) -> None:
+    """Reading a FIFO waits until a program writes it: say so, rather than hang in
+    silence."""
+    if _is_fifo(path):
+        print(
+            f"appmode: waiting for a program to write to the FIFO {os.fspath(path)} "
+            "(Ctrl-C gives up)",
+            file=sys.stderr,
+            flush=True,
+        )

@@ -1,14 +1,18 @@
 """Parameter reads and verified sets as a state machine, with no I/O.
 
 A ParamQuery sends `{Q:P}` (after `{n:v}` for a set) and waits for C records. The
-protocol has no checksum, so a corrupted digit can still make a well-formed C record: a
-read is reported only when AGREE C records, each asked for separately, agree. A set is
-done when the agreed values show it. On a timeout the request is sent again; after
-`tries × agree` requests the query ends in QueryFailed.
+protocol has no checksum, so a lost or doubled digit can still make a well-formed C
+record — and the same wrong one often: `10000` losing any of its four zeros reads
+`1000`. So the C records of a query, each asked for separately, are votes: a value is
+reported when it has AGREE votes and leads every other value by AGREE — or, once the
+query has seen a garbled or a differing C record (a noisy link), by NOISY_LEAD
+(docs/protocol.md §3.3). A set is done when the agreed values show it. On a timeout the
+request is sent again; after `tries × agree` requests the query ends in QueryFailed.
 """
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 
 from appmode.protocol import app, params
@@ -16,6 +20,10 @@ from appmode.protocol import app, params
 TIMEOUT = 0.5
 TRIES = 5
 AGREE = 2
+NOISY_LEAD = 4
+"""The lead a value needs over every other once the link has shown noise: a wrong value
+that a noisy link makes 5 % of the time then wins before the true one with odds of
+about (0.05 / 0.8)^4, 1 in 65,000 queries (docs/protocol.md §3.3)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,8 +65,8 @@ class ParamQuery:
         self.agree = agree
         self.sent = 0
         self.deadline = 0.0
-        self._candidate: tuple[int, ...] | None = None
-        self._seen = 0
+        self._votes: Counter[tuple[int, ...]] = Counter()
+        self._noisy = False
         self._mismatch: int | None = None
         self._mismatches = 0
         self.known: tuple[int, ...] | None = None
@@ -66,7 +74,8 @@ class ParamQuery:
 
     @property
     def limit(self) -> int:
-        return self.tries * self.agree
+        """Requests at most: `tries` times the votes a value needs."""
+        return self.tries * (NOISY_LEAD if self._noisy else self.agree)
 
     def _request(self, now: float, with_change: bool) -> bytes:
         self.sent += 1
@@ -82,11 +91,14 @@ class ParamQuery:
 
     def on_params(self, values: tuple[int, ...], now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived: (bytes to send, outcome or None)."""
-        if values == self._candidate:
-            self._seen += 1
-        else:
-            self._candidate, self._seen = values, 1
-        if self._seen < self.agree:
+        votes = self._votes
+        if self.change is not None and values[self.change[0]] == self.change[1]:
+            for before in [v for v in votes if v[self.change[0]] != self.change[1]]:
+                del votes[before]  # the set has taken: the records before it are history
+        votes[values] += 1
+        self._noisy = self._noisy or len(votes) > 1
+        lead = votes[values] - max((n for v, n in votes.items() if v != values), default=0)
+        if votes[values] < self.agree or lead < (NOISY_LEAD if self._noisy else self.agree):
             if self.sent >= self.limit:
                 return self._retry(now)
             return self._request(now, with_change=False), None  # ask again to confirm
@@ -98,7 +110,7 @@ class ParamQuery:
         same = self._mismatch == values[index]
         self._mismatch = values[index]
         self._mismatches = self._mismatches + 1 if same else 1
-        self._candidate, self._seen = None, 0
+        self._votes.clear()  # the set is sent again: the board may change
         if self._mismatches >= MISMATCHES:  # the board has decided, twice: say what it did
             return b"", self._refused(index, value)
         return self._retry(now)
@@ -115,7 +127,9 @@ class ParamQuery:
         return QueryFailed(f"set {name} = {value} was not taken: {what}")
 
     def on_garbled(self, now: float) -> tuple[bytes, Outcome | None]:
-        """A C record arrived garbled: ask again at once rather than wait for the timeout."""
+        """A C record arrived garbled: the link is noisy; ask again at once rather than
+        wait for the timeout."""
+        self._noisy = True
         return self._retry(now)
 
     def on_time(self, now: float) -> tuple[bytes, Outcome | None]:

@@ -63,12 +63,12 @@ def open_link(url: str, timeout: float | None = 0.05, baud: int = BAUD) -> seria
 
 def _check_address(url: str, scheme: str) -> None:
     """HOST:PORT must be there before pyserial sees the URL (its messages are Python's)."""
-    parts = urlsplit(url)
     try:
-        port = parts.port
-    except ValueError:
-        port = None
-    if not parts.hostname or port is None or not 0 < port < 65536:
+        parts = urlsplit(url)
+        host, port = parts.hostname, parts.port
+    except ValueError:  # an unclosed [IPv6 address, a port that is not a number
+        host, port = None, None
+    if not host or port is None or not 0 < port < 65536:
         raise AppmodeError(
             f"{url!r} needs a host and a port 1–65535: {scheme}://HOST:PORT, "
             f"e.g. {scheme}://127.0.0.1:5000"
@@ -111,7 +111,10 @@ def explain_open_error(where: str, exc: Exception) -> str:
         )
     if "Name or service not known" in text or "nodename nor servname" in text:
         return f"unknown host in {where}: check the address"
-    return f"cannot open {where}: {text}"
+    if code == errno.ENXIO or "No such device or address" in text:
+        return f"{where} is not a device this program can open (no such device or address)"
+    reason = getattr(exc, "strerror", None) or text  # pyserial repeats errno and path
+    return f"cannot open {where}: {reason}"
 
 
 def new_pty() -> PtyPort:

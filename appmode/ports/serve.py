@@ -87,7 +87,6 @@ class PtyEndpoint:
 
     def __init__(self, sel: selectors.BaseSelector, log: Log, link: str | None = None) -> None:
         try:  # POSIX only: imported where a pty is made, so Windows can serve on TCP
-            import pty
             import tty
         except ImportError:
             raise AppmodeError(
@@ -95,11 +94,17 @@ class PtyEndpoint:
             ) from None
 
         try:
-            self._master, self._slave = pty.openpty()
+            self._master, self._slave = os.openpty()  # pty.openpty hides the errno
         except OSError as exc:
+            if exc.errno in (errno.EMFILE, errno.ENFILE):
+                raise AppmodeError(
+                    f"cannot open another pseudo-terminal: this process may open no more "
+                    f"files ({exc.strerror}); raise the open-file limit (ulimit -n) or "
+                    f"serve fewer boards (--count)"
+                ) from None
             raise AppmodeError(
-                f"cannot open another pseudo-terminal: {exc.strerror or exc}; serve fewer "
-                f"boards (--count), or raise the open-file limit (ulimit -n)"
+                f"cannot open another pseudo-terminal: {exc.strerror or exc}; the system "
+                f"has no more ptys: serve fewer boards (--count), or close other terminals"
             ) from None
         tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
         os.set_blocking(self._master, False)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
+from appmode.files import check_fifo_read
 from appmode.protocol.escaping import escape, unescape
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2, Event, PortsReader
 
@@ -128,6 +129,7 @@ class Recorder:
         cls, path: str | os.PathLike[str], origin: float = 0.0, directives: tuple[str, ...] = ()
     ) -> Recorder:
         new = not os.path.lexists(path)
+        check_fifo_read(path, "transcript")
         try:
             out = open(path, "w", encoding="utf-8")  # noqa: SIM115 - owned by the recorder
         except OSError as exc:

@@ -11,8 +11,8 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from appmode.board.profiles import PROFILES
-from appmode.errors import AppmodeError
-from appmode.files import check_writable, write_whole
+from appmode.errors import AppmodeError, InvalidValue
+from appmode.files import check_writable, say_if_fifo, write_whole
 from appmode.protocol import app, control
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
@@ -41,7 +41,7 @@ Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.Board
 
 
 def decoded(
-    items: Iterable[Entry | Directive], drive: DriveType | None
+    items: Iterable[Entry | Directive], drive: DriveType | None, path: str
 ) -> Iterator[tuple[float, str, Decoded]]:
     """(time, direction, event) for every command, record, frame and reply of a
     transcript's lines; a `<` line with `*` or `LO..HI` fields (a `2<` line with `??`) is
@@ -56,7 +56,10 @@ def decoded(
         if entry.direction == RECEIVED2 and "??" in entry.text:
             yield entry.time, RECEIVED2, BytesPattern(entry.data, b"", entry.text)
             continue
-        pattern = parse_pattern(entry.text) if entry.direction == RECEIVED else None
+        try:
+            pattern = parse_pattern(entry.text) if entry.direction == RECEIVED else None
+        except InvalidValue as exc:
+            raise AppmodeError(f"{path}:{entry.lineno}: {exc}") from None
         if pattern is not None and any(f is None or f[0] != f[1] for f in pattern.fields):
             yield entry.time, RECEIVED, pattern
             continue
@@ -94,13 +97,14 @@ def expectation_json(pattern: Pattern, layout: ALayout = VELOCITY) -> dict[str, 
 def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> int:
     """Print every event; A records named as `profile` lays them out (default: the
     transcript's `@board profile=…`, else the sheet's)."""
+    say_if_fifo(path)
     needs = needs_of(path, lambda text: None)  # the second pass warns
     layout = (PROFILES[profile] if profile else needs.profile).a_layout
     if fmt == "csv":
         writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
         writer.writeheader()
     items = iter_transcript(path, lambda text: print(f"appmode: WARNING: {text}", file=sys.stderr))
-    for t, direction, event in decoded(items, needs.drive):
+    for t, direction, event in decoded(items, needs.drive, path):
         shown = None
         if isinstance(event, BytesPattern):
             body = {"kind": "expectation", "raw": event.text}
@@ -170,7 +174,7 @@ def run_plot(path: str, output: str) -> int:
     motion: dict[int, list[int]] = {i: [] for i in layout.motion}
     series: dict[str, list[Any]] = {k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")}
     commands: list[tuple[float, str]] = []
-    for t, direction, event in decoded(transcript.items, needs.drive):
+    for t, direction, event in decoded(transcript.items, needs.drive, path):
         if isinstance(event, app.Velocity):
             series["tA"].append(t)
             values = app.record_fields(event)[1]

@@ -22,7 +22,7 @@ import re
 from dataclasses import dataclass, field
 
 from appmode.board.profiles import SHEET, Profile, profile_named
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, InvalidValue
 from appmode.line.wire import APP as APP_PORT
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.protocol import app
@@ -93,10 +93,19 @@ def parse_pattern(text: str) -> Pattern | None:
     return Pattern(match.group(1), fields, text)
 
 
+MAX_DIGITS = 20
+"""Digits a field of an expectation may have: a record's fields are 32-bit numbers."""
+
+
 def _span(text: str) -> Span:
     if text == "*":
         return None
     low, _, high = text.partition("..")
+    if max(len(low), len(high)) > MAX_DIGITS:
+        raise InvalidValue(
+            f"a field of {max(len(low), len(high)):,} digits: a record's fields are whole "
+            f"numbers of at most {MAX_DIGITS} digits"
+        )
     return (int(low), int(high or low))
 
 
@@ -147,7 +156,7 @@ class Check:
             elif item.direction in (SENT, SENT2):
                 self.sends.append(item)
                 last_send = max(last_send, item.time)
-            elif (pattern := _expected(item)) is not None:
+            elif (pattern := _expected(item, self.transcript.path)) is not None:
                 if isinstance(pattern, Pattern) and any(
                     f is not None and f[0] > f[1] for f in pattern.fields
                 ):
@@ -292,13 +301,16 @@ class Check:
         )
 
 
-def _expected(entry: Entry) -> Pattern | BytesPattern | None:
+def _expected(entry: Entry, path: str) -> Pattern | BytesPattern | None:
     """The expectation of a `<` or `2<` line, or None when it expects nothing."""
     if entry.direction == RECEIVED2:
         hexed = uart2_bytes(entry.text)
         if hexed is not None:
             return BytesPattern(hexed[0], hexed[1], entry.text)
-    return parse_pattern(entry.text)
+    try:
+        return parse_pattern(entry.text)
+    except InvalidValue as exc:
+        raise AppmodeError(f"{path}:{entry.lineno}: {exc}") from None
 
 
 def board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:

@@ -4,12 +4,16 @@ transcript lines are numbered as an editor numbers them."""
 
 from __future__ import annotations
 
+import os
+import resource
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 from appmode.protocol.transcript import parse_transcript
-from tests.support.processes import run
+from tests.support.processes import ROOT, appmode_cmd, run
 
 REFUSED = [
     ("send", "sim://", "Z", "--listen", "inf"),
@@ -78,3 +82,70 @@ def test_a_transcript_with_nothing_to_check_is_refused(tmp_path: Path) -> None:
     done = run("conform", str(path), timeout=20)
     assert done.returncode == 2 and "PASS" not in done.stdout
     assert done.stderr == f"appmode: error: {path} has no '>' or '<' lines: nothing to check\n"
+
+
+def test_odd_inputs_end_in_one_line_naming_what_and_where(tmp_path: Path) -> None:
+    """Issue 22.10: each of these was a traceback or a message that said nothing."""
+    digits = tmp_path / "digits.transcript"
+    digits.write_text("# appmode transcript v1\n0.0 > J\n0.5 < {A" + "9" * 5000 + ":0:0:0}$\n")
+    cases = [
+        (("conform", str(digits)), f"{digits}:3: a field of 5,000 digits"),
+        (("dump", str(digits)), f"{digits}:3: a field of 5,000 digits"),
+        (("params", "socket://[::1"), "needs a host and a port 1–65535"),
+        (("params", "/dev/tty"), "/dev/tty is not a device this program can open"),
+    ]
+    for args, message in cases:
+        done = run(*args, timeout=20)
+        assert done.returncode == 2, (args, done.stderr)
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and message in lines[0], (args, done.stderr)
+        assert lines[0].count("Errno") <= 1, "the reason is said once"
+
+
+def test_a_fifo_nobody_reads_is_named_instead_of_waited_on(tmp_path: Path) -> None:
+    fifo = tmp_path / "out"
+    os.mkfifo(fifo)
+    for args in (
+        ("record", "sim://", str(fifo), "--count", "2"),
+        ("send", "sim://", "J", "--record", str(fifo)),
+        ("conform", "transcripts/suite/s5_save.transcript", "--junit", str(fifo)),
+    ):
+        done = run(*args, timeout=20)
+        assert done.returncode == 2
+        assert "it is a FIFO and no program reads it; start its reader first" in done.stderr
+
+
+def test_the_open_file_limit_is_named_when_ptys_run_out() -> None:
+    def few_files() -> None:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (8, 8))
+
+    done = subprocess.run(
+        appmode_cmd("board", "--count", "3"),
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        preexec_fn=few_files,
+        timeout=20,
+        check=False,
+    )
+    assert done.returncode == 2
+    assert "may open no more files" in done.stderr and "ulimit -n" in done.stderr
+
+
+def test_started_as_the_program_a_ctrl_c_ends_it_quietly_from_the_first_import(
+    tmp_path: Path,
+) -> None:
+    """Issue 22.10: SIGINT while appmode loads gave a KeyboardInterrupt traceback. Started
+    as `appmode`, the quiet handler is in place before pyserial loads; a program that
+    imports appmode keeps its own."""
+    probe = "import appmode, signal; print(getattr(signal.getsignal(signal.SIGINT), '__name__'))"
+    script = tmp_path / "appmode"
+    script.write_text(probe + "\n")
+    as_program = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, cwd=ROOT, check=True
+    )
+    assert as_program.stdout.strip() == "_quit"
+    imported = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, check=True
+    )
+    assert imported.stdout.strip() == "default_int_handler"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from appmode.host.query import ParamQuery, QueryDone, QueryFailed
+from appmode.host.query import NOISY_LEAD, ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import HostState
 from appmode.protocol import params
 from appmode.protocol.app import ParamsRecord, encode
@@ -33,11 +33,26 @@ def test_read_ends_when_two_c_records_asked_for_separately_agree() -> None:
 
 
 def test_a_corrupted_digit_is_not_reported() -> None:
+    """Issue 22.6: once the link shows noise, a value must lead every other by
+    NOISY_LEAD votes (a digit lost the same way twice must not win)."""
     state = HostState()
     state.start_query(ParamQuery(), 0.0)
     state.feed(c_record(max_speed=900), 0.1)  # a digit hit by noise: well-formed, wrong
-    assert outcomes(state.feed(c_record(), 0.2)) == []
-    [done] = outcomes(state.feed(c_record(), 0.3))
+    for i in range(NOISY_LEAD):
+        assert outcomes(state.feed(c_record(), 0.2 + 0.1 * i)) == []
+    [done] = outcomes(state.feed(c_record(), 0.7))
+    assert isinstance(done, QueryDone) and done.values[0] == 500
+
+
+def test_a_wrong_value_seen_twice_does_not_win_against_the_true_one() -> None:
+    state = HostState()
+    state.start_query(ParamQuery(), 0.0)
+    wrong = c_record(max_speed=50)  # 500 with a zero lost, as it often is
+    for record in (c_record(), wrong, wrong, c_record(), wrong):
+        assert outcomes(state.feed(record, 0.1)) == []
+    for _ in range(4):  # 500 leads by 1, 2, 3 votes: not yet
+        assert outcomes(state.feed(c_record(), 0.2)) == []
+    [done] = outcomes(state.feed(c_record(), 0.3))  # by NOISY_LEAD: reported
     assert isinstance(done, QueryDone) and done.values[0] == 500
 
 
