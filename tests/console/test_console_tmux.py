@@ -16,8 +16,9 @@ from appmode.protocol import params
 from tests.support.processes import ROOT, board_process, board_state, sent_lines, wait_for
 
 SESSION = "appmode-test"
-TMUX = ["tmux", "-L", "appmode-tests"]
-"""A tmux server of the tests' own: the user's server, and its environment, stay apart."""
+TMUX = ["tmux", "-L", f"appmode-tests-{os.getpid()}"]
+"""A tmux server of this test process's own: the user's server and its environment, and
+another test run's, stay apart."""
 
 
 def tmux(*args: str) -> str:

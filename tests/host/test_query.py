@@ -105,3 +105,22 @@ def test_set_that_never_takes_is_retried_then_fails_naming_the_value_read() -> N
 def test_query_rejects_out_of_range_before_sending() -> None:
     with pytest.raises(ValueError, match="max_speed"):
         ParamQuery((0, 70000))
+
+
+def test_the_records_of_a_noisy_session_do_not_make_a_lost_zero_the_answer() -> None:
+    """Issue 22.6, as seeded session 32 under heavy faults saw it: a zero lost from
+    max_position 10000 twice in a row (any of its four zeros gives 1000) was reported."""
+    state = HostState()
+    state.start_query(ParamQuery(tries=10), 0.0)
+    seen = [100000, None, 1000, 10000, None, 1000, 1000]  # None: a garbled C record
+    for i, max_position in enumerate(seen):
+        if max_position is None:
+            state.feed(b"{C500:1OK\r\n0000:20:0:10:10:10:0:0}$", 0.1 * i)
+        else:
+            assert outcomes(state.feed(c_record(max_position=max_position), 0.1 * i)) == []
+    done: list[object] = []
+    t = 1.0
+    while not done:
+        done = outcomes(state.feed(c_record(), t))
+        t += 0.1
+    assert isinstance(done[0], QueryDone) and done[0].values[1] == 10000
