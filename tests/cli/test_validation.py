@@ -5,7 +5,6 @@ transcript lines are numbered as an editor numbers them."""
 from __future__ import annotations
 
 import os
-import resource
 import subprocess
 import sys
 from pathlib import Path
@@ -13,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from appmode.protocol.transcript import parse_transcript
-from tests.support.processes import ROOT, appmode_cmd, run
+from tests.support.processes import ROOT, run
 
 REFUSED = [
     ("send", "sim://", "Z", "--listen", "inf"),
@@ -113,23 +112,6 @@ def test_a_fifo_nobody_reads_is_named_instead_of_waited_on(tmp_path: Path) -> No
         done = run(*args, timeout=20)
         assert done.returncode == 2
         assert "it is a FIFO and no program reads it; start its reader first" in done.stderr
-
-
-def test_the_open_file_limit_is_named_when_ptys_run_out() -> None:
-    def few_files() -> None:
-        resource.setrlimit(resource.RLIMIT_NOFILE, (8, 8))
-
-    done = subprocess.run(
-        appmode_cmd("board", "--count", "3"),
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        preexec_fn=few_files,
-        timeout=20,
-        check=False,
-    )
-    assert done.returncode == 2
-    assert "may open no more files" in done.stderr and "ulimit -n" in done.stderr
 
 
 def test_started_as_the_program_a_ctrl_c_ends_it_quietly_from_the_first_import(

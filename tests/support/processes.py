@@ -7,7 +7,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -18,7 +18,13 @@ def appmode_cmd(*args: str) -> list[str]:
     return [sys.executable, "-m", "appmode", *args]
 
 
-def run(*args: str, timeout: float = 60, stdin: bytes = b"") -> subprocess.CompletedProcess[str]:
+def run(
+    *args: str,
+    timeout: float = 60,
+    stdin: bytes = b"",
+    limits: Callable[[], None] | None = None,
+) -> subprocess.CompletedProcess[str]:
+    """`appmode ARGS` run to its end; `limits` runs in the child first (resource limits)."""
     done = subprocess.run(
         appmode_cmd(*args),
         input=stdin.decode(),
@@ -27,6 +33,7 @@ def run(*args: str, timeout: float = 60, stdin: bytes = b"") -> subprocess.Compl
         timeout=timeout,
         cwd=ROOT,
         check=False,
+        preexec_fn=limits,
     )
     return done
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 import io
 import resource
 import signal
-import subprocess
 import tracemalloc
 from pathlib import Path
 
@@ -15,7 +14,7 @@ import pytest
 
 from appmode.protocol.transcript import TranscriptError, parse_transcript, read_transcript
 from appmode.transcript.dump import run_dump
-from tests.support.processes import ROOT, appmode_cmd, run
+from tests.support.processes import run
 
 WHOLE = "# appmode transcript v1\n0.000 > J\n0.050 > A\n0.400 < {A0:1..500:0:0}$\n1.000 > Z\n"
 
@@ -61,15 +60,7 @@ def test_a_recording_on_a_disk_already_full_leaves_no_empty_file(tmp_path: Path)
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (0, 0))
 
-    done = subprocess.run(
-        appmode_cmd("record", "sim://", str(record), "--count", "3"),
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        preexec_fn=no_room,
-        timeout=30,
-        check=False,
-    )
+    done = run("record", "sim://", str(record), "--count", "3", limits=no_room)
     assert done.returncode == 2
     assert "cannot write transcript" in done.stderr
     assert not record.exists()
