@@ -19,6 +19,7 @@ from pathlib import Path
 
 from appmode.errors import AppmodeError
 
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none (and no fork to leak into)
 LEFTOVER = re.compile(r"\.(?P<name>.+)\.[0-9a-f]{8}\.appmode-tmp")
 """The name of a temporary file of ours: `.NAME.XXXXXXXX.appmode-tmp` beside NAME."""
 
@@ -35,7 +36,7 @@ def write_whole(path: str | os.PathLike[str], data: bytes, what: str) -> None:
         raise AppmodeError(f"cannot write {what} {shown}: {exc.strerror}") from None
     try:
         if existing is not None and not stat.S_ISREG(existing.st_mode):
-            _write_in_place(target, data)
+            _write_in_place(target, data, what)
         else:
             _replace(target, data, existing)
     except OSError as exc:
@@ -64,9 +65,8 @@ def check_writable(path: str | os.PathLike[str], what: str) -> None:
     written (no folder, no permission, a folder in its place, a FIFO nobody reads)."""
     shown = os.fspath(path)
     target = Path(os.path.realpath(path))
-    if _is_fifo(target):
-        check_fifo_read(path, what)
-        return
+    if is_fifo(target):
+        return  # opening it now would end its reader's input: it is checked as written
     if target.is_dir():
         raise AppmodeError(f"cannot write {what} {shown}: it is a folder; name a file")
     if not target.parent.is_dir():
@@ -92,8 +92,8 @@ def temporary_beside(target: Path) -> Path:
     return target.with_name(f".{target.name}.{secrets.token_hex(4)}.appmode-tmp")
 
 
-def _write_in_place(target: Path, data: bytes) -> None:
-    fd = os.open(target, os.O_WRONLY | os.O_CLOEXEC)
+def _write_in_place(target: Path, data: bytes, what: str) -> None:
+    fd = open_fifo(target, what) if is_fifo(target) else os.open(target, os.O_WRONLY | _CLOEXEC)
     try:
         _write_all(fd, data)
     finally:
@@ -137,22 +137,26 @@ def _fsync_directory(directory: Path) -> None:
         os.close(fd)
 
 
-def check_fifo_read(path: str | os.PathLike[str], what: str) -> None:
-    """AppmodeError if `path` is a FIFO that no program reads: opening it to write would
-    wait for ever."""
-    if not _is_fifo(path):
-        return
+def open_fifo(path: str | os.PathLike[str], what: str) -> int:
+    """The write end of the FIFO `path`. With no program reading it yet the open waits
+    for one, as a FIFO does — saying so on stderr rather than hanging in silence."""
     try:
-        os.close(os.open(path, os.O_WRONLY | getattr(os, "O_NONBLOCK", 0)))
+        fd = os.open(path, os.O_WRONLY | getattr(os, "O_NONBLOCK", 0) | _CLOEXEC)
     except OSError as exc:
-        if exc.errno == errno.ENXIO:
-            raise AppmodeError(
-                f"cannot write {what} {os.fspath(path)}: it is a FIFO and no program reads "
-                "it; start its reader first"
-            ) from None
+        if exc.errno != errno.ENXIO:
+            raise
+        print(
+            f"appmode: waiting for a program to read the FIFO {os.fspath(path)} before "
+            f"writing the {what} (Ctrl-C gives up)",
+            file=sys.stderr,
+            flush=True,
+        )
+        return os.open(path, os.O_WRONLY | _CLOEXEC)
+    os.set_blocking(fd, True)
+    return fd
 
 
-def _is_fifo(path: str | os.PathLike[str]) -> bool:
+def is_fifo(path: str | os.PathLike[str]) -> bool:
     try:
         return stat.S_ISFIFO(os.stat(path).st_mode)
     except OSError:
@@ -162,7 +166,7 @@ def _is_fifo(path: str | os.PathLike[str]) -> bool:
 def say_if_fifo(path: str | os.PathLike[str]) -> None:
     """Reading a FIFO waits until a program writes it: say so, rather than hang in
     silence."""
-    if _is_fifo(path):
+    if is_fifo(path):
         print(
             f"appmode: waiting for a program to write to the FIFO {os.fspath(path)} "
             "(Ctrl-C gives up)",

@@ -6,7 +6,8 @@ record — and the same wrong one often: `10000` losing any of its four zeros re
 `1000`. So the C records of a query, each asked for separately, are votes: a value is
 reported when it has AGREE votes and leads every other value by AGREE — or, once the
 query has seen a garbled or a differing C record (a noisy link), by NOISY_LEAD
-(docs/protocol.md §3.3). A set is done when the agreed values show it. On a timeout the
+(docs/protocol.md §3.3). A set is done when the agreed values show it; records that
+still show the value read before it stop counting once one shows the new value. On a timeout the
 request is sent again; after `tries × agree` requests the query ends in QueryFailed.
 """
 
@@ -92,9 +93,11 @@ class ParamQuery:
     def on_params(self, values: tuple[int, ...], now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived: (bytes to send, outcome or None)."""
         votes = self._votes
-        if self.change is not None and values[self.change[0]] == self.change[1]:
-            for before in [v for v in votes if v[self.change[0]] != self.change[1]]:
-                del votes[before]  # the set has taken: the records before it are history
+        if self.change is not None and self.known is not None:
+            index, value = self.change
+            if values[index] == value != self.known[index]:  # the set has taken:
+                for before in [v for v in votes if v[index] == self.known[index]]:
+                    del votes[before]  # the records from before it are history
         votes[values] += 1
         self._noisy = self._noisy or len(votes) > 1
         lead = votes[values] - max((n for v, n in votes.items() if v != values), default=0)

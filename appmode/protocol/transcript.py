@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
-from appmode.files import check_fifo_read
+from appmode.files import is_fifo, open_fifo
 from appmode.protocol.escaping import escape, unescape
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2, Event, PortsReader
 
@@ -112,10 +112,16 @@ class Recorder:
     rest when it ends. Each line carries the arrival time of its first byte.
     """
 
-    def __init__(self, out: TextIO, origin: float = 0.0, directives: tuple[str, ...] = ()) -> None:
+    def __init__(
+        self,
+        out: TextIO,
+        origin: float = 0.0,
+        directives: tuple[str, ...] = (),
+        name: str | None = None,
+    ) -> None:
         self._out = out
         self._owned = False  # a stream given by the caller stays open
-        self.name = str(getattr(out, "name", "the transcript"))
+        self.name = name or str(getattr(out, "name", "the transcript"))
         self._failed = False
         self._origin = origin
         self._reader = PortsReader()
@@ -129,15 +135,17 @@ class Recorder:
         cls, path: str | os.PathLike[str], origin: float = 0.0, directives: tuple[str, ...] = ()
     ) -> Recorder:
         new = not os.path.lexists(path)
-        check_fifo_read(path, "transcript")
         try:
-            out = open(path, "w", encoding="utf-8")  # noqa: SIM115 - owned by the recorder
+            if is_fifo(path):  # written as it is read: opened without waiting for a reader
+                out = os.fdopen(open_fifo(path, "transcript"), "w", encoding="utf-8")
+            else:
+                out = open(path, "w", encoding="utf-8")  # noqa: SIM115 - the recorder's
         except OSError as exc:
             raise AppmodeError(
                 f"cannot write transcript {os.fspath(path)}: {exc.strerror}"
             ) from None
         try:
-            recorder = cls(out, origin, directives)
+            recorder = cls(out, origin, directives, os.fspath(path))
         except AppmodeError:  # not even the header fits (a full disk): leave nothing
             with contextlib.suppress(OSError):
                 out.close()

@@ -81,6 +81,7 @@ def test_read_resends_on_timeout_then_fails_with_a_clear_error() -> None:
 
 def test_set_is_verified_by_agreeing_c_records_read_after_it() -> None:
     state = HostState()
+    state.feed(c_record(), 0.0)  # what the host read before the set
     state.start_query(ParamQuery((0, 800)), 0.0)
     assert state.take_outbox() == b"{0:800}{Q:P}"
     assert outcomes(state.feed(c_record(), 0.02)) == []  # already on its way: old value
@@ -124,3 +125,15 @@ def test_the_records_of_a_noisy_session_do_not_make_a_lost_zero_the_answer() -> 
         done = outcomes(state.feed(c_record(), t))
         t += 0.1
     assert isinstance(done[0], QueryDone) and done[0].values[1] == 10000
+
+
+def test_a_set_garbled_on_its_way_is_not_reported_as_taken() -> None:
+    """Issue 22.6, as seeded session 862 saw it: `{5:4242}` reached the board as
+    42422; its C records, with a 2 lost, read 4242 too. Records of a value other than
+    the one read before the set are votes against, not history."""
+    state = HostState()
+    state.feed(c_record(), 0.0)
+    state.start_query(ParamQuery((5, 4242), tries=10), 0.0)
+    for i, kp in enumerate([42422, 4242, 42422, 4242, 42422, 42422, 42422]):
+        events = outcomes(state.feed(c_record(velocity_kp=kp), 0.1 * (i + 1)))
+        assert not any(isinstance(e, QueryDone) for e in events), f"record {i}"
