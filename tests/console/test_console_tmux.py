@@ -221,8 +221,10 @@ def test_the_console_keeps_its_history_in_the_tests_folder_whatever_tmux_holds(
         tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", appmode_in_tmux("drive"))
         wait_screen(r"params\s+max_speed 500")
         tmux("send-keys", "-t", SESSION, ":")
-        tmux("send-keys", "-t", SESSION, "speed 600", "Enter")
-        wait_screen(r"max_speed 600")
+        tmux("send-keys", "-t", SESSION, "-l", "speed 600")
+        wait_screen(r"(?m)^:speed 600", timeout=30)  # typed into the command line
+        tmux("send-keys", "-t", SESSION, "Enter")
+        wait_screen(r"max_speed 600", timeout=30)
         tmux("send-keys", "-t", SESSION, "C-q")
         tmux("send-keys", "-t", SESSION, "C-q")
         wait_for(lambda: not _alive())
