@@ -219,7 +219,7 @@ def test_the_console_keeps_its_history_in_the_tests_folder_whatever_tmux_holds(
     )
     try:
         tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", appmode_in_tmux("drive"))
-        wait_screen(r"params\s+max_speed 500")
+        wait_screen(r"parameters read", timeout=30)  # the first read is over: not busy
         tmux("send-keys", "-t", SESSION, ":")
         tmux("send-keys", "-t", SESSION, "-l", "speed 600")
         wait_screen(r"(?m)^:speed 600", timeout=30)  # typed into the command line
