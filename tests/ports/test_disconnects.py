@@ -7,6 +7,7 @@ import socket
 import struct
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -45,6 +46,9 @@ def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> No
 
 
 def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path) -> None:
+    """The board dies before `drive A` and comes back before `drive C`. Each step waits
+    for what the console says, not for a clock: on a loaded machine the console may
+    take seconds to start (issue 22.15)."""
     link = str(tmp_path / "board")
     first = BoardProcess("--pty", "--link", link, "--quiet")
     drive = subprocess.Popen(
@@ -53,22 +57,36 @@ def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
+        text=True,
     )
-    assert drive.stdin is not None
+    assert drive.stdin is not None and drive.stdout is not None
+    said: list[str] = []
+
+    def until(text: str) -> None:
+        assert drive.stdout is not None
+        while not any(text in line for line in said):
+            line = drive.stdout.readline()
+            assert line, f"the console ended before saying {text!r}: {said}"
+            said.append(line)
+
     record = tmp_path / "second.transcript"
     second = None
+    watchdog = threading.Timer(90, drive.kill)  # a console that says nothing ends the wait
+    watchdog.start()
     try:
-        drive.stdin.write(b"wait 1.5\ndrive A\nwait 3\ndrive C\nwait 0.5\nstatus\n")
+        drive.stdin.write("wait 2\ndrive A\nwait 4\ndrive C\nwait 0.5\nstatus\n")
         drive.stdin.flush()
-        time.sleep(1.0)
+        until("parameters read")
         first.kill()  # the board dies before `drive A`
-        time.sleep(1.5)
+        until("link is down: not driving")
         second = BoardProcess("--pty", "--link", link, "--quiet", "--record", str(record))
-        out, _ = drive.communicate(timeout=20)
+        out, _ = drive.communicate(timeout=30)
     finally:
+        watchdog.cancel()
+        drive.kill()
         if second is not None:
             second.stop()
-    text = out.decode()
+    text = "".join(said) + out
     assert "lost" in text and "link is down: not driving" in text and "is back" in text
     assert "in force  C right" in text
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
