@@ -27,18 +27,26 @@ def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> No
         stderr=subprocess.PIPE,
         text=True,
     )
+    assert monitor.stderr is not None and monitor.stdout is not None
+    said: list[str] = []  # what it says on stderr, read as it comes
+    reader = threading.Thread(target=lambda: said.extend(monitor.stderr), daemon=True)
+    reader.start()
     second = None
     try:
-        time.sleep(1.5)
+        monitor.stdout.readline()  # a record came: it is monitoring
         first.kill()  # the device vanishes: the pty is gone, the link dangles
-        time.sleep(1.5)
+        wait_for(lambda: any("lost" in line for line in said), timeout=30)
         second = BoardProcess("--pty", "--link", link, "--quiet")
-        time.sleep(2.5)
+        wait_for(lambda: any("is back" in line for line in said), timeout=30)
+        time.sleep(1.0)  # records again
     finally:
         monitor.send_signal(signal.SIGINT)
-        out, err = monitor.communicate(timeout=10)
+        out = monitor.stdout.read()  # to its end: the monitor has stopped
+        monitor.wait(10)
+        reader.join(10)
         if second is not None:
             second.stop()
+    err = "".join(said)
     assert "lost" in err and "is back" in err, err
     after_back = out.splitlines()[-5:]
     assert all(" < {" in line for line in after_back), "records again after the return"
@@ -74,12 +82,15 @@ def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path
     watchdog = threading.Timer(90, drive.kill)  # a console that says nothing ends the wait
     watchdog.start()
     try:
-        drive.stdin.write("wait 2\ndrive A\nwait 4\ndrive C\nwait 0.5\nstatus\n")
+        drive.stdin.write("wait 2\ndrive A\nwait 4\n")
         drive.stdin.flush()
         until("parameters read")
         first.kill()  # the board dies before `drive A`
         until("link is down: not driving")
         second = BoardProcess("--pty", "--link", link, "--quiet", "--record", str(record))
+        until("is back")
+        drive.stdin.write("drive C\nwait 0.5\nstatus\n")
+        drive.stdin.flush()
         out, _ = drive.communicate(timeout=30)
     finally:
         watchdog.cancel()
