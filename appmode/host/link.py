@@ -212,11 +212,11 @@ class Link(Generic[E]):
         with signals.atomic():
             if self._port is None:
                 return None
-            stop = self._stop() if self.stop_on_close else b""
+            stop = b""
             try:
-                if stop:
+                if self.stop_on_close:
                     self._before_stop()
-                    stop = self._stop()  # what was read may change it
+                    stop = self._stop()
                     self.send(stop)
             except LinkLost:
                 return self.close()  # the port is gone: nothing was sent
