@@ -8,7 +8,6 @@ Thread-free: every call reads what the board has sent meanwhile and lets the hos
 from __future__ import annotations
 
 import contextlib
-import time
 from collections.abc import Callable
 
 import serial
@@ -39,7 +38,6 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         self,
         url: str,
         tap: Tap | None = None,
-        clock: Callable[[], float] = time.monotonic,
         opener: Callable[[str], serial.SerialBase] = open_link,
         stop_on_close: bool = True,
         layout: ALayout = VELOCITY,
@@ -51,7 +49,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
                 f"{url} is the simulated board's control port (UART2, binary frames): this "
                 "command speaks the APP protocol; leave out port=uart2"
             )
-        super().__init__(url, tap, clock, opener)
+        super().__init__(url, tap, opener)
         self.stop_on_close = stop_on_close
         self.state = HostState(layout)
         self.confirm_stop = confirm_stop

@@ -12,7 +12,6 @@ sends a zero velocity frame last (after completing a frame left open by raw byte
 from __future__ import annotations
 
 import contextlib
-import time
 from collections.abc import Callable, Iterable, Iterator
 from functools import partial
 
@@ -62,7 +61,6 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
         self,
         url: str,
         tap: Tap | None = None,
-        clock: Callable[[], float] = time.monotonic,
         opener: Callable[[str], serial.SerialBase] = OPEN_UART2,
         stop_on_close: bool = True,
         drive: DriveType | None = None,
@@ -76,7 +74,7 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
                 f"{url} is the simulated board's APP port: --uart2 speaks the control "
                 "port's frames; use port=uart2 or leave port= out"
             )
-        super().__init__(url, tap, clock, opener)
+        super().__init__(url, tap, opener)
         self.stop_on_close = stop_on_close
         self.timeout = timeout
         self.tries = tries

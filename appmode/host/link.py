@@ -47,22 +47,22 @@ class Link(Generic[E]):
         self,
         url: str,
         tap: Tap | None,
-        clock: Callable[[], float],
         opener: Callable[[str], serial.SerialBase],
     ) -> None:
         self.url = url
         self.tap = tap
-        self._clock = clock
         self._opener = opener
         self._port: serial.SerialBase | None = opener(url)
-        self._origin = clock()  # after opening: an in-process sim:// board booted just now
+        # after opening: an in-process sim:// board booted just now, and its clock is ours
+        board_origin = getattr(self._port, "clock_origin", None)
+        self._origin = time.monotonic() if board_origin is None else float(board_origin)
         self._lost_at = 0.0
         self._ahead: Ahead | None = None  # the line's rate, known once the port is open
         self._pending: list[E | LinkStatus] = []
 
     def now(self) -> float:
         """Seconds since the session started."""
-        return self._clock() - self._origin
+        return time.monotonic() - self._origin
 
     @property
     def connected(self) -> bool:
@@ -116,8 +116,16 @@ class Link(Generic[E]):
                     self._lost(exc)
                     raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
                 if self.tap is not None:
-                    self.tap(self.sent, self.now(), chunk)
+                    self.tap(self.sent, self._written_at(port), chunk)
                 self._sent(chunk)
+
+    def _written_at(self, port: serial.SerialBase) -> float:
+        """When the bytes just written left: the time the board took them for a port that
+        keeps the board's clock (sim://: a recording of it replays exactly), else now."""
+        written_at = getattr(port, "written_at", None)
+        if written_at is None:
+            return self.now()
+        return float(written_at) + (float(port.clock_origin) - self._origin)
 
     def _pace(self, size: int) -> None:
         """Hand the OS no more than a chunk ahead of the line's rate: what it holds would

@@ -13,6 +13,7 @@ are its two ports). There is no thread: the board runs whenever a port is used.
 
 from __future__ import annotations
 
+import math
 import random
 import threading
 import time
@@ -32,6 +33,7 @@ from appmode.line.pacing import Line
 from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
+from appmode.protocol.transcript import TIME_DIGITS
 
 OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults", "port", "share")
 BOARD_OPTIONS = ("profile", "drive", "flash", "pace")
@@ -115,6 +117,8 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         self._faults: tuple[FaultyLine, FaultyLine] | None = None
         self._rx = bytearray()
         self._origin = 0.0
+        self.written_at = 0.0
+        """Board time at which the last write went on the line (`board_time`)."""
         self.board: Board | None = None
         super().__init__(*args, **kwargs)
 
@@ -204,6 +208,18 @@ class SimSerial(SerialBase):  # type: ignore[misc]
     def _now(self) -> float:
         return time.monotonic() - self._origin
 
+    @property
+    def clock_origin(self) -> float:
+        """`time.monotonic()` at the board's power-up: its clock's zero."""
+        return float(self._origin)
+
+    def board_time(self) -> float:
+        """The board's time now, on the grid of a transcript's times (0.1 ms, floored):
+        what a recording stamps a write with is the time the board took it, so a
+        recording of a simulated session replays exactly on virtual time."""
+        grid: int = 10**TIME_DIGITS
+        return math.floor(self._now() * grid) / grid
+
     def _pump(self) -> Wire:
         wire, shared = self._wire, self._shared
         if not self.is_open or wire is None or shared is None:
@@ -262,12 +278,13 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         while len(self._line(wire)) > WRITE_BUFFER:  # the line is slower than the writer
             time.sleep(max(0.0, self._next_wakeup(wire) - self._now()))
             wire = self._pump()
-        if self._faults is None:
-            assert self._shared is not None
-            with self._shared.lock:
-                wire.write(payload, self._now(), self._side)
-        else:
-            self._faults[0].push(payload, self._now())
+        assert self._shared is not None
+        with self._shared.lock:
+            self.written_at = now = self.board_time()
+            if self._faults is None:
+                wire.write(payload, now, self._side)
+            else:
+                self._faults[0].push(payload, now)
         return len(payload)
 
     def flush(self) -> None:

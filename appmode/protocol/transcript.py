@@ -23,6 +23,8 @@ SUFFIX = ".transcript"
 MAX_TIME = 86400.0
 """The latest time a line may have: a day. Later is surely a mistake, and a run to it
 could not finish."""
+TIME_DIGITS = 4
+"""A line's time is written to 0.1 ms."""
 HOLD = 0.5
 """Seconds a recorder waits for a unit to end before writing it as far as it goes (the
 lines after it wait too: the file stays in time order)."""
@@ -195,7 +197,7 @@ class Recorder:
             payload = uart2_payload(raw, self._reader.app_mode)
         else:
             payload = escape(raw)
-        self._write(f"{max(0.0, time - self._origin):.4f} {direction} {payload}\n")
+        self._write(f"{max(0.0, time - self._origin):.{TIME_DIGITS}f} {direction} {payload}\n")
 
     def _write(self, text: str) -> None:
         try:

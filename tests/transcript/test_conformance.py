@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import io
 import re
+import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 
+from appmode.host.client import Host
+from appmode.ports.sim import SimSerial
 from appmode.protocol import params
-from appmode.protocol.transcript import parse_transcript, read_transcript
+from appmode.protocol.transcript import Recorder, parse_transcript, read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, board_process, board_state, run
 
@@ -204,3 +208,42 @@ def test_a_real_board_is_driven_only_when_the_user_agrees() -> None:
     assert "the car moves" in refused.stderr and "Add --yes" in refused.stderr
     simulated = run("conform", "--board", "sim://", "transcripts/suite/s5_save.transcript")
     assert simulated.returncode == 0, simulated.stderr
+
+
+class _LateSimSerial(SimSerial):
+    """A sim:// port whose writes return 7 ms after the board took the bytes: a host
+    preempted between its write and its clock, as on a loaded machine."""
+
+    def write(self, data: bytes) -> int:
+        written = super().write(data)
+        time.sleep(0.007)
+        return written
+
+
+def test_a_recording_of_a_simulated_session_has_the_times_the_board_took_its_bytes() -> None:
+    """A simulated session's recording replays exactly on virtual time even when the host
+    is slow: each `>` line has the time the board took its bytes, not the host's time
+    after the write returned (under load, that crossed the board's 10 ms ticks)."""
+    took: list[tuple[float, bytes]] = []
+    out = io.StringIO()
+    recorder = Recorder(out, 0.0, ("board drive=mecanum",))
+
+    def opener(url: str) -> SimSerial:
+        port = _LateSimSerial(url, timeout=0.01)
+        assert port._wire is not None
+        port._wire.tap = lambda direction, when, data: (
+            took.append((when, data)) if direction == ">" else None
+        )
+        return port
+
+    with Host("sim://?drive=mecanum", tap=recorder, opener=opener) as host:
+        for letters in (b"J", b"A", b"B", b"G", b"H", b"Z"):
+            host.send(letters)
+            host.poll(0.137)
+    recorder.close()
+    transcript = parse_transcript(out.getvalue())
+    sent = [(entry.time, entry.data) for entry in transcript.entries if entry.direction == ">"]
+    assert [data for _, data in sent] == [data for _, data in took]
+    assert [when for when, _ in sent] == [when for when, _ in took]
+    result = run_virtual(transcript)
+    assert result.passed, result.failure
