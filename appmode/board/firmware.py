@@ -18,7 +18,8 @@ from dataclasses import dataclass
 from typing import cast
 
 from appmode.board import kinematics
-from appmode.board.intake import INT_PARAMS, FirmwareIntake, Frame, c_int
+from appmode.board.chip import c_int, float32, times_float32
+from appmode.board.intake import INT_PARAMS, ControlIntake, FirmwareIntake, Frame
 from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
 from appmode.board.vehicle import YAW_GAIN, Vehicle, battery_percent, wrap_degrees
@@ -47,6 +48,10 @@ POSITION_GAIN = 2.0
 (at most max_speed): the car slows as it nears the target and holds it (§9.3)."""
 ANGLE_SPEED = 0.5
 """Angle mode turns at this fraction of max_speed (§9.1)."""
+COPY_MS = 5
+"""How often the reference loop takes UART2's last frame (§13.1)."""
+GYRO_PER_DEGREE = 16.4
+"""The gyro's raw z rate per °/s (±2000 °/s full scale: our decision, §13.1)."""
 UART3, UART2 = "uart3", "uart2"
 """The ports, as the board's log names them."""
 
@@ -100,9 +105,11 @@ class Board:
         self.warnings = 0
         self._boot = now
         self._tick_ms = 0  # the next control tick, in ms from boot
-        self._record_ms = 0  # the next record
-        self._show_a = profile.first_record == "A"
         self._startup = profile.startup_text
+        self._record_ms = profile.startup_ms if self._startup else profile.first_record_ms
+        self._show_a = profile.first_record == "A"
+        self._copy_ms = 0.0 if profile.firmware_uart2 else math.inf  # the next COPY_MS tick
+        self._burst_ms = math.inf  # when UART2's status burst goes out (firmware_uart2)
         self._c_pending = False
         self._c_on_wire_until = -math.inf
         self._outbox = bytearray()
@@ -121,6 +128,8 @@ class Board:
         self._frames = control.HostDecoder(self.drive_type, profile.motor_width)
         self._app2 = app.HostDecoder()
         self._intake2 = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
+        self._control_intake = ControlIntake()
+        self._last_frame: bytes | None = None  # UART2's last frame, not yet taken
 
     # ------------------------------------------------------------ clock
 
@@ -132,7 +141,7 @@ class Board:
         """When the board next sends on UART3 and on UART2 (infinity: nothing planned).
         Records go out on UART3, or on UART2 in APP mode (§12); replies and encoder
         reports on UART2."""
-        uart3, uart2 = float(self._record_ms), math.inf
+        uart3, uart2 = float(self._record_ms), self._burst_ms
         if self._mode("app_mode"):
             uart3, uart2 = uart2, uart3
         if self._reads:
@@ -157,8 +166,15 @@ class Board:
                 period = self.profile.period_ms or TICK_MS
                 late = self._tick_ms - self._record_ms
                 self._record_ms += -(-late // period) * period
-        while min(self._tick_ms, self._record_ms) <= due:
-            if self._tick_ms <= self._record_ms:
+            self._copy_ms = max(self._copy_ms, self._tick_ms)
+        while (at := min(self._tick_ms, self._record_ms, self._copy_ms, self._burst_ms)) <= due:
+            if self._copy_ms == at:  # before the control tick of the same millisecond
+                self._take_frame(self._boot + at / 1000)
+                self._copy_ms += COPY_MS
+            elif self._burst_ms == at:
+                self._out2 += self._status_burst()
+                self._burst_ms = math.inf
+            elif self._tick_ms == at:
                 if self._tick_ms:
                     self._control(1)
                 self._uart2_tick()
@@ -200,6 +216,9 @@ class Board:
         self.uart2_received += len(data)
         if self._mode("app_mode"):
             self._receive_app(data, now, UART2)
+        elif self.profile.firmware_uart2:
+            for frame in self._control_intake.feed(data):
+                self._last_frame = frame
         else:
             for event in self._frames.feed(data):  # never in APP mode: _app2 has that
                 self._apply_control(cast(control.HostEvent, event), now)
@@ -253,6 +272,9 @@ class Board:
         if 0 < speed < profile.stall_speed:
             self.params[params.MAX_SPEED] = speed = profile.stall_speed
         vehicle = self.vehicle
+        if self.uart2_control and profile.firmware_uart2:
+            self._drive_firmware_uart2(ticks)
+            return
         if self.uart2_control and not self._mode("app_mode"):
             for _ in range(min(ticks, MAX_RAMP)):  # beyond that the car has long settled
                 self._drive_uart2(speed)
@@ -262,9 +284,44 @@ class Board:
             vehicle.step(self._target_velocity, ticks * TICK)
         else:
             pushes = self._pushes() if self._powered(self._tick_ms) else (0, 0, 0)
+            rounding = float32 if profile.float32 else float
             for _ in range(min(ticks, MAX_RAMP)):  # beyond that a ramp has long settled
-                vehicle.ramp(pushes, speed, profile.ramp, profile.coast, TICK)
+                vehicle.ramp(pushes, speed, profile.ramp, profile.coast, TICK, rounding)
             self._target_velocity = (vehicle.vx, vehicle.vy, vehicle.vz)
+
+    def _drive_firmware_uart2(self, ticks: int) -> None:
+        """Control ticks as the reference loop runs them once UART2 drives (§13.1): the
+        last velocity frame taken sets the velocity as it is; with none the car keeps
+        the velocity it had at the take-over."""
+        command, vehicle = self._command, self.vehicle
+        if isinstance(command, control.VelocityFrame):
+            vehicle.vx, vehicle.vy, vehicle.vz = map(float, command.values)
+        self._target_velocity = (vehicle.vx, vehicle.vy, vehicle.vz)
+        vehicle.step(self._target_velocity, ticks * TICK)
+
+    def _take_frame(self, now: float) -> None:
+        """A COPY_MS tick of the reference loop (§13.1): once UART2 drives, its last frame
+        is taken, if none is being received; only a velocity frame moves the car."""
+        frame = self._last_frame
+        if frame is None or not self.uart2_control or self._control_intake.receiving:
+            return
+        self._last_frame = None
+        shown = frame.hex(" ").upper()
+        mode = frame[2]
+        if mode not in self.profile.control_modes:
+            name = control.MODES.get(mode, f"mode {mode:02X}")
+            self._note(now, "rejected", f"{shown}: {name} frame: no effect (§13.1)", UART2)
+            return
+        event = control.HostDecoder().feed(frame)[0]
+        assert isinstance(event, control.VelocityFrame), "control_modes holds only 01 here"
+        self._command = event
+        self._note(now, "applied", f"{shown}: velocity {event.values}, as it is (§13.1)", UART2)
+
+    def _status_burst(self) -> bytes:
+        """What reaches the host of the status the reference loop writes to UART2 after
+        each APP record (§13.1): `FF FE` and the gyro z rate's low byte."""
+        rate = self.vehicle.vz * YAW_GAIN * GYRO_PER_DEGREE
+        return control.HEADER + bytes([(int(rate) + 0x8000) & 0xFF])
 
     def _drive_uart2(self, speed: float) -> None:
         """One control tick with UART2 in control: its last motion frame, angle mode's
@@ -371,9 +428,11 @@ class Board:
         )
 
     def _pushes(self) -> tuple[int | None, ...]:
-        """Which way a ramping board pushes x, y, z this tick (vehicle.ramp)."""
+        """Which way a ramping board pushes x, y, z this tick (vehicle.ramp): with no
+        direction x and y coast, and z too on the button page; on the direction page a
+        rotation that ended stops at once (§13.1)."""
         motion = motion_for(self.page, self.direction, self.profile.buttons)
-        z: int | None = self.turn or None
+        z: int | None = self.turn or (0 if self.page is Page.DIRECTION else None)
         if motion is None:
             return (None, None, z)
         x, y, turn = (int(math.copysign(1, f)) if f else 0 for f in motion.holonomic)
@@ -385,7 +444,10 @@ class Board:
         data = self._startup
         if data:
             self._startup = b""
-        elif self._c_pending:
+            self._outbox += data
+            self._record_ms = max(profile.first_record_ms, at)
+            return
+        if self._c_pending:
             self._c_pending = False
             values = tuple(c_int(v) if profile.c_saturates else int(v) for v in self.params)
             data = app.encode(app.ParamsRecord(values))
@@ -398,6 +460,8 @@ class Board:
             self._out2 += data  # §12: records go out on UART2, UART3's transmitter is idle
         else:
             self._outbox += data
+        if profile.firmware_uart2:  # written once the record has gone out
+            self._burst_ms = at + math.ceil(len(data) * profile.byte_ms)
         if profile.period_ms is not None:
             self._record_ms = at + profile.period_ms
         else:
@@ -418,7 +482,10 @@ class Board:
         sign = -1 if self._mode("encoder_reverse") else 1
         fields = [0, 0, 0, 0]
         for i, value in zip(layout.motion, (v.vx, v.vy, v.vz), strict=False):
-            shown = self._whole(sign * value * layout.scale)
+            if self.profile.float32:
+                shown = self._whole(times_float32(sign * value, layout.scale))
+            else:
+                shown = self._whole(sign * value * layout.scale)
             fields[i] = shown if layout.signed else abs(shown) % 256
         if layout.battery is not None:
             fields[layout.battery] = self._battery(ms)

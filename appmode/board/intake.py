@@ -4,16 +4,17 @@
 (§2.1's table) and a `Frame` for each frame collected from `{` to `}`. Frames are read
 as the firmware reads them: position 3 `P` reads, `W` saves, `#` in position 1 makes the
 frame ignored, else position 1 is a parameter index and the value is the float32 sum of
-(byte − 0x30) × 10^k over the bytes from position 3 to the one before `}`.
+(byte − 0x30) × 10^k over the bytes from position 3 to the one before `}`, summed from
+the last (§13.1).
 """
 
 from __future__ import annotations
 
 import math
-import struct
 from dataclasses import dataclass
 
-from appmode.protocol import app
+from appmode.board.chip import float32
+from appmode.protocol import app, control
 
 INT_PARAMS = (0, 1)
 """max_speed and max_position, which the firmware keeps as `int` (the others as floats)."""
@@ -43,33 +44,11 @@ class Steer:
 _STEER = tuple(tuple(Steer(event, framed) for event in app.SINGLE_BYTE) for framed in (False, True))
 
 
-def float32(x: float) -> float:
-    """`x` rounded to the nearest 32-bit float (±inf beyond its range), as C stores it."""
-    if not math.isfinite(x):
-        return x
-    try:
-        return float(struct.unpack("<f", struct.pack("<f", x))[0])
-    except OverflowError:
-        return math.copysign(math.inf, x)
-
-
-def c_int(x: float) -> int:
-    """A float converted to a 32-bit `int` as the chip does: truncated, saturated, NaN 0."""
-    if math.isnan(x):
-        return 0
-    if x >= 2**31:
-        return 2**31 - 1
-    if x <= -(2**31):
-        return -(2**31)
-    return math.trunc(x)
-
-
 def frame_value(digits: bytes) -> float:
-    """Σ (byte − 0x30) × 10^k, k = 0 at the last byte, summed from the first in float32."""
+    """Σ (byte − 0x30) × 10^k, k = 0 at the last byte, summed from the last byte to the
+    first: each term in double, the sum rounded to float32 at every step (§13.1)."""
     total = 0.0
-    last = len(digits) - 1
-    for i, byte in enumerate(digits):
-        k = last - i
+    for k, byte in enumerate(reversed(digits)):
         total = float32(total + (byte - 0x30) * (10.0**k if k < 309 else math.inf))
     return total
 
@@ -120,4 +99,32 @@ class FirmwareIntake:
                     out.append(Frame(bytes(frame[:64]), "ignored", reason=reason))
                 else:
                     out.append(parse_frame(bytes(frame)))
+        return out
+
+
+class ControlIntake:
+    """UART2 as the reference loop reads it (§13.1): `FF FE` looked for only between
+    frames, then the next 8 bytes are a frame whatever they hold. `feed` returns the
+    frames completed, header included; `receiving` says whether one is under way."""
+
+    def __init__(self) -> None:
+        self._frame = bytearray()
+
+    @property
+    def receiving(self) -> bool:
+        return bool(self._frame)
+
+    def feed(self, data: bytes) -> list[bytes]:
+        out: list[bytes] = []
+        frame = self._frame
+        for byte in data:
+            if len(frame) >= len(control.HEADER) or byte == control.HEADER[len(frame)]:
+                frame.append(byte)
+            elif frame:  # a header broken off: this byte may start one
+                frame.clear()
+                if byte == control.HEADER[0]:
+                    frame.append(byte)
+            if len(frame) == control.FRAME:
+                out.append(bytes(frame))
+                frame.clear()
         return out

@@ -54,7 +54,11 @@ class Profile:
     """Units a held direction adds per 10 ms tick, up to ±max_speed; None: a first-order
     lag toward the target (vehicle.RESPONSE_TAU)."""
     coast: float
-    """With no direction, x and y (and z with no rotation) are divided by this each tick."""
+    """With no direction, x and y (and z on the button page) are divided by this each
+    tick."""
+    float32: bool
+    """The car's velocity and the A record's scaling are the chip's 32-bit float
+    arithmetic (§13.1), each result rounded as it is stored."""
     dead_time: float
     """Seconds after power-up with the motors off and the battery voltage read as 0."""
     # -- records (§3)
@@ -80,12 +84,23 @@ class Profile:
     """A `{Q:P}` that arrives while a C record is going out is lost."""
     startup_text: bytes
     """What the APP port carries at power-up, before the first record."""
+    startup_ms: int
+    """When the start-up text goes out, in ms after power-up."""
+    first_record_ms: int
+    """When the first record goes out, in ms after power-up."""
     # -- the control port (§8–§12)
     takeover_byte: int
     """The byte received on UART2 at which UART2 takes over the motion (§8.3)."""
     control_modes: frozenset[int]
     """The frame modes UART2 obeys (01 velocity, 02 motors, 03 position, 80 settings and
     reads); frames of other modes are ignored and counted."""
+    firmware_uart2: bool
+    """UART2 as the reference loop runs it (§13.1): after `FF FE` the next 8 bytes are a
+    frame, whatever they hold; the last frame is taken at a COPY_MS tick with no frame
+    being received, once UART2 drives; a velocity frame sets the velocity as it is (no
+    clamp, no lag), and until one does the motion freezes at the take-over; after each
+    APP record UART2 carries what is left of the status the loop writes there. Else the
+    sheet's frames (§8–§12)."""
     angle_mode: bool
     """Bit 4 of a velocity frame's direction byte turns the third field into an angle."""
     motor_width: int
@@ -107,6 +122,7 @@ class Profile:
 
 MPU_LINES = (
     "mpu_set_sensor complete ......",
+    "mpu_set_sensor complete ......",
     "mpu_configure_fifo complete ......",
     "mpu_set_sample_rate complete ......",
     "dmp_load_motion_driver_firmware complete ......",
@@ -115,9 +131,9 @@ MPU_LINES = (
     "dmp_set_fifo_rate complete ......",
     "setting bias succesfully ......",
     "mpu_set_dmp_state complete ......",
-    "mpu_dmp_init complete ......",
 )
-"""The reference firmware's sensor start-up messages (§13), spelling as it prints them."""
+"""The reference firmware's sensor start-up messages (§13.1), spelling as it prints them:
+`mpu_set_sensor` twice, and no `mpu_dmp_init` line."""
 
 SHEET = Profile(
     name="sheet",
@@ -135,6 +151,7 @@ SHEET = Profile(
     sticky_rotation=False,
     ramp=None,
     coast=1.0,
+    float32=False,
     dead_time=0.0,
     a_layout=VELOCITY,
     truncate=False,
@@ -147,8 +164,11 @@ SHEET = Profile(
     first_record="A",
     read_lost_in_c=False,
     startup_text=b"",
+    startup_ms=0,
+    first_record_ms=0,
     takeover_byte=10,
     control_modes=frozenset({0x01, 0x02, 0x03, 0x80}),
+    firmware_uart2=False,
     angle_mode=True,
     motor_width=2,
 )
@@ -179,7 +199,8 @@ MINIBALANCE = Profile(
     sticky_rotation=True,
     ramp=0.5,
     coast=1.05,
-    dead_time=1.0,
+    float32=True,
+    dead_time=1.9,
     a_layout=SCALED,
     truncate=True,
     yaw_low=-180,
@@ -191,8 +212,11 @@ MINIBALANCE = Profile(
     first_record="B",
     read_lost_in_c=True,
     startup_text=b"".join(line.encode() + b"\r\n" for line in MPU_LINES),
+    startup_ms=500,
+    first_record_ms=1400,
     takeover_byte=11,
-    control_modes=frozenset({0x01, 0x02}),
+    control_modes=frozenset({0x01}),
+    firmware_uart2=True,
     angle_mode=False,
     motor_width=1,
 )

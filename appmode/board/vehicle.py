@@ -7,7 +7,7 @@ Documented model (all constants here):
 - yaw turns at YAW_GAIN degrees a second per unit of z (z = 500 turns 90 °/s), clockwise +;
 - pitch and roll lean with acceleration: TILT_GAIN degrees per unit/s² (nose up while
   speeding up forward, right side down while speeding up to the right);
-- or, on a board whose profile ramps (§13), velocity is set by `ramp` each tick;
+- or, on a board whose profile ramps (§13, §13.1), velocity is set by `ramp` each tick;
 - the battery starts full (12.60 V) and drains IDLE_DRAIN centivolts a second plus
   LOAD_DRAIN per unit of speed; percent is (cV − 1110) × 2 / 3, at most 100, and at least
   0 on the sheet (§3.2).
@@ -16,6 +16,7 @@ Documented model (all constants here):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 RESPONSE_TAU = 0.1
@@ -70,22 +71,30 @@ class Vehicle:
         self._move(old_x, old_y, dt)
 
     def ramp(
-        self, pushes: tuple[int | None, ...], limit: float, step: float, coast: float, dt: float
+        self,
+        pushes: tuple[int | None, ...],
+        limit: float,
+        step: float,
+        coast: float,
+        dt: float,
+        rounding: Callable[[float], float] = float,
     ) -> None:
-        """One control tick of a ramping board (§13): an axis pushed by ±1 gains ±step up
-        to ±limit (checked as the firmware does, upper bound first), an axis pushed by 0
-        is set to 0, an axis pushed by None coasts (divided by `coast`)."""
+        """One control tick of a ramping board (§13.1): an axis pushed by ±1 gains ±step,
+        an axis pushed by 0 is set to 0, an axis pushed by None coasts (divided by
+        `coast`); then every axis is clamped to ±limit as the firmware does, lower bound
+        first (a negative limit holds every axis at it). `rounding` is the chip's float
+        (each result stored as it stores it)."""
         old_x, old_y = self.vx, self.vy
         axes = [self.vx, self.vy, self.vz]
         for i, push in enumerate(pushes):
             if push is None:
-                axes[i] /= coast
+                value = rounding(axes[i] / coast)
             elif push == 0:
-                axes[i] = 0.0
+                value = 0.0
             else:
-                value = axes[i] + push * step
-                value = limit if value > limit else value
-                axes[i] = -limit if value < -limit else value
+                value = rounding(axes[i] + push * step)
+            value = -limit if value < -limit else value
+            axes[i] = limit if value > limit else value
         self.vx, self.vy, self.vz = axes
         self._move(old_x, old_y, dt)
 

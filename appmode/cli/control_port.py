@@ -9,6 +9,7 @@ from collections.abc import Iterable
 from contextlib import ExitStack
 from typing import TextIO
 
+from appmode.board.profiles import SHEET, Profile
 from appmode.cli.hostio import with_recording
 from appmode.host.control_client import ControlHost, Event
 from appmode.host.control_tokens import Step, parse_setting, parse_token, perform
@@ -16,8 +17,10 @@ from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
 from appmode.protocol import control, params, reader, settings
 from appmode.protocol.control_view import settings_table
+from appmode.protocol.params import DriveType
 from appmode.protocol.render import line, view
 
+UNLIMITED = "a minibalance board takes velocities unlimited by max_speed (§13.1)"
 TAKEOVER = (
     "frames sent on the control port take over the car's motion from the APP port "
     "(any 10 bytes, docs/protocol.md §8.3)"
@@ -25,10 +28,21 @@ TAKEOVER = (
 
 
 def open_control_host(
-    stack: ExitStack, url: str, record: str | None, stop_on_close: bool = True
+    stack: ExitStack,
+    url: str,
+    record: str | None,
+    stop_on_close: bool = True,
+    profile: Profile = SHEET,
 ) -> ControlHost:
-    """The control-port host, then its recording (hostio.with_recording)."""
-    return with_recording(stack, ControlHost(url, stop_on_close=stop_on_close), record)
+    """The control-port host, then its recording (hostio.with_recording). A profile
+    without drive types drives an omni car: nothing to read first."""
+    host = ControlHost(
+        url,
+        stop_on_close=stop_on_close,
+        drive=None if profile.drive_types else DriveType.OMNI,
+        takeover_byte=profile.takeover_byte,
+    )
+    return with_recording(stack, host, record)
 
 
 def show(
@@ -101,14 +115,21 @@ def run_send(
     as_json: bool,
     record: str | None,
     out: TextIO,
+    profile: Profile = SHEET,
 ) -> int:
     """Send the tokens in order, printing what comes back; the zero velocity frame is
-    always sent last. `report` turns the encoder report on for the session."""
+    always sent last. `report` turns the encoder report on for the session (on a board
+    that has one: a profile without settings frames has no reads and no report)."""
     steps = [parse_token(token) for token in tokens]  # all checked before sending
+    if profile.firmware_uart2 and any(
+        isinstance(step, Step) and step.kind == "velocity" for step in steps
+    ):
+        print(f"appmode: note: {UNLIMITED}", file=sys.stderr)
     with ExitStack() as stack:
-        host = open_control_host(stack, url, record)
+        host = open_control_host(stack, url, record, profile=profile)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         report_bit = params.MODE_BIT["encoder_report"]
+        report = report and control.SETTINGS in profile.control_modes
         mode = host.read("system_mode") if report else report_bit
         if not mode & report_bit:  # on for the session, then as it was (before the stop)
             host.send_frame(control.setting("system_mode", mode | report_bit))
@@ -147,22 +168,25 @@ def run_monitor(
     record: str | None,
     out: TextIO,
     stop_on_exit: bool = False,
+    profile: Profile = SHEET,
 ) -> int:
     """Print replies and encoder reports as they arrive; passive unless `stop_on_exit`."""
-    seen = errors = 0
+    seen = errors = bursts = 0
     with ExitStack() as stack:
-        host = open_control_host(stack, url, record, stop_on_close=stop_on_exit)
+        host = open_control_host(stack, url, record, stop_on_exit, profile)
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         try:
             for event in host.events(duration):
                 errors += isinstance(event, control.Garbage)
+                bursts += isinstance(event, control.Status)
                 seen += isinstance(event, (control.Reply, control.EncoderReport))
                 if count is not None and seen >= count:
                     break
         finally:
+            also = f", {bursts} status bursts (a minibalance board's, §13.1)" if bursts else ""
             print(
-                f"monitor: {seen} replies and reports, {errors} errors in {host.now():.1f} s",
+                f"monitor: {seen} replies and reports{also}, {errors} errors in {host.now():.1f} s",
                 file=sys.stderr,
             )
     return 0

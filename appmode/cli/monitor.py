@@ -18,6 +18,7 @@ from appmode.cli.options import (
     add_url,
     layout_for,
     number_type,
+    profile_for,
 )
 from appmode.errors import AppmodeError
 from appmode.host.client import Event
@@ -75,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
             raise AppmodeError("--filter picks APP records: not with --uart2")
         return control_port.run_monitor(
             args.url,
+            profile=profile_for(args.url, args.profile),
             as_json=args.json,
             duration=args.duration,
             count=args.count,

@@ -18,6 +18,7 @@ from appmode.cli.options import (
     add_url,
     layout_for,
     number_type,
+    profile_for,
     stop_again_for,
 )
 from appmode.host import control_tokens
@@ -65,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
         return control_port.run_send(
             args.url,
             args.tokens,
+            profile=profile_for(args.url, args.profile),
             listen=args.listen,
             report=not args.no_report,
             as_json=args.json,

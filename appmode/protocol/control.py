@@ -160,7 +160,19 @@ class EncoderReport:
     raw: bytes = _raw()
 
 
-BoardEvent = Reply | EncoderReport | Garbage | app.BoardEvent
+@dataclass(frozen=True, slots=True)
+class Status:
+    """`FF …`: what reaches the host of the 12-byte status the reference firmware writes
+    after each APP record (§13.1): `FF`, then up to two bytes (`FE` and the gyro's low
+    byte on the compiled firmware). Not an error: a host lets it pass."""
+
+    raw: bytes
+
+
+STATUS_MAX = 3
+"""Bytes of a status burst at most."""
+
+BoardEvent = Reply | EncoderReport | Status | Garbage | app.BoardEvent
 ERRORS = (BadFrame, Garbage)
 """Event types that carry bytes which decoded to nothing."""
 
@@ -460,7 +472,8 @@ def _report_length(buf: bytes, pos: int) -> int | None:
 
 
 class BoardDecoder:
-    """board→host bytes → `#` replies and encoder reports (§11, §12); while `app_mode`
+    """board→host bytes → `#` replies, encoder reports (§11, §12) and the reference
+    firmware's status bursts (§13.1); while `app_mode`
     (system_mode bit 7) is on, APP records (§3) instead. `wheels` (3 or 4) fixes a
     report's length; None tells it by where the report's `19` is: a 3-wheel report's
     end falls where a 4-wheel report holds wheel D's top byte, never 19 for a speed."""
@@ -506,6 +519,15 @@ class BoardDecoder:
                 out.append(Reply(raw[1], int.from_bytes(raw[2:], "big", signed=signed), raw))
                 pos += REPLY_LEN
                 continue
+            if byte == HEADER[0]:
+                end = buf.find(HEADER[:1], pos + 1, pos + STATUS_MAX)
+                if end < 0:
+                    if n - pos < STATUS_MAX:
+                        break  # the burst may go on: hold it
+                    end = pos + STATUS_MAX
+                out.append(Status(buf[pos:end]))
+                pos = end
+                continue
             if byte == REPORT:
                 report_len = fixed or _report_length(buf, pos)
                 if report_len is None or n - pos < report_len:
@@ -521,7 +543,7 @@ class BoardDecoder:
                     continue
             end = pos + 1
             limit = min(n, pos + MAX_RUN)
-            while end < limit and buf[end] not in (REPLY, REPORT):
+            while end < limit and buf[end] not in (REPLY, REPORT, HEADER[0]):
                 end += 1
             if end == n and n - pos < MAX_RUN:
                 break  # the run may go on: hold it
@@ -535,4 +557,6 @@ class BoardDecoder:
         if self._app is not None:
             return list(self._app.flush())
         raw, self._buf = self._buf, b""
+        if raw.startswith(HEADER[:1]):
+            return [Status(raw)]
         return [Garbage(raw, "truncated reply or report at end of stream")] if raw else []

@@ -15,10 +15,12 @@ EVENTS = (
     control.ReadFrame,
     control.Reply,
     control.EncoderReport,
+    control.Status,
     control.BadFrame,
     control.Garbage,
 )
 """The control port's event types: what these views show."""
+BoardOrHost = control.HostEvent | control.Reply | control.EncoderReport | control.Status
 KINDS = dict(
     zip(
         EVENTS,
@@ -31,6 +33,7 @@ KINDS = dict(
             "read",
             "reply",
             "encoder_report",
+            "status",
             "bad_frame",
             "garbage",
         ),
@@ -43,7 +46,9 @@ def hex_text(raw: bytes) -> str:
     return raw.hex(" ").upper()
 
 
-def to_json(event: control.HostEvent | control.Reply | control.EncoderReport) -> dict[str, Any]:
+def to_json(
+    event: control.HostEvent | control.Reply | control.EncoderReport | control.Status,
+) -> dict[str, Any]:
     """One JSON-ready object: `kind`, its values, and `raw` as hex pairs."""
     body: dict[str, Any] = {"kind": KINDS[type(event)]}
     if isinstance(event, control.VelocityFrame):
@@ -62,12 +67,14 @@ def to_json(event: control.HostEvent | control.Reply | control.EncoderReport) ->
         body.update(name=event.name, value=event.value)
     elif isinstance(event, control.EncoderReport):
         body.update(targets=list(event.targets), actuals=list(event.actuals))
-    else:
+    elif not isinstance(event, control.Status):
         body["reason"] = event.reason
     return {**body, "raw": hex_text(event.raw)}
 
 
-def describe(event: control.HostEvent | control.Reply | control.EncoderReport) -> str:
+def describe(
+    event: control.HostEvent | control.Reply | control.EncoderReport | control.Status,
+) -> str:
     """A short human description."""
     if isinstance(event, control.VelocityFrame):
         what = f"velocity {event.a} {event.b} {event.c}"
@@ -87,6 +94,8 @@ def describe(event: control.HostEvent | control.Reply | control.EncoderReport) -
     if isinstance(event, control.EncoderReport):
         pairs = zip("ABCD", event.targets, event.actuals, strict=False)
         return "encoders " + " ".join(f"{w}={t}/{a}" for w, t, a in pairs)
+    if isinstance(event, control.Status):
+        return "the firmware's status burst (§13.1)"
     return f"error: {event.reason}"
 
 

@@ -14,12 +14,15 @@ from appmode.protocol.transcript import read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, BoardProcess, board_process, run
 
+BOOT = 2.0
+"""Seconds the firmware takes to boot: records from 1.4 s, motors from 1.9 s (§13.1)."""
 MINIBALANCE_SUITE = sorted((ROOT / "transcripts" / "suite" / "minibalance").glob("*"))
 
 
 @pytest.fixture(scope="module")
 def board() -> Iterator[BoardProcess]:
     with board_process("--pty", "--profile", "minibalance", "--quiet") as served:
+        time.sleep(BOOT)
         yield served
 
 

@@ -129,10 +129,12 @@ def test_started_as_the_program_a_ctrl_c_ends_it_quietly_from_the_first_import(
     script = tmp_path / "appmode"
     script.write_text(probe + "\n")
     as_program = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, cwd=ROOT, check=True
+        [sys.executable, str(script)], capture_output=True, text=True, cwd=ROOT
     )
-    assert as_program.stdout.strip() == "_quit"
+    assert (as_program.returncode, as_program.stdout.strip()) == (0, "_quit"), as_program.stderr
     imported = subprocess.run(
-        [sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, check=True
+        [sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT
     )
-    assert imported.stdout.strip() == "default_int_handler"
+    assert (imported.returncode, imported.stdout.strip()) == (0, "default_int_handler"), (
+        imported.stderr
+    )

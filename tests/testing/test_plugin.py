@@ -111,7 +111,7 @@ def test_the_plugin_names_its_options_in_pytest_help(tmp_path: Path) -> None:
 
 @pytest.mark.appmode_board(profile="minibalance")
 def test_the_marker_picks_the_profile(appmode_board: ServedBoard) -> None:
-    with serial.Serial(appmode_board.port, 9600, timeout=0.1) as port:
+    with serial.Serial(appmode_board.port, 9600, timeout=2) as port:
         text = port.read_until(b"mpu_set_sensor", 4000)  # the firmware's start-up text
     assert b"mpu_set_sensor" in text
     assert appmode_board.profile.name == "minibalance"

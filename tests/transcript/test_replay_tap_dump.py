@@ -195,7 +195,7 @@ def test_plot_writes_a_png(tmp_path: Path) -> None:
 
 def test_plot_and_dump_read_a_minibalance_transcript_by_its_profile(tmp_path: Path) -> None:
     record = tmp_path / "mb.transcript"
-    done = run("send", "sim://?profile=minibalance", "--record", str(record), "wait:1.1", "J", "A")
+    done = run("send", "sim://?profile=minibalance", "--record", str(record), "wait:2.0", "J", "A")
     assert done.returncode == 0, done.stderr
     assert "@board profile=minibalance" in record.read_text()
     dumped = run("dump", str(record), "--json")

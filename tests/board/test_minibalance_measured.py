@@ -1,0 +1,128 @@
+"""The minibalance profile against docs/protocol.md §13.1 (the firmware measured again):
+each case played on the board's wires, paced as the real lines are."""
+
+from __future__ import annotations
+
+from appmode.board.firmware import Board
+from appmode.board.profiles import MINIBALANCE
+from appmode.line.wire import APP, UART2, Wire
+from appmode.protocol import app
+
+ON = 2.0
+"""After the dead time (the battery reads 1.9 s after power-up)."""
+STEP = 0.001
+
+Script = list[tuple[float, str, bytes]]
+
+
+def play(script: Script, until: float) -> tuple[Board, list[tuple[float, app.Record]], bytes]:
+    """Send each (time, port, bytes) on a fresh board's paced wires; the APP port's records
+    with the time each came, and all UART2 carried."""
+    wire = Wire(Board(profile=MINIBALANCE))
+    decoder = app.BoardDecoder()
+    out: list[tuple[float, app.Record]] = []
+    uart2 = b""
+    pending = sorted(script, key=lambda item: item[0])
+    t = 0.0
+    while t <= until + 1e-9:
+        while pending and pending[0][0] <= t + 1e-9:
+            _, port, data = pending.pop(0)
+            wire.write(data, t, port)
+        out += [(t, e) for e in decoder.feed(wire.pump(t, APP)) if isinstance(e, app.RECORDS)]
+        uart2 += wire.pump(t, UART2)
+        t = round(t + STEP, 3)
+    wire.board.advance(until)  # the board runs its ticks when it is next used
+    return wire.board, out, uart2
+
+
+def a_after(records: list[tuple[float, app.Record]], t: float) -> list[app.Velocity]:
+    return [r for when, r in records if when > t and isinstance(r, app.Velocity)]
+
+
+def test_a_negative_max_speed_holds_every_axis_and_the_car_turns() -> None:
+    board, records, _ = play([(ON, APP, b"{0:-5}")], ON + 1.0)
+    assert board.params[0] == -25
+    shown = {(r.x, r.y) for r in a_after(records, ON + 0.2)}
+    assert shown == {(17, 17)}, "|−25 · 0.7| at rest"
+    assert board.vehicle.vz == -25 and board.vehicle.heading != 0
+
+
+def test_lowering_max_speed_while_moving_cuts_the_speed_at_the_next_tick() -> None:
+    script = [(ON, APP, b"{0:300}"), (ON + 0.1, APP, b"JA"), (ON + 1.6, APP, b"{0:20}")]
+    _, records, _ = play(script, ON + 2.0)
+    before = a_after(records, ON + 1.4)[0]
+    assert before.y > 40
+    assert a_after(records, ON + 1.62)[0].y <= 14, "clamped to 20, not coasting from 75"
+
+
+def test_a_set_value_is_summed_from_its_last_digit() -> None:
+    _, records, _ = play([(ON, APP, b"{0:123456789}{Q:P}")], ON + 0.4)
+    values = [r.values for _, r in records if isinstance(r, app.ParamsRecord)]
+    assert values and values[0][0] == 123456784
+
+
+def test_the_a_record_scales_in_float32() -> None:
+    script = [(ON, APP, b"{0:90}"), (ON + 0.1, APP, b"JA")]
+    _, records, _ = play(script, ON + 3.1)
+    assert a_after(records, ON + 3.0)[0].y == 63, "90 · 0.7f is 63 in float32, 62.999… in double"
+
+
+def test_a_rotation_that_ended_stops_at_once_on_the_direction_page() -> None:
+    script = [(ON, APP, b"KC"), (ON + 1.0, APP, b"B"), (ON + 1.1, APP, b"J")]
+    board, _, _ = play(script, ON + 1.09)
+    coasting = board.vehicle.vz
+    assert 0 < coasting < 30, "on the button page z coasts"
+    board, _, _ = play(script, ON + 1.13)
+    assert board.vehicle.vz == 0
+
+
+def test_a_uart2_velocity_is_taken_unclamped_and_without_a_ramp() -> None:
+    frame = bytes.fromhex("FF FE 01 00 00 00 C8 00 00 00 00")
+    board, records, _ = play([(ON, UART2, frame)], ON + 0.2)
+    assert board.params[0] == 30 and board.uart2_control
+    assert a_after(records, ON)[0].y == 140, "200 · 0.7 in the first record, max_speed 30"
+
+
+def test_uart2_motor_frames_move_nothing() -> None:
+    board, _, _ = play([(ON, UART2, bytes.fromhex("FF FE 02 64 64 64 00 00 00 00 00"))], ON + 1)
+    assert board.uart2_control
+    assert (board.vehicle.vx, board.vehicle.vy, board.vehicle.vz) == (0, 0, 0)
+
+
+def test_the_take_over_freezes_the_motion() -> None:
+    script = [(ON, APP, b"{0:300}"), (ON + 0.1, APP, b"JA"), (ON + 1.1, UART2, bytes(11))]
+    board, records, _ = play(script, ON + 3.0)
+    assert board.uart2_control
+    assert {r.y for r in a_after(records, ON + 1.2)} == {35}, "50 units, kept"
+
+
+def test_the_8_bytes_after_a_header_are_a_frame_whatever_they_hold() -> None:
+    data = bytes.fromhex("FF FE 05 FF FE 01 00 00 00 14 00 00 00")
+    board, _, _ = play([(ON, UART2, data)], ON + 1)
+    assert board.uart2_control
+    assert board.vehicle.vy == 0, "the header inside the mode-05 frame starts nothing"
+
+
+def test_a_frame_is_taken_only_when_the_line_pauses() -> None:
+    first = bytes.fromhex("FF FE 01 00 00 00 64 00 00 00")
+    second = bytes.fromhex("FF FE 01 00 00 00 32 00 00 00")
+    script = [(ON, UART2, bytes(11)), (ON + 0.1, UART2, first + second[:2])]
+    board, _, _ = play(script, ON + 0.5)
+    assert board.vehicle.vy == 0, "a frame under way: the first is not taken"
+    board, _, _ = play([*script, (ON + 0.5, UART2, second[2:])], ON + 0.6)
+    assert board.vehicle.vy == 50, "the last frame, once the line pauses"
+
+
+def test_a_frame_before_the_take_over_counts_only_if_it_is_the_last() -> None:
+    velocity = bytes.fromhex("FF FE 01 00 00 00 64 00 00 00")
+    motors = bytes.fromhex("FF FE 02 10 10 10 00 00 00 00")
+    board, _, _ = play([(ON, UART2, velocity + b"\0")], ON + 0.1)
+    assert board.vehicle.vy == 100
+    board, _, _ = play([(ON, UART2, velocity), (ON + 0.1, UART2, motors)], ON + 0.3)
+    assert board.uart2_control and board.vehicle.vy == 0
+
+
+def test_uart2_carries_a_burst_after_each_app_record() -> None:
+    _, records, uart2 = play([], ON)
+    assert uart2 == b"\xff\xfe\x00" * len(records), "FF FE and the gyro's low byte, at rest"
+
