@@ -8,7 +8,7 @@ import itertools
 import pytest
 
 from appmode.board.firmware import Board
-from appmode.board.profiles import MINIBALANCE, MPU_LINES, PROFILES, SHEET
+from appmode.board.profiles import MINIBALANCE, PROFILES, SHEET
 from appmode.board.store import MemoryStore
 from appmode.board.vehicle import battery_percent
 from appmode.errors import AppmodeError

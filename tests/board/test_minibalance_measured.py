@@ -125,4 +125,3 @@ def test_a_frame_before_the_take_over_counts_only_if_it_is_the_last() -> None:
 def test_uart2_carries_a_burst_after_each_app_record() -> None:
     _, records, uart2 = play([], ON)
     assert uart2 == b"\xff\xfe\x00" * len(records), "FF FE and the gyro's low byte, at rest"
-
