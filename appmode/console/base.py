@@ -180,7 +180,7 @@ class BaseSession(ABC):
         if not record:
             return
         try:
-            self.start_recording(record)
+            self.start_recording(record, origin=0.0)  # from the session's start
         except BaseException:
             self.close()
             raise
@@ -189,7 +189,7 @@ class BaseSession(ABC):
         if self.recorder is None:
             return
         try:
-            self.recorder(direction, self.now(), data)
+            self.recorder(direction, time, data)
         except AppmodeError as exc:
             self._drop_recorder()
             self.say(f"{exc}; recording stopped")
@@ -200,9 +200,11 @@ class BaseSession(ABC):
             with contextlib.suppress(AppmodeError):
                 recorder.close()
 
-    def start_recording(self, path: str) -> None:
+    def start_recording(self, path: str, origin: float | None = None) -> None:
+        """Record from now on, times counted from `origin` (default: now)."""
         try:
-            recorder = Recorder.create(path, self.now(), sim_directives(self.url))
+            start = self.now() if origin is None else origin
+            recorder = Recorder.create(path, start, sim_directives(self.url))
         except AppmodeError as exc:
             if self.recorder is None:
                 raise

@@ -119,6 +119,12 @@ def test_a_fifo_nobody_reads_is_waited_on_saying_so(tmp_path: Path) -> None:
         assert proc.returncode == 130 and "Traceback" not in err
 
 
+def _default_sigint() -> None:
+    """A child with Ctrl-C as a terminal gives it (a test run in the background, `pytest
+    &`, has SIGINT ignored, and Python then keeps it ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_started_as_the_program_a_ctrl_c_ends_it_quietly_from_the_first_import(
     tmp_path: Path,
 ) -> None:
@@ -128,8 +134,9 @@ def test_started_as_the_program_a_ctrl_c_ends_it_quietly_from_the_first_import(
     probe = "import appmode, signal; print(getattr(signal.getsignal(signal.SIGINT), '__name__'))"
     script = tmp_path / "appmode"
     script.write_text(probe + "\n")
+    default = {"preexec_fn": _default_sigint} if os.name == "posix" else {}
     as_program = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, cwd=ROOT
+        [sys.executable, str(script)], capture_output=True, text=True, cwd=ROOT, **default
     )
     assert (as_program.returncode, as_program.stdout.strip()) == (0, "_quit"), as_program.stderr
     imported = subprocess.run(

@@ -117,3 +117,32 @@ def test_a_speed_step_past_the_range_says_what_it_set() -> None:
     assert done.returncode == 0, done.stderr
     assert "max_speed -4500 is out of 0–65535: setting 0" in done.stdout
     assert "max_speed = 0 (verified)" in done.stdout
+
+
+def test_a_console_recording_has_the_times_the_board_took_its_bytes(tmp_path: Path) -> None:
+    """On sim:// the console's recording stamps what it sends with the time the board took
+    it, counted from the session's start, not with the console's clock after the write
+    (under load those differ by ms, and a replay on virtual time then differs)."""
+    record = tmp_path / "s.transcript"
+    session = Session("sim://", HoldToDrive(), str(record))
+    port = session.host.link
+    assert port is not None
+    write = port.write
+
+    def late_write(data: bytes) -> int:  # the console preempted after its write
+        written = write(data)
+        time.sleep(0.005)
+        return int(written)
+
+    port.write = late_write  # type: ignore[method-assign]
+    try:
+        time.sleep(0.2)
+        session.run("drive A")
+        took = port.written_at
+        time.sleep(0.05)
+    finally:
+        session.close()
+    stamps = [
+        float(line.split(" ")[0]) for line in record.read_text().splitlines() if " > A" in line
+    ]
+    assert stamps[0] == took
