@@ -125,7 +125,7 @@ class Board:
         self._target_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
         self._reads: list[settings.Read] = []
         self._out2 = bytearray()
-        self._frames = control.HostDecoder(self.drive_type, profile.motor_width)
+        self._frames = control.HostDecoder(self.drive_type)
         self._app2 = app.HostDecoder()
         self._intake2 = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
         self._control_intake = ControlIntake()
@@ -355,9 +355,7 @@ class Board:
         return kinematics.wheels(self.drive_type, *self._target_velocity)
 
     def _angle_mode(self, frame: control.VelocityFrame) -> bool:
-        return (
-            frame.angle and self.profile.angle_mode and self.drive_type is not DriveType.DIFF_GYRO
-        )
+        return frame.angle and self.drive_type is not DriveType.DIFF_GYRO
 
     def _velocity_target(
         self, frame: control.VelocityFrame, speed: float

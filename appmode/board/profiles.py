@@ -101,10 +101,6 @@ class Profile:
     clamp, no lag), and until one does the motion freezes at the take-over; after each
     APP record UART2 carries what is left of the status the loop writes there. Else the
     sheet's frames (§8–§12)."""
-    angle_mode: bool
-    """Bit 4 of a velocity frame's direction byte turns the third field into an angle."""
-    motor_width: int
-    """Bytes per motor speed in a mode-02 frame: 2, or 1 (always a 10-byte frame)."""
 
     def check(self, drive: bool, flash: bool) -> None:
         """AppmodeError when a board of this profile is asked for what it does not have."""
@@ -169,8 +165,6 @@ SHEET = Profile(
     takeover_byte=10,
     control_modes=frozenset({0x01, 0x02, 0x03, 0x80}),
     firmware_uart2=False,
-    angle_mode=True,
-    motor_width=2,
 )
 
 MINIBALANCE = Profile(
@@ -217,8 +211,6 @@ MINIBALANCE = Profile(
     takeover_byte=11,
     control_modes=frozenset({0x01}),
     firmware_uart2=True,
-    angle_mode=False,
-    motor_width=1,
 )
 
 PROFILES: dict[str, Profile] = {p.name: p for p in (SHEET, MINIBALANCE)}

@@ -239,9 +239,8 @@ def velocity(
     return VelocityFrame(x, y, z)
 
 
-def encode(item: HostFrame | Reply | EncoderReport, motor_width: int = 2) -> bytes:
-    """The wire bytes of a frame, reply or report; ValueError when a value is out of range.
-    `motor_width` 1 is §13's one byte per motor."""
+def encode(item: HostFrame | Reply | EncoderReport) -> bytes:
+    """The wire bytes of a frame, reply or report; ValueError when a value is out of range."""
     if isinstance(item, VelocityFrame):
         for name, value in zip("abc", item.values, strict=True):
             _check(f"velocity field {name}", value, U16)
@@ -251,13 +250,9 @@ def encode(item: HostFrame | Reply | EncoderReport, motor_width: int = 2) -> byt
         count = len(item.speeds)
         if count not in _MOTOR_BITS:
             raise InvalidValue(f"a motor frame has 3 or 4 speeds, not {count}")
-        top = 0xFF if motor_width == 1 else U16
         for i, speed in enumerate(item.speeds):
-            _check(f"motor {i + 1}", speed, top)
+            _check(f"motor {i + 1}", speed, U16)
         signs = bytes([_signs(item.speeds, _MOTOR_BITS[count])])
-        if motor_width == 1:
-            body = bytes(abs(s) for s in item.speeds).ljust(6, b"\0")
-            return HEADER + bytes([MOTORS]) + body + signs
         return HEADER + bytes([MOTORS]) + _u16s(item.speeds) + signs
     if isinstance(item, PositionFrame):
         values = (item.x, item.y, item.z)
@@ -320,19 +315,14 @@ def _signed(raw: bytes, at: int, bits: int, bit: int) -> int:
     return -value if bits >> bit & 1 else value
 
 
-def _parse(raw: bytes, motors: int, motor_width: int) -> HostEvent:
+def _parse(raw: bytes, motors: int) -> HostEvent:
     mode, bits = raw[2], raw[len(raw) - 1]
     if mode == VELOCITY:
         a, b, c = (_signed(raw, 3 + 2 * i, bits, bit) for i, bit in enumerate(_FIELD_BITS))
         return VelocityFrame(a, b, c, bool(bits & ANGLE_BIT), raw)
     if mode == MOTORS:
         order = _MOTOR_BITS[motors]
-        if motor_width == 1:
-            speeds = tuple(
-                -raw[3 + i] if bits >> bit & 1 else raw[3 + i] for i, bit in enumerate(order)
-            )
-        else:
-            speeds = tuple(_signed(raw, 3 + 2 * i, bits, bit) for i, bit in enumerate(order))
+        speeds = tuple(_signed(raw, 3 + 2 * i, bits, bit) for i, bit in enumerate(order))
         return MotorFrame(speeds, raw)
     if mode == POSITION:
         x, y, z = (_signed(raw, 3 + 2 * i, bits, bit) for i, bit in enumerate(_FIELD_BITS))
@@ -359,17 +349,13 @@ def _parse(raw: bytes, motors: int, motor_width: int) -> HostEvent:
 
 
 class HostDecoder:
-    """host→board bytes → frames (§8.2). `drive` fixes a mode-02 frame's length;
-    `motor_width` 1 reads §13's one byte per motor (always a 10-byte frame)."""
+    """host→board bytes → frames (§8.2). `drive` fixes a mode-02 frame's length."""
 
     LIMIT = max(MOTOR_FRAME_4, MAX_RUN)
     """Most bytes ever held between calls."""
 
-    def __init__(
-        self, drive: DriveType = DriveType.OMNI, motor_width: int = 2, app_mode: bool = False
-    ) -> None:
+    def __init__(self, drive: DriveType = DriveType.OMNI, app_mode: bool = False) -> None:
         self._buf = b""
-        self.motor_width = motor_width
         self.drive = drive
         self._app: app.HostDecoder | None = app.HostDecoder() if app_mode else None
 
@@ -393,10 +379,9 @@ class HostDecoder:
     def drive(self, drive: DriveType) -> None:
         self._drive = drive
         self._motors = motor_count(drive)
-        four = self._motors == 4 and self.motor_width == 2
         self._lengths = {
             VELOCITY: FRAME,
-            MOTORS: MOTOR_FRAME_4 if four else FRAME,
+            MOTORS: MOTOR_FRAME_4 if self._motors == 4 else FRAME,
             POSITION: FRAME,
             SETTINGS: FRAME,
         }
@@ -431,7 +416,7 @@ class HostDecoder:
                 continue
             if n - pos < length:
                 break
-            out.append(_parse(buf[pos : pos + length], self._motors, self.motor_width))
+            out.append(_parse(buf[pos : pos + length], self._motors))
             pos += length
         self._buf = buf[pos:]
         return out

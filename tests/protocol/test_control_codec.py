@@ -123,12 +123,6 @@ def test_s9_2_motor_bits_four_motors_bit_3_is_motor_4() -> None:
     assert encode(MotorFrame((-1, 2, 3))) == hexes("FF FE 02 00 01 00 02 00 03 04")
 
 
-def test_s9_2_one_byte_motors_of_the_reference_firmware() -> None:
-    raw = encode(MotorFrame((10, -20, 30)), motor_width=1)
-    assert raw == hexes("FF FE 02 0A 14 1E 00 00 00 02")
-    assert decode_whole(partial(HostDecoder, DriveType.OMNI, 1), raw) == [MotorFrame((10, -20, 30))]
-
-
 def test_s9_3_position_frame() -> None:
     raw = encode(PositionFrame(100, -200, 0))
     assert raw == hexes("FF FE 03 00 64 00 C8 00 00 02")
