@@ -112,7 +112,13 @@ def run(args: argparse.Namespace) -> int:
             raise AppmodeError("--drive-type is for the control port: add --uart2")
         return run_drive(
             Session(
-                url, driving, args.record, on_message, layout, stop_again_for(url, args.profile)
+                url,
+                driving,
+                args.record,
+                on_message,
+                layout,
+                stop_again_for(url, args.profile),
+                profile_for(url, args.profile).steer_in_frames,
             ),
             interactive,
             sys.stdin,

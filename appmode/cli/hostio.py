@@ -27,6 +27,7 @@ def open_host(
     stop_on_close: bool = True,
     layout: ALayout = VELOCITY,
     stop_again: bytes | None = None,
+    frames_stop: bool = False,
 ) -> Host:
     """The APP host, then its recording (`with_recording`). With `stop_again` it confirms
     its stop on the board's A records, sending those bytes while the car still moves."""
@@ -36,6 +37,7 @@ def open_host(
         layout=layout,
         confirm_stop=stop_again is not None,
         stop_again=stop_again or b"",
+        frames_stop=frames_stop,
     )
     return with_recording(stack, host, record)
 

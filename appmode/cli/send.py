@@ -83,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
         out=sys.stdout,
         layout=layout_for(args.url, args.profile),
         stop_again=stop_again_for(args.url, args.profile),
+        frames_stop=profile_for(args.url, args.profile).steer_in_frames,
     )
 
 
@@ -97,12 +98,16 @@ def run_send(
     out: TextIO,
     layout: ALayout = VELOCITY,
     stop_again: bytes | None = None,
+    frames_stop: bool = False,
 ) -> int:
     """Send the tokens in order, printing what comes back; `Z` is always sent last (and
-    with `stop_again`, confirmed on the board's A records)."""
+    with `stop_again`, confirmed on the board's A records). `frames_stop`: every frame
+    stops this board's car (§13)."""
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:
-        host = open_host(stack, url, record, layout=layout, stop_again=stop_again)
+        host = open_host(
+            stack, url, record, layout=layout, stop_again=stop_again, frames_stop=frames_stop
+        )
         for step in steps:
             if isinstance(step, Wait):
                 for event in host.events(step.seconds):

@@ -28,7 +28,7 @@ from appmode.protocol.directions import (
     grid_for,
     letter_name,
 )
-from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, ALayout
 
 COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("params", "", "read the nine parameters"),
@@ -73,6 +73,7 @@ class Session(BaseSession):
         on_message: Callable[[str], None] | None = None,
         layout: ALayout = VELOCITY,
         stop_again: bytes | None = None,
+        frames_stop: bool = False,
     ) -> None:
         super().__init__(url, driving, on_message)
         self.host = Host(
@@ -81,6 +82,7 @@ class Session(BaseSession):
             layout=layout,
             confirm_stop=stop_again is not None,
             stop_again=stop_again or b"",
+            frames_stop=frames_stop,
         )
         self.page = Page.DIRECTION
         self.page_letter = "J"
@@ -202,7 +204,7 @@ class Session(BaseSession):
     def _frame_while_driving(self) -> None:
         """A parameter frame is about to go out while a direction is in force: on the
         reference firmware every frame stops the car (§13), so say so, never silently."""
-        if self.host.state.layout is SCALED:
+        if self.host.state.frames_stop:
             self.stop()
             self.say("stopped: a minibalance car stops at every frame; drive again after it")
         else:

@@ -43,6 +43,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         layout: ALayout = VELOCITY,
         confirm_stop: bool = False,
         stop_again: bytes = app.stop_again(frames_take_letters=True),
+        frames_stop: bool = False,
     ) -> None:
         if is_simulated(url) and sim_side(url) == UART2:
             raise AppmodeError(
@@ -51,7 +52,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
             )
         super().__init__(url, tap, opener)
         self.stop_on_close = stop_on_close
-        self.state = HostState(layout)
+        self.state = HostState(layout, frames_stop)
         self.confirm_stop = confirm_stop
         """Check on the board's A records that the final stop took (`_confirm`)."""
         self.stop_again = stop_again

@@ -107,9 +107,11 @@ class LinkStats:
 class HostState:
     """Last records seen and link counters, fed with the board's bytes."""
 
-    def __init__(self, layout: ALayout = VELOCITY) -> None:
+    def __init__(self, layout: ALayout = VELOCITY, frames_stop: bool = False) -> None:
         self.layout = layout
         """How the board's A records are laid out (§3.1, §13)."""
+        self.frames_stop = frames_stop
+        """Every frame sent stops the car (a minibalance board: its `{` steers, §13)."""
         self.decoder = app.BoardDecoder()
         self.stats = LinkStats()
         self.velocity: app.Velocity | None = None
@@ -154,7 +156,9 @@ class HostState:
             if isinstance(event, app.Move):
                 self.stopped_at = None
                 self.moving_since = now
-            elif isinstance(event, (app.Stop, app.SwitchPage)):
+            elif isinstance(event, (app.Stop, app.SwitchPage)) or (
+                self.frames_stop and event.raw.startswith(b"{")
+            ):
                 self.stopped_at, self._warned = now, False
                 self.moving_since = None
 

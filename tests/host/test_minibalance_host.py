@@ -7,6 +7,7 @@ import time
 
 from appmode.board.profiles import MINIBALANCE
 from appmode.host.client import Host
+from appmode.host.state import BoardWarning
 from appmode.ports.sim import SimSerial
 
 URL = "sim://?profile=minibalance"
@@ -36,3 +37,21 @@ def test_s13_a_set_whose_read_is_lost_during_a_c_record_is_still_verified() -> N
         assert values[0] == 100
         assert sum("max_speed = 100" in n for n in notes) >= 1
         host.set_param(0, 30)
+
+
+def _warnings_after_a_read_while_driving(frames_stop: bool) -> list[str]:
+    """J A until the car moves, then {Q:P}: on the reference firmware the frame's `{`
+    stops the car (§13), and it coasts to a stand."""
+    with Host(URL, layout=MINIBALANCE.a_layout, frames_stop=frames_stop) as host:
+        list(host.events(2.0))  # the board boots: motors from 1.9 s (§13.1)
+        host.send(b"JA")
+        list(host.events(0.7))
+        host.send(b"{Q:P}")
+        events = list(host.events(2.0))
+    return [event.text for event in events if isinstance(event, BoardWarning)]
+
+
+def test_a_frame_that_stops_a_minibalance_car_is_no_take_over() -> None:
+    assert _warnings_after_a_read_while_driving(frames_stop=True) == []
+    blind = _warnings_after_a_read_while_driving(frames_stop=False)
+    assert any("may have taken over" in text for text in blind), "what it said before"
