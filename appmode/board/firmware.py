@@ -601,7 +601,8 @@ class Board:
             self.errors += 1
             self._note(now, "rejected", f"{shown}: save failed: {exc}", port)
             return
-        self._note(now, "applied", f"{shown}: saved {list(saved)}", port)
+        nine, calibration = list(saved[: params.PARAM_COUNT]), saved[params.PARAM_COUNT]
+        self._note(now, "applied", f"{shown}: saved {nine} (gyro calibration {calibration})", port)
 
     def _load(self, values: tuple[int, ...] | tuple[float, ...]) -> None:
         """Load settings into the running copy; system_mode's unsaved bits stay (§10)."""

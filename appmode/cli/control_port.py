@@ -19,7 +19,13 @@ from appmode.protocol import control, params, reader, settings
 from appmode.protocol.control_view import settings_table
 from appmode.protocol.params import DriveType
 from appmode.protocol.render import line, view
+from appmode.text import counted, wrapped
 
+QUIET_UART2 = (
+    "a board sends replies only to reads, and encoder reports only while system_mode "
+    "bit 6 is set (docs/protocol.md §12); 'appmode send URL --uart2 wait:5' turns the "
+    "report on for its session"
+)
 UNLIMITED = "a minibalance board takes velocities unlimited by max_speed (§13.1)"
 TAKEOVER = (
     "frames sent on the control port take over the car's motion from the APP port "
@@ -184,9 +190,12 @@ def run_monitor(
                 if count is not None and seen >= count:
                     break
         finally:
-            also = f", {bursts} status bursts (a minibalance board's, §13.1)" if bursts else ""
+            also = f", {counted(bursts, 'status burst')} (a minibalance board's)" if bursts else ""
             print(
-                f"monitor: {seen} replies and reports{also}, {errors} errors in {host.now():.1f} s",
+                f"monitor: {seen} replies and reports{also}, {counted(errors, 'error')} "
+                f"in {host.now():.1f} s",
                 file=sys.stderr,
             )
+            if not seen:
+                print(wrapped(f"monitor: {QUIET_UART2}"), file=sys.stderr)
     return 0

@@ -24,6 +24,7 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Event
 from appmode.protocol import app
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.text import counted
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -130,7 +131,7 @@ def run_monitor(
         finally:
             stats = host.state.stats
             print(
-                f"{name}: {stats.records} records, {stats.errors} errors, "
+                f"{name}: {counted(stats.records, 'record')}, {counted(stats.errors, 'error')}, "
                 f"{stats.bytes_in} bytes in {host.now():.1f} s",
                 file=sys.stderr,
             )

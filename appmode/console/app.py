@@ -311,10 +311,12 @@ def run_drive(
             for note in session.closing_notes:
                 print(f"appmode: WARNING: {note}", file=sys.stderr)
             if warning is not None:
-                print(
-                    f"appmode: {warning}: the board keeps it until it is switched off",
-                    file=sys.stderr,
+                lasts = (
+                    "the embedded board ends with this session"
+                    if session.simulated
+                    else "the board keeps it until it is switched off"
                 )
+                print(f"appmode: {warning}: {lasts}", file=sys.stderr)
     return 0
 
 

@@ -11,6 +11,7 @@ from appmode.console.base import BaseSession
 from appmode.console.hold import HoldToDrive
 from appmode.host.state import HostState, LinkStats
 from appmode.protocol import app
+from appmode.text import counted
 
 Fragments = StyleAndTextTuples
 
@@ -78,7 +79,7 @@ def link_line(
     recent = stats.recent_errors(now)
     if recent:
         out: Fragments = [
-            ("reverse bold fg:ansiyellow", f" link DEGRADED: {recent} errors in 5 s ")
+            ("reverse bold fg:ansiyellow", f" link DEGRADED: {counted(recent, 'error')} in 5 s ")
         ]
     else:
         out = [("fg:ansired bold" if age > 1.0 else "fg:ansigreen", " link up")]

@@ -37,7 +37,7 @@ COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("speed", "+N|-N|N", f"change max_speed (keys + and - step {SPEED_STEP})"),
     CommandSpec("drive", "A-H", "drive in a direction (latched: until stop)"),
     CommandSpec("stop", "", "stop the car (Z)"),
-    CommandSpec("page", "NAME", "switch page: direction, button, gravity (I, J, K)"),
+    CommandSpec("page", "NAME", "switch page: direction (J), button (K), gravity (I)"),
     CommandSpec("send", "TOKEN...", "send raw tokens: letters, {frames}, \\xNN"),
 )
 PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}

@@ -83,7 +83,7 @@ def test_sighup_ends_monitor_with_its_summary(tmp_path: Path) -> None:
             _, err = proc.communicate(timeout=10)
         finally:
             proc.kill()
-    assert "monitor: " in err.decode() and " records, " in err.decode()
+    assert "monitor: " in err.decode() and " record" in err.decode()
     assert "Traceback" not in err.decode()
 
 

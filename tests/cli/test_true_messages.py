@@ -1,0 +1,49 @@
+"""Issue 23.2: what appmode says is what happened."""
+
+from __future__ import annotations
+
+from appmode.board.firmware import Board
+from appmode.console.session import COMMANDS
+from appmode.protocol import params
+from appmode.text import counted, wrapped
+from tests.support.processes import run
+
+
+def test_counts_agree_with_their_nouns() -> None:
+    assert [counted(n, "error") for n in (0, 1, 2)] == ["0 errors", "1 error", "2 errors"]
+    assert counted(1, "reply", "replies") == "1 reply"
+
+
+def test_wrapped_lines_fit_and_keep_words_whole() -> None:
+    text = "word " * 40 + "docs/protocol.md §12 'appmode send URL --uart2 wait:5'"
+    lines = wrapped(text).splitlines()
+    assert max(map(len, lines)) <= 80
+    assert " ".join(line.strip() for line in lines) == text.strip()
+
+
+def test_a_quiet_control_port_says_why() -> None:
+    done = run("monitor", "sim://?port=uart2", "--uart2", "--duration", "0.3")
+    assert done.returncode == 0, done.stderr
+    assert "0 replies and reports, 0 errors" in done.stderr
+    assert "encoder reports only while" in done.stderr and "system_mode bit 6" in done.stderr
+    assert max(len(line) for line in done.stderr.splitlines()) <= 80
+
+
+def test_quitting_the_embedded_board_unsaved_says_it_ends_with_the_session() -> None:
+    done = run("drive", stdin=b"set max_speed 800\nquit\n")
+    assert "not saved: max_speed 500 → 800: the embedded board ends with this session" in (
+        done.stderr
+    )
+    assert "switched off" not in done.stderr
+
+
+def test_the_page_command_pairs_each_page_with_its_letter() -> None:
+    page = next(spec for spec in COMMANDS if spec.name == "page")
+    assert "direction (J), button (K), gravity (I)" in page.help
+
+
+def test_the_board_log_shows_nine_parameters_saved_and_the_calibration_apart() -> None:
+    board = Board()
+    board.receive(b"{Q:W}", 0.1)
+    (note,) = [n.text for n in board.take_notes()]
+    assert note == f"{{Q:W}}: saved {list(params.DEFAULTS)} (gyro calibration 0)"
