@@ -60,10 +60,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "port's records (two sim:// URLs are one simulated board)",
     )
     drive.add_argument(
+        "--drive",
         "--drive-type",
+        dest="drive_type",
         choices=DRIVE_NAMES,
-        help="with UART2: the car's drive type, for a board that does not answer reads "
-        "(default: read from system_mode)",
+        help="the car's drive type: the embedded board's (sim://?drive=; default: omni), "
+        "or with UART2 a board's that does not answer reads (default: read from "
+        "system_mode)",
     )
     drive.add_argument(
         "--hold-first",
@@ -101,15 +104,18 @@ def run(args: argparse.Namespace) -> int:
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
-    url = _with_profile(args.url, args.profile)
+    url = _with_options(args.url, profile=args.profile, drive=args.drive_type)
     on_message = None if interactive else _print_message
     layout = layout_for(url, args.profile)
     uart2_url = args.uart2_url or args.url2
     if args.url2 and args.uart2_url:
         raise AppmodeError("give the control port once: a second URL or --uart2-url")
     if uart2_url is None and not args.uart2:
-        if args.drive_type:
-            raise AppmodeError("--drive-type is for the control port: add --uart2")
+        if args.drive_type and not is_simulated(url):
+            raise AppmodeError(
+                "--drive on a real board's APP port: its drive type is part of "
+                "system_mode (appmode params URL --set system_mode=N), or add --uart2"
+            )
         return run_drive(
             Session(
                 url,
@@ -126,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
         )
     app_url = None
     if uart2_url is not None:
-        app_url, url = url, _with_profile(uart2_url, args.profile)
+        app_url, url = url, _with_options(uart2_url, profile=args.profile, drive=args.drive_type)
         if is_simulated(app_url) and is_simulated(url):
             app_url, url = _one_board(app_url, url)
     session = ControlSession(
@@ -142,10 +148,13 @@ def run(args: argparse.Namespace) -> int:
     return run_drive(session, interactive, sys.stdin, sys.stdout)
 
 
-def _with_profile(url: str, profile: str | None) -> str:
-    """A sim:// URL with `--profile` as its profile."""
-    if profile and url.lower().startswith("sim://") and "profile=" not in url:
-        url += f"{'&' if '?' in url else '?'}profile={profile}"
+def _with_options(url: str, **options: str | None) -> str:
+    """A sim:// URL with `--profile` and `--drive` as its options, where it has none."""
+    if not url.lower().startswith("sim://"):
+        return url
+    for name, value in options.items():
+        if value and f"{name}=" not in url:
+            url += f"{'&' if '?' in url else '?'}{name}={value}"
     return url
 
 

@@ -27,6 +27,7 @@ from appmode.cli import (
     send,
     tap,
 )
+from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
 from appmode.host import signals
 
@@ -55,13 +56,13 @@ Handler = Callable[[argparse.Namespace], int]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="appmode",
         description="Drive, emulate and test robot-car boards that speak the APP protocol "
         "(9600 bps: letters drive, {…} frames read and set parameters).",
     )
     parser.add_argument("--version", action="version", version=f"appmode {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
     for command in COMMANDS:
         command.register(sub).set_defaults(handler=command.run)

@@ -6,7 +6,7 @@ import argparse
 import contextlib
 import math
 from collections.abc import Callable
-from typing import TypeAlias
+from typing import Any, TypeAlias
 
 from serial import SerialException
 
@@ -92,6 +92,15 @@ def stop_again_for(url: str | None, name: str | None) -> bytes:
 def layout_for(url: str | None, name: str | None) -> ALayout:
     """The A record layout of `profile_for(url, name)`."""
     return profile_for(url, name).a_layout
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser that takes options only as spelled: no prefix matching, so a
+    mistyped option is an error naming it, never another option."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
 
 Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"

@@ -1,4 +1,4 @@
-"""Issue 23.2: what appmode says is what happened."""
+"""Issue 23.2 and 23.4: what appmode says is what happened; options do what they say."""
 
 from __future__ import annotations
 
@@ -47,3 +47,18 @@ def test_the_board_log_shows_nine_parameters_saved_and_the_calibration_apart() -
     board.receive(b"{Q:W}", 0.1)
     (note,) = [n.text for n in board.take_notes()]
     assert note == f"{{Q:W}}: saved {list(params.DEFAULTS)} (gyro calibration 0)"
+
+
+def test_options_are_taken_only_as_spelled() -> None:
+    done = run("send", "--lis", "1", "sim://", "Z")
+    assert done.returncode == 2 and "unrecognized arguments: --lis" in done.stderr
+    done = run("drive", "--drive-t", "mecanum")
+    assert done.returncode == 2 and "unrecognized arguments: --drive-t" in done.stderr
+
+
+def test_drive_takes_the_drive_type_the_other_commands_take() -> None:
+    done = run("drive", "--drive", "mecanum", stdin=b"status\nquit\n")
+    assert done.returncode == 0, done.stderr
+    assert "sim://?drive=mecanum" in done.stdout
+    real = run("drive", "/dev/null", "--drive", "mecanum")
+    assert real.returncode == 2 and "--drive on a real board's APP port" in real.stderr
