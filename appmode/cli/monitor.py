@@ -130,9 +130,10 @@ def run_monitor(
                     break
         finally:
             stats = host.state.stats
+            skipped = f" ({stats.skipped} before the first record)" if stats.skipped else ""
             print(
                 f"{name}: {counted(stats.records, 'record')}, {counted(stats.errors, 'error')}, "
-                f"{stats.bytes_in} bytes in {host.now():.1f} s",
+                f"{stats.bytes_in} bytes{skipped} in {host.now():.1f} s",
                 file=sys.stderr,
             )
     return 0

@@ -69,6 +69,9 @@ class LinkStats:
     records: int = 0
     errors: int = 0
     discarded: int = 0
+    skipped: int = 0
+    """Bytes before the first record of a link that start no record (the end of one
+    caught half way, a board's start-up text): not errors."""
     last_record: float | None = None
     _recent: deque[float] = field(default_factory=deque)
     _error_times: deque[float] = field(default_factory=deque)
@@ -113,6 +116,8 @@ class HostState:
         self.frames_stop = frames_stop
         """Every frame sent stops the car (a minibalance board: its `{` steers, §13)."""
         self.decoder = app.BoardDecoder()
+        self.in_step = False
+        """A record has come since the link opened: undecodable bytes are errors now."""
         self.stats = LinkStats()
         self.velocity: app.Velocity | None = None
         self.attitude: app.Attitude | None = None
@@ -226,14 +231,19 @@ class HostState:
     def reset_decoder(self) -> None:
         """Forget a partial record (after the link was lost: the board may restart)."""
         self.decoder = app.BoardDecoder()
+        self.in_step = False
         self.letters_ignored = False
 
     def _apply(self, event: app.BoardEvent, now: float) -> Outcome | None:
         if isinstance(event, app.ERRORS):
-            self.stats.count_error(now, len(event.raw))
+            if not self.in_step and not event.raw.startswith(b"{"):  # no record's start
+                self.stats.skipped += len(event.raw)
+            else:
+                self.stats.count_error(now, len(event.raw))
             if self.query is not None and event.raw.startswith(b"{C"):
                 return self._step(*self.query.on_garbled(now))
             return None
+        self.in_step = True
         self.stats.count_record(now)
         if isinstance(event, app.Velocity):
             self.velocity = event

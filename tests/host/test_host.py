@@ -10,7 +10,7 @@ import pytest
 
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
-from appmode.host.state import LinkStatus
+from appmode.host.state import HostState, LinkStatus
 from appmode.protocol.app import Attitude, ParamsRecord, Velocity
 from tests.support.processes import BoardProcess, board_process
 
@@ -116,3 +116,16 @@ def test_a_board_holding_values_out_of_range_is_read_and_shown() -> None:
         [record] = [e for e in events if isinstance(e, ParamsRecord)]
         assert record.out_of_range == ("position_ki", "system_mode")
         assert host.state.params == record
+
+
+def test_a_record_caught_half_way_at_the_start_is_no_error() -> None:
+    """Issue 23.2: a link opened mid-record showed DEGRADED (`1 errors in 5 s`)."""
+    state = HostState()
+    state.feed(b"0:0}$", 0.0)
+    state.feed(b"{A0:0:0:0}$", 0.05)
+    assert (state.stats.errors, state.stats.skipped, state.stats.recent_errors(0.1)) == (0, 5, 0)
+    state.feed(b"0:0}$", 0.1)  # once records flow, the same bytes are an error
+    assert state.stats.errors == 1
+    state.reset_decoder()  # the link was lost: a new start
+    state.feed(b"0}${B0:0:0:100}$", 0.2)
+    assert state.stats.errors == 1

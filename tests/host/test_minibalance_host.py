@@ -18,7 +18,8 @@ def test_s13_a_read_at_power_up_gets_past_the_start_up_text() -> None:
         started = time.monotonic()
         assert host.read_params() == MINIBALANCE.defaults
         took = time.monotonic() - started
-        assert host.state.stats.errors >= 1, "the ten text lines decode to nothing"
+        stats = host.state.stats
+        assert stats.errors == 0 and stats.skipped > 300, "the start-up text is no error"
         assert took < 2.0, f"{took:.2f} s: the first C comes after the text, not a timeout"
 
 
