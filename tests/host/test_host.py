@@ -124,7 +124,7 @@ def test_a_record_caught_half_way_at_the_start_is_no_error() -> None:
     state.feed(b"0:0}$", 0.0)
     state.feed(b"{A0:0:0:0}$", 0.05)
     assert (state.stats.errors, state.stats.skipped, state.stats.recent_errors(0.1)) == (0, 5, 0)
-    state.feed(b"0:0}$", 0.1)  # once records flow, the same bytes are an error
+    state.feed(b"0:0}${A0:0:0:0}$", 0.1)  # once records flow, the same bytes are an error
     assert state.stats.errors == 1
     state.reset_decoder()  # the link was lost: a new start
     state.feed(b"0}${B0:0:0:100}$", 0.2)
