@@ -92,6 +92,7 @@ class BaseSession(ABC):
         self.simulated = is_simulated(url)
         self.driving = driving or HoldToDrive()
         self.messages: deque[str] = deque(maxlen=LOG)
+        self._down_said = False  # "link is down" said in this outage
         self.on_message = on_message
         self.recorder: Recorder | None = None
         self.completions: dict[str, object] = {
@@ -149,6 +150,17 @@ class BaseSession(ABC):
         mistake."""
 
     # ------------------------------------------------------------ messages
+
+    def link_down(self) -> bool:
+        """Whether the link is down, saying so at the first key of each outage (keys
+        repeat many times a second: one line says it)."""
+        if self.host.connected:
+            self._down_said = False
+            return False
+        if not self._down_said:
+            self._down_said = True
+            self.say("link is down: not driving")
+        return True
 
     def say(self, text: str) -> None:
         self.messages.append(text)

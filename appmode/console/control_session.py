@@ -224,8 +224,7 @@ class ControlSession(BaseSession):
 
     def press(self, key: str) -> None:
         """A held key: a motion's name (`forward`, `rotate-cw`…) or STOP_LETTER."""
-        if not self.host.connected:
-            self.say("link is down: not driving")
+        if self.link_down():
             return
         what = self.driving.press(key, self.now())
         if what == STOP_LETTER:

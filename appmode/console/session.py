@@ -142,8 +142,7 @@ class Session(BaseSession):
 
     def press(self, letter: str) -> None:
         """A driving key: a letter of the current page, or Z."""
-        if not self.host.connected:
-            self.say("link is down: not driving")
+        if self.link_down():
             return
         to_send = self.driving.press(letter, self.host.now())
         if to_send is not None:
