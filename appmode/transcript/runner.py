@@ -28,6 +28,7 @@ from appmode.ports.link import is_simulated, open_link
 from appmode.protocol import app, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
+from appmode.text import wrapped
 from appmode.transcript.matcher import Check
 
 Progress = Callable[[str], None]
@@ -277,6 +278,8 @@ def run_conform(
     finally:
         if board is not None and found is not None:
             out.write(restore_params(board, found) + "\n")
+    if board2 is not None and not is_simulated(board2) and _sent_on_uart2(transcripts, results):
+        out.write(wrapped(f"note: {TAKEN_OVER}") + "\n")
     failed = sum(not r.passed for r in results)
     skipped = sum(r.skipped is not None for r in results)
     target = f"the embedded simulated board ({profile} profile)" if board is None else board
@@ -286,6 +289,21 @@ def run_conform(
     if junit:
         write_junit(junit, results)
     return 1 if failed else 0
+
+
+TAKEN_OVER = (
+    "the board's control port (UART2) has taken over its motion (docs/protocol.md §8.3): "
+    "drive letters on the APP port (the phone app, appmode send, drive) do nothing until "
+    "the board is reset or powered off; nothing sent can give the APP port its motion back"
+)
+
+
+def _sent_on_uart2(transcripts: list[Transcript], results: list[Result]) -> bool:
+    """Whether a transcript that ran on the board sent on its control port."""
+    return any(
+        result.skipped is None and any(e.direction == SENT2 for e in transcript.entries)
+        for transcript, result in zip(transcripts, results, strict=False)
+    )
 
 
 def _run_all(

@@ -198,6 +198,7 @@ def test_the_suite_passes_in_real_time_against_a_board_process() -> None:
         done.stdout
     )
     assert "restored the parameters found at the start (" in done.stdout
+    assert "note: the board's control port (UART2) has taken over its motion" in done.stdout
     assert values == (800, *params.DEFAULTS[1:])
 
 
