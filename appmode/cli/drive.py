@@ -86,6 +86,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     drive.add_argument(
         "--latched", action="store_true", help="a direction stays until stop (key l toggles it)"
     )
+    drive.add_argument(
+        "--keep-going",
+        action="store_true",
+        help="script mode (commands on stdin): run every line after an error (by default "
+        "the first error ends the script); the exit status is 1 if any line failed",
+    )
     add_profile(
         drive,
         "the board's profile: with no URL, the simulated board's (sheet or minibalance: the "
@@ -129,6 +135,7 @@ def run(args: argparse.Namespace) -> int:
             interactive,
             sys.stdin,
             sys.stdout,
+            keep_going=args.keep_going,
         )
     app_url = None
     if uart2_url is not None:
@@ -145,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
         drive=DriveType.from_cli_name(args.drive_type) if args.drive_type else None,
         takeover_byte=profile_for(url, args.profile).takeover_byte,
     )
-    return run_drive(session, interactive, sys.stdin, sys.stdout)
+    return run_drive(session, interactive, sys.stdin, sys.stdout, keep_going=args.keep_going)
 
 
 def _with_options(url: str, **options: str | None) -> str:
@@ -179,4 +186,8 @@ def _one_board(app_url: str, uart2_url: str) -> tuple[str, str]:
 
 
 def _print_message(text: str) -> None:
-    print(text, flush=True)
+    """Script mode's messages: errors on stderr, the rest on stdout."""
+    if text.startswith("error: "):
+        print(f"appmode: {text}", file=sys.stderr, flush=True)
+    else:
+        print(text, flush=True)

@@ -293,16 +293,18 @@ def run_drive(
     out: TextIO,
     input: Input | None = None,
     output: Output | None = None,
+    keep_going: bool = False,
 ) -> int:
     """Start the session, run the console (or script mode), and always close it: `Z` last.
-    Parameters set and not saved are named at the end."""
+    Parameters set and not saved are named at the end. Script mode ends at the first
+    error (every line with `keep_going`); its exit status is 1 if any line failed."""
     try:
         session.start()
         if interactive:
             app = build_app(session, input, output, command_history())
             asyncio.run(run_app(app, session))
         else:
-            run_script(session, script, out)
+            run_script(session, script, out, keep_going)
     finally:
         warning = session.unsaved_warning()
         try:
@@ -317,7 +319,7 @@ def run_drive(
                     else "the board keeps it until it is switched off"
                 )
                 print(f"appmode: {warning}: {lasts}", file=sys.stderr)
-    return 0
+    return 1 if session.failures and not interactive else 0
 
 
 def is_quit(text: str) -> bool:
@@ -337,13 +339,22 @@ def command_history() -> History:
     return FileHistory(str(path))
 
 
-def run_script(session: BaseSession, lines: Iterable[str], out: TextIO) -> int:
+def run_script(
+    session: BaseSession, lines: Iterable[str], out: TextIO, keep_going: bool = False
+) -> None:
     """Script mode: run commands line by line; `wait S` lets S seconds pass.
 
-    A parameter read or set finishes before the next line runs.
+    A parameter read or set finishes before the next line runs. The first error ends
+    the script, unless `keep_going`.
     """
     _settle(session, 0.0)
     for raw in lines:
+        if session.failures and not keep_going:
+            print(
+                "appmode: the script stopped at its first error (--keep-going runs on)",
+                file=sys.stderr,
+            )
+            break
         try:
             step = session.run(raw)
         except Quit:
@@ -351,7 +362,6 @@ def run_script(session: BaseSession, lines: Iterable[str], out: TextIO) -> int:
         _show(session, step)
         _settle(session, step.seconds if isinstance(step, Wait) else 0.0)
     out.flush()
-    return 0
 
 
 def _show(session: BaseSession, step: Step) -> None:

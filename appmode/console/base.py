@@ -93,6 +93,8 @@ class BaseSession(ABC):
         self.driving = driving or HoldToDrive()
         self.messages: deque[str] = deque(maxlen=LOG)
         self._down_said = False  # "link is down" said in this outage
+        self.failures = 0
+        """Commands and queries that failed (`fail`)."""
         self.on_message = on_message
         self.recorder: Recorder | None = None
         self.completions: dict[str, object] = {
@@ -161,6 +163,11 @@ class BaseSession(ABC):
             self._down_said = True
             self.say("link is down: not driving")
         return True
+
+    def fail(self, text: str) -> None:
+        """Say what went wrong, and count it (script mode's exit status)."""
+        self.failures += 1
+        self.say(f"error: {text}")
 
     def say(self, text: str) -> None:
         self.messages.append(text)
@@ -243,14 +250,14 @@ class BaseSession(ABC):
         try:
             words = shlex.split(line, comments=True)
         except ValueError as exc:
-            self.say(f"error: {exc}")
+            self.fail(str(exc))
             return None
         if not words:
             return None
         try:
             return self._common(words[0].lower(), words[1:])
         except (AppmodeError, ValueError) as exc:
-            self.say(f"error: {exc}")
+            self.fail(str(exc))
             return None
 
     def _common(self, name: str, args: list[str]) -> Step:

@@ -164,7 +164,7 @@ class ControlSession(BaseSession):
             elif isinstance(event, ReadDone):
                 self._done(event)
             elif isinstance(event, QueryFailed):
-                self.say(f"error: {event.text}")
+                self.fail(event.text)
                 self.rotation = None
         if self.app is not None:
             for app_event in self.app.poll_nowait():
@@ -209,7 +209,7 @@ class ControlSession(BaseSession):
         try:
             done = rotation_done(left, self.now() - started)
         except AppmodeError as exc:
-            self.say(f"error: {exc}")
+            self.fail(str(exc))
             self.stop()
             return
         if done:

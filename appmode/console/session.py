@@ -132,7 +132,7 @@ class Session(BaseSession):
                     self.baseline = event.values
                 self.say(event.text)
             elif isinstance(event, QueryFailed):
-                self.say(f"error: {event.text}")
+                self.fail(event.text)
         if self.driving.release_due(self.host.now()):
             self._send_letter(STOP_LETTER)
             return True

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 from appmode.board.firmware import Board
 from appmode.console.session import COMMANDS
 from appmode.protocol import params
@@ -62,3 +65,29 @@ def test_drive_takes_the_drive_type_the_other_commands_take() -> None:
     assert "sim://?drive=mecanum" in done.stdout
     real = run("drive", "/dev/null", "--drive", "mecanum")
     assert real.returncode == 2 and "--drive on a real board's APP port" in real.stderr
+
+
+def test_script_mode_errors_go_to_stderr_and_fail_the_script() -> None:
+    done = run("drive", stdin=b"bogus\nset max_speed 800\nquit\n")
+    assert done.returncode == 1
+    assert "appmode: error: unknown command 'bogus'" in done.stderr
+    assert "the script stopped at its first error" in done.stderr
+    assert "error" not in done.stdout and "800" not in done.stdout, "nothing after it ran"
+    going = run("drive", "--keep-going", stdin=b"set max_speed 70000\nset max_speed 800\n")
+    assert going.returncode == 1 and "max_speed = 800 (verified)" in going.stdout
+    assert "appmode: error: max_speed (parameter 0) must be in 0–65535" in going.stderr
+    clean = run("drive", stdin=b"set max_speed 800\nset max_speed 500\n")
+    assert clean.returncode == 0 and clean.stderr == "", clean.stderr
+
+
+def test_script_mode_against_a_port_that_never_answers_fails(tmp_path: Path) -> None:
+    import pty
+
+    master, slave = pty.openpty()
+    try:
+        done = run("drive", os.ttyname(slave), stdin=b"status\n", timeout=60)
+    finally:
+        os.close(master)
+        os.close(slave)
+    assert done.returncode == 1
+    assert "appmode: error: no parameters" in done.stderr, done.stderr

@@ -52,8 +52,8 @@ def test_script_mode_drives_turns_and_sets_over_the_embedded_control_port(tmp_pa
         b"drive forward\nwait 0.8\nstatus\nstop\nset max_speed 800\nread max_speed\n"
         b"rotate 30\nwait 1.5\nset max_speed 70000\nfly\nquit\n"
     )
-    done = run("drive", "--uart2", "--record", str(record), stdin=script)
-    assert done.returncode == 0, done.stderr
+    done = run("drive", "--uart2", "--keep-going", "--record", str(record), stdin=script)
+    assert done.returncode == 1, done.stderr  # two lines failed, on purpose
     out = done.stdout
     assert "SIMULATED BOARD" in out and "sim://?port=uart2" in out
     assert re.search(r"control\s+UART2\s+drives", out) and "drive omni" in out
@@ -62,8 +62,8 @@ def test_script_mode_drives_turns_and_sets_over_the_embedded_control_port(tmp_pa
     assert wheel_a and int(wheel_a.group(1)) == 260 and int(wheel_a.group(2)) > 200, out
     assert "set max_speed = 800 (verified)" in out and "max_speed = 800" in out
     assert re.search(r"rotated 30° in \d\.\d\d s", out)
-    assert "error: max_speed" in out  # out of range: one message, nothing sent
-    assert "error: unknown command 'fly'" in out
+    assert "appmode: error: max_speed" in done.stderr  # out of range: nothing sent
+    assert "appmode: error: unknown command 'fly'" in done.stderr
     assert "not saved: max_speed 500 → 800" in done.stderr
     sent = uart2_sent(record)
     assert "FF FE 01 00 00 01 2C 00 00 00" in sent  # forward at 300

@@ -17,13 +17,13 @@ from tests.support.processes import BoardProcess, run, sent_lines
 def test_script_mode_reads_commands_from_stdin(tmp_path: Path) -> None:
     record = tmp_path / "s.transcript"
     script = b"set max_speed 800\ndrive A\nwait 0.6\nstatus\nspeed -300\nfly\nquit\n"
-    done = run("drive", "--record", str(record), stdin=script)
-    assert done.returncode == 0, done.stderr
+    done = run("drive", "--keep-going", "--record", str(record), stdin=script)
+    assert done.returncode == 1, done.stderr  # `fly` failed
     out = done.stdout
     assert "max_speed = 800 (verified)" in out
     assert "SIMULATED BOARD" in out and "in force  A forward" in out
     assert "max_speed = 500 (verified)" in out
-    assert "error: unknown command 'fly': type help for the list" in out
+    assert "appmode: error: unknown command 'fly': type help for the list" in done.stderr
     sent = [line for line in record.read_text().splitlines() if " > " in line]
     assert sent[-1].endswith(" > Z"), sent[-3:]
 
@@ -77,10 +77,10 @@ def test_a_recording_that_fails_never_ends_the_session(tmp_path: Path) -> None:
         "record /dev/full\ndrive B\nwait 0.2\n"
         f"record {second}\ndrive C\nwait 0.2\nquit\n"
     )
-    done = run("drive", stdin=script.encode())
-    assert done.returncode == 0 and done.stderr == "", done.stderr
-    assert f"{tmp_path}/no/such/folder.transcript: No such file or directory; still " in done.stdout
-    assert "/dev/full: No space left on device; still recording to" in done.stdout
+    done = run("drive", "--keep-going", stdin=script.encode())
+    assert done.returncode == 1, done.stderr
+    assert f"{tmp_path}/no/such/folder.transcript: No such file or directory; still " in done.stderr
+    assert "/dev/full: No space left on device; still recording to" in done.stderr
     assert sent_lines(first)[-2:] == ["A", "B"], "the first recording went on, then closed"
     assert sent_lines(second)[-2:] == ["C", "Z"]
 
