@@ -34,6 +34,8 @@ Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning
 class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
     """A session with one board's APP port."""
 
+    proves_return = True  # back at the first record (the board streams them)
+
     def __init__(
         self,
         url: str,
@@ -74,7 +76,11 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         data = self._read_bytes(block)
         events += self._take_pending()
         if data:
-            events += self.state.feed(data, self.now())
+            new = self.state.feed(data, self.now())
+            if any(isinstance(event, app.RECORDS) for event in new):
+                self._proven_by_output()
+                events += self._take_pending()  # "is back" before what proved it
+            events += new
         outcome = self.state.tick(self.now())
         if outcome is not None:
             events.append(outcome)

@@ -42,6 +42,10 @@ class Link(Generic[E]):
     sent = ">"
     received = "<"
     stop_on_close = True
+    proves_return = False
+    """A reopened link is back only once the protocol has decoded the board's output
+    (`_proven`): a path left by a board that died (a pty's) may now lead to another
+    program's port."""
 
     def __init__(
         self,
@@ -59,6 +63,7 @@ class Link(Generic[E]):
         self._lost_at = 0.0
         self._ahead: Ahead | None = None  # the line's rate, known once the port is open
         self._pending: list[E | LinkStatus] = []
+        self._proven = True  # the port opened is the board's, or has shown it is
 
     def now(self) -> float:
         """Seconds since the session started."""
@@ -66,7 +71,8 @@ class Link(Generic[E]):
 
     @property
     def connected(self) -> bool:
-        return self._port is not None
+        """The port is open, and (after a reopening) has shown it is the board's."""
+        return self._port is not None and self._proven
 
     @property
     def link(self) -> serial.SerialBase | None:
@@ -83,7 +89,8 @@ class Link(Generic[E]):
         self._port = None
         self._lost_at = self.now()
         self._on_lost()
-        self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
+        if self._proven:  # a reopened port that never showed the board: already said
+            self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
 
     def _reconnect(self) -> None:
         if self.now() - self._lost_at < RETRY:
@@ -93,7 +100,20 @@ class Link(Generic[E]):
             self._port = self._opener(self.url)
         except AppmodeError:
             return
-        self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
+        if not self.proves_return:
+            self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
+            return
+        if self._proven:  # said once an outage
+            self._pending.append(
+                LinkStatus(False, f"{self.url} opens again; waiting for the board's output")
+            )
+        self._proven = False
+
+    def _proven_by_output(self) -> None:
+        """The protocol decoded the board's output: a reopened link is back."""
+        if not self._proven:
+            self._proven = True
+            self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
 
     def _write(self, data: bytes) -> None:
         """Write bytes to the board, CHUNK at a time, each tapped and followed (`_sent`)

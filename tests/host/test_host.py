@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import socket
 import time
 from pathlib import Path
@@ -77,8 +78,9 @@ def test_lost_link_is_reported_and_recovered_after_board_restart() -> None:
                     restarted = BoardProcess("--listen", f"127.0.0.1:{port}", "--quiet")
                 if event.up:
                     break
-        assert [s.up for s in statuses] == [False, True], statuses
-        assert "lost" in statuses[0].text and "back" in statuses[1].text
+        assert [s.up for s in statuses] == [False, False, True], statuses
+        assert "lost" in statuses[0].text and "back" in statuses[2].text
+        assert "opens again; waiting for the board's output" in statuses[1].text
         assert host.read_params()[0] == 500
     finally:
         host.close()
@@ -129,3 +131,35 @@ def test_a_record_caught_half_way_at_the_start_is_no_error() -> None:
     state.reset_decoder()  # the link was lost: a new start
     state.feed(b"0}${B0:0:0:100}$", 0.2)
     assert state.stats.errors == 1
+
+
+def test_a_path_that_opens_again_without_a_board_is_not_back(tmp_path: Path) -> None:
+    """Issue 23.6: a pty path left by a board that died may lead to another program's
+    pty. The host opens it again but says the link is back only when records come; until
+    then it is not connected (a console does not drive into it)."""
+    import pty
+
+    with board_process("--pty", "--quiet") as board:
+        link = tmp_path / "car"
+        link.symlink_to(board.url)
+        host = Host(str(link))
+        try:
+            assert any(isinstance(e, Velocity) for e in host.poll(1.0))
+            master, slave = pty.openpty()  # another program's pty
+            try:
+                board.kill()
+                statuses = [e for e in host.events(0.6) if isinstance(e, LinkStatus)]
+                link.unlink()
+                link.symlink_to(os.ttyname(slave))
+                statuses += [e for e in host.events(1.5) if isinstance(e, LinkStatus)]
+                assert not host.connected and host.link is not None, "open, not proven"
+                assert not any(s.up for s in statuses), statuses
+                assert "waiting for the board's output" in statuses[-1].text
+                os.write(master, b"{A0:0:0:0}$")
+                statuses = [e for e in host.events(0.5) if isinstance(e, LinkStatus)]
+                assert host.connected and statuses[-1].up, "records came: back"
+            finally:
+                os.close(master)
+                os.close(slave)
+        finally:
+            host.close()
