@@ -130,6 +130,11 @@ def motion_text(record: p.Velocity, layout: ALayout = VELOCITY) -> str:
     return " ".join(shown)
 
 
+SHOWN_PARAMS = 2
+"""Parameters a C record's description names (the record shows all nine; `params`
+prints them as a table, `--json` by name)."""
+
+
 def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
     """A short human description of an event (an A record's fields as `layout` reads them)."""
     if isinstance(event, p.Velocity):
@@ -140,7 +145,8 @@ def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
             f"battery={event.battery}%"
         )
     if isinstance(event, p.ParamsRecord):
-        text = "params " + " ".join(f"{k}={v}" for k, v in event.as_dict().items())
+        first = list(event.as_dict().items())[:SHOWN_PARAMS]
+        text = "params " + " ".join(f"{k}={v}" for k, v in first) + " …"
         odd = event.out_of_range
         return text if not odd else f"{text} (out of range: {', '.join(odd)})"
     if isinstance(event, p.OtherRecord):

@@ -91,3 +91,11 @@ def test_script_mode_against_a_port_that_never_answers_fails(tmp_path: Path) -> 
         os.close(slave)
     assert done.returncode == 1
     assert "appmode: error: no parameters" in done.stderr, done.stderr
+
+
+def test_a_c_record_is_described_in_a_line_not_230_columns() -> None:
+    """Issue 23.3: demo, send and dump printed every parameter by name after the record."""
+    done = run("send", "sim://", "{Q:P}", "wait:0.2")
+    (c_line,) = [line for line in done.stdout.splitlines() if "< {C" in line]
+    assert c_line.endswith("params max_speed=500 max_position=10000 …")
+    assert len(c_line) < 90
