@@ -19,9 +19,7 @@ from appmode.protocol import settings
 from appmode.protocol.control_view import describe
 from appmode.protocol.directions import STOP_LETTER
 
-SILENT_HINT = (
-    "check the baud rate (115200), the wiring, that the car is on (§13 boards stay silent)"
-)
+SILENT_HINT = "check the baud rate (115200), the wiring, and that the car is on"
 
 
 def control_body(session: ControlSession) -> Fragments:

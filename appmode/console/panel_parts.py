@@ -73,7 +73,7 @@ def link_line(
         waiting = now > SILENT
         return [
             ("reverse bold fg:ansired" if waiting else "", " port open, nothing received "),
-            ("", f"  {hint if waiting else ''}\n"),
+            ("", f"\n  {hint}\n" if waiting else "\n"),
         ]
     last = f"{noun} live" if age < STALE else f"last {noun[:-1]} {age:.1f} s ago"
     recent = stats.recent_errors(now)

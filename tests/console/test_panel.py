@@ -83,6 +83,8 @@ def test_a_silent_port_is_not_called_up() -> None:
         os.close(slave)
     assert "port open, nothing received" in text and "check the baud rate" in text
     assert "link up" not in text
+    hint = next(line for line in text.splitlines() if "check the baud rate" in line)
+    assert hint.strip().endswith("and Bluetooth is paired") and len(hint) <= 80, "issue 23.3"
 
 
 def test_old_readings_are_shown_with_their_age() -> None:
