@@ -32,7 +32,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         description="Read the nine parameters; with --set, set each and verify it by reading "
         "back; with --save, save them to the board's flash. Names: "
         + ", ".join(p.name for p in params.PARAMS)
-        + " (or their numbers 0-8).",
+        + " (or their numbers 0-8). Each table numbers its values as its port does: n is "
+        "the index of the APP port's {n:value} frame (0-8), and with --uart2 SS is the "
+        "setting's byte in the control port's FF FE 80 80 SS frame (1-10).",
     )
     add_url(prm)
     prm.add_argument(

@@ -102,7 +102,7 @@ def describe(
 def settings_table(values: dict[str, int]) -> str:
     """The ten settings as an aligned table (docs/protocol.md §10): id, name, value,
     range, default; a value outside its range (a board may hold one) is flagged."""
-    rows = [f"{'id':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
+    rows = [f"{'SS':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
     for setting in settings.SETTINGS:
         value = values[setting.name]
         flag = "" if settings.value_error(setting, value) is None else "  out of range"

@@ -99,3 +99,15 @@ def test_a_c_record_is_described_in_a_line_not_230_columns() -> None:
     (c_line,) = [line for line in done.stdout.splitlines() if "< {C" in line]
     assert c_line.endswith("params max_speed=500 max_position=10000 …")
     assert len(c_line) < 90
+
+
+def test_each_parameter_table_says_what_its_numbers_are() -> None:
+    """Issue 23.2: the APP table numbers 0-8, the UART2 table 1-10: each is the number its
+    port's frames carry, and the tables and the help say so."""
+    app_table = run("params", "sim://").stdout.splitlines()
+    uart2_table = run("params", "sim://?port=uart2", "--uart2").stdout.splitlines()
+    assert app_table[0].split()[:2] == ["n", "name"] and app_table[1].split()[0] == "0"
+    assert uart2_table[0].split()[:2] == ["SS", "name"] and uart2_table[1].split()[0] == "1"
+    helped = " ".join(run("params", "--help").stdout.split())
+    assert "n is the index of the APP port's {n:value} frame (0-8)" in helped
+    assert "SS is the setting's byte in the control port's FF FE 80 80 SS frame" in helped
