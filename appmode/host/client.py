@@ -27,6 +27,8 @@ from appmode.protocol.render import motion_text
 
 CONFIRM_STEP = 0.05
 """Seconds between looks at the clock while a stop is being confirmed."""
+REFUSALS = 2
+"""Connections in a row closed before a byte after which a query gives up at once."""
 
 Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning
 
@@ -104,11 +106,13 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         """Run a read or set to its end; AppmodeError if it fails."""
         self.start_query(query)
         while True:
+            if self.refused is not None and self.refusals >= REFUSALS:
+                raise AppmodeError(self.refused)
             for event in self.poll(query.timeout):
                 if isinstance(event, QueryDone):
                     return event.values
                 if isinstance(event, QueryFailed):
-                    raise AppmodeError(event.text)
+                    raise AppmodeError(self.refused or event.text)
 
     def read_params(self, timeout: float = TIMEOUT, tries: int = TRIES) -> tuple[int, ...]:
         """Send `{Q:P}` and wait for the C record, retrying; AppmodeError if none comes."""

@@ -20,6 +20,7 @@ from appmode.host import signals
 from appmode.host.state import LinkStatus
 from appmode.line.pacing import Ahead
 from appmode.line.wire import Tap
+from appmode.ports.link import is_network
 
 RETRY = 0.5
 CHUNK = 64
@@ -64,6 +65,12 @@ class Link(Generic[E]):
         self._ahead: Ahead | None = None  # the line's rate, known once the port is open
         self._pending: list[E | LinkStatus] = []
         self._proven = True  # the port opened is the board's, or has shown it is
+        self._heard = False  # bytes have come since the port was (re)opened
+        self.refused: str | None = None
+        """Why the link drops at once, when the far end closes it before a byte: a TCP
+        board serving another client."""
+        self.refusals = 0
+        """Times in a row the far end closed the link before a byte."""
 
     def now(self) -> float:
         """Seconds since the session started."""
@@ -89,6 +96,13 @@ class Link(Generic[E]):
         self._port = None
         self._lost_at = self.now()
         self._on_lost()
+        if not self._heard and is_network(self.url):
+            self.refused = (
+                f"{self.url} closed the connection before the board sent anything: a TCP "
+                "board serves one client at a time; close the other client and retry"
+            )
+            self.refusals += 1
+            exc = OSError(self.refused)
         if self._proven:  # a reopened port that never showed the board: already said
             self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
 
@@ -100,6 +114,7 @@ class Link(Generic[E]):
             self._port = self._opener(self.url)
         except AppmodeError:
             return
+        self._heard = False
         if not self.proves_return:
             self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
             return
@@ -175,8 +190,10 @@ class Link(Generic[E]):
         except (serial.SerialException, OSError) as exc:
             self._lost(exc)
             return b""
-        if data and self.tap is not None:
-            self.tap(self.received, self.now(), data)
+        if data:
+            self._heard, self.refused, self.refusals = True, None, 0
+            if self.tap is not None:
+                self.tap(self.received, self.now(), data)
         return data
 
     def _read_once(self, block: bool) -> list[E | LinkStatus]:

@@ -38,6 +38,11 @@ URL_HELP = (
 )
 
 
+def is_network(url: str) -> bool:
+    """A TCP link (socket://, rfc2217://)."""
+    return url.split("://", 1)[0].lower() in NETWORK_SCHEMES if "://" in url else False
+
+
 def is_simulated(url: str) -> bool:
     return url.lower().startswith("sim://")
 

@@ -163,3 +163,21 @@ def test_a_path_that_opens_again_without_a_board_is_not_back(tmp_path: Path) -> 
                 os.close(slave)
         finally:
             host.close()
+
+
+def test_a_second_client_of_a_tcp_board_is_told_it_was_refused() -> None:
+    """Issue 23.2: it waited 5.8 s and said no parameters came back."""
+    with board_process("--listen", "0", "--quiet") as board:
+        first = Host(board.url)
+        try:
+            assert first.read_params()
+            second = Host(board.url)
+            try:
+                started = time.monotonic()
+                with pytest.raises(AppmodeError, match="serves one client at a time"):
+                    second.read_params()
+                assert time.monotonic() - started < 3.0
+            finally:
+                second.close()
+        finally:
+            first.close()
