@@ -51,6 +51,12 @@ REDRAW = 0.1
 """How often the panel is checked, and redrawn if what it shows changed (a key redraws at
 once)."""
 
+HELP_TITLE = "help · ? or Esc close · PgUp/PgDn scroll"
+NO_WAVES = (
+    "no waveforms on the control port's console: they plot the APP port's A and B "
+    "records (appmode drive APP_URL)"
+)
+
 
 def _completer(session: BaseSession) -> NestedCompleter:
     table: dict[str, object] = dict.fromkeys(session.command_names)
@@ -134,11 +140,18 @@ def build_app(
     keys.add("?", filter=driving)(lambda e: view.toggle("help"))
     if session.waveforms:
         keys.add("v", filter=driving)(lambda e: view.toggle("waves"))
+    else:
+        keys.add("v", filter=driving)(lambda e: session.say(NO_WAVES))
     keys.add("escape", filter=driving & Condition(lambda: view.top != "panel"))(
         lambda e: view.toggle(view.top)
     )
 
     def scroll(lines: int) -> None:
+        if view.top == "help":  # the help scrolls, not the messages under it
+            shown = status.render_info.window_height if status.render_info else MESSAGES
+            last = max(0, len(session.help_lines()) + 1 - shown)
+            view.help_first = min(last, max(0, view.help_first - max(1, shown - 1) * lines))
+            return
         height = messages.render_info.window_height if messages.render_info else MESSAGES
         step = max(1, height - 1) * lines
         oldest = max(0, len(session.messages) - height)  # the first page, full
@@ -226,14 +239,18 @@ class View:
         """"panel", "waves" (the panel with waveforms) or "help"."""
         self.back = 0
         """Message lines scrolled back from the newest (PageUp / PageDown)."""
+        self.help_first = 0
+        """The first line of the help shown (PageUp / PageDown while it is shown)."""
 
     def toggle(self, name: str) -> None:
         self.top = "panel" if self.top == name else name
+        self.help_first = 0
 
 
 def _top(session: BaseSession, view: View) -> Fragments:
     if view.top == "help":
-        return [("", "\n".join(session.help_lines()))]
+        lines = [HELP_TITLE, *session.help_lines()][view.help_first :]
+        return [("", "\n".join(lines))]
     fragments = status_fragments(session, waveforms=view.top == "waves")
     style, text, *_ = fragments[-1]
     return [*fragments[:-1], (style, text.rstrip("\n"))]  # no blank line under it

@@ -20,6 +20,7 @@ from appmode.host.tokens import Wait, parse_token
 from appmode.ports.link import is_simulated
 from appmode.ports.sim import sim_directives
 from appmode.protocol.transcript import Recorder
+from appmode.text import wrapped
 
 if TYPE_CHECKING:
     from appmode.host.client import Host
@@ -176,15 +177,18 @@ class BaseSession(ABC):
 
     def help_lines(self) -> list[str]:
         """The commands, a line each, then the keys."""
+        specs = (*self.commands, *COMMON)
+        usages = [f"{spec.name} {spec.args}".strip() for spec in specs]
+        width = max(map(len, usages)) + 2
         lines = [
-            f"{spec.name} {spec.args}".strip().ljust(18) + spec.help
-            for spec in (*self.commands, *COMMON)
+            wrapped(usage.ljust(width) + spec.help, indent=" " * width)
+            for usage, spec in zip(usages, specs, strict=True)
         ]
         return [
             *lines,
             "",
             *self.keys_help.splitlines(),
-            "PgUp/PgDn scroll the messages · ? or Esc close",
+            "PgUp/PgDn scroll the messages · End: the newest",
         ]
 
     @property

@@ -163,3 +163,25 @@ def test_frames_sent_by_command_show_as_the_frame_in_force() -> None:
     assert done.returncode == 0, done.stderr
     forces = re.findall(r"in force\s+(\w[\w ]*?)\s{2,}", done.stdout)
     assert forces == ["velocity 0 300 0", "stopped"], done.stdout
+
+
+def test_the_uart2_consoles_help_fits_80_by_24_and_scrolls() -> None:
+    """Issue 23.3: at 80×24 the help hid its own close key, ran columns together, and
+    PgUp scrolled the messages under it; `v` did nothing, silently."""
+    command = appmode_in_tmux("drive --uart2")
+    tmux("new-session", "-d", "-s", SESSION, "-x", "80", "-y", "24", command)
+    try:
+        wait_screen(r"settings\s+max_speed 500")
+        tmux("send-keys", "-t", SESSION, "v")
+        wait_screen(r"no waveforms on the control port's console")
+        tmux("send-keys", "-t", SESSION, "?")
+        shown = wait_screen(r"help · \? or Esc close · PgUp/PgDn scroll").string
+        assert re.search(r"velocity X Y Z\|L R  +send a velocity frame", shown), shown
+        assert re.search(r"quit\s+stop the car and leave", shown), "all of it, close key too"
+        assert all(len(line) <= 80 for line in shown.splitlines())
+        tmux("send-keys", "-t", SESSION, "PageUp")
+        assert "lines back" not in screen(), "PgUp moves the help, not the messages"
+        tmux("send-keys", "-t", SESSION, "Escape")
+        wait_screen(r"settings\s+max_speed 500")
+    finally:
+        tmux("kill-session", "-t", SESSION)
