@@ -42,6 +42,7 @@ from appmode.console.panel_parts import ARROWS, KEY_GRID, WIDTH, Fragments
 from appmode.files import data_folder
 from appmode.host import signals
 from appmode.host.tokens import Wait
+from appmode.text import wrapped
 
 REFRESH = 0.02
 """Seconds between reads of the link (and checks of the hold-to-drive timers)."""
@@ -97,9 +98,14 @@ def build_app(
         dont_extend_height=True,
     )
 
+    def log_lines() -> list[str]:
+        """The messages in lines of the window's width, words whole."""
+        width = messages.render_info.window_width if messages.render_info else WIDTH
+        return [part for text in session.messages for part in wrapped(text, width).split("\n")]
+
     def shown() -> list[str]:
         """The log up to its newest line, or to `view.back` lines before it."""
-        log = list(session.messages)
+        log = log_lines()
         return log[: len(log) - view.back]
 
     def bottom() -> Point:  # the window follows this point: the end of what is shown
@@ -154,7 +160,7 @@ def build_app(
             return
         height = messages.render_info.window_height if messages.render_info else MESSAGES
         step = max(1, height - 1) * lines
-        oldest = max(0, len(session.messages) - height)  # the first page, full
+        oldest = max(0, len(log_lines()) - height)  # the first page, full
         view.back = min(oldest, max(0, view.back + step))
 
     keys.add("pageup")(lambda e: scroll(1))

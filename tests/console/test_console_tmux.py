@@ -234,3 +234,14 @@ def test_the_console_keeps_its_history_in_the_tests_folder_whatever_tmux_holds(
     history = Path(os.environ["XDG_DATA_HOME"]) / "appmode" / "history"
     assert "speed 600" in history.read_text()
     assert not decoy.exists()
+
+
+def test_messages_wrap_between_words() -> None:
+    """Issue 23.3: a message longer than the screen was cut inside a word (`th at`)."""
+    tmux("new-session", "-d", "-s", SESSION, "-x", "60", "-y", "20", appmode_in_tmux("drive"))
+    try:
+        wait_screen(r"parameters read")
+        tmux("send-keys", "-t", SESSION, ":", "set max_speed 70000000", "Enter")
+        wait_screen(r"error: max_speed \(parameter 0\) must be in 0–65535, not\n  70000000")
+    finally:
+        tmux("kill-session", "-t", SESSION)
