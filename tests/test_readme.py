@@ -25,3 +25,12 @@ def test_readme_opens_with_two_setup_commands() -> None:
         "pip install . && appmode drive",
         "pip install '.[test]' && pytest",
     ]
+
+
+def test_the_headings_appmode_points_at_are_in_the_readme() -> None:
+    """Issue 23.5: the `ports` hint pointed at a heading that does not exist."""
+    lines = README.read_text().splitlines()
+    headings = {line.lstrip("#").strip() for line in lines if line.startswith("#")}
+    for path in (README.parent / "appmode").rglob("*.py"):
+        for name in re.findall(r"see '([^']+)' in the README", path.read_text()):
+            assert name in headings, f"{path}: no heading {name!r} in the README"
