@@ -22,6 +22,7 @@ from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from appmode.errors import AppmodeError
 from appmode.ports.link import is_simulated
 from appmode.ports.sim import parse_sim_url
+from appmode.protocol import control
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 
 
@@ -142,6 +143,7 @@ def run(args: argparse.Namespace) -> int:
         app_url, url = url, _with_options(uart2_url, profile=args.profile, drive=args.drive_type)
         if is_simulated(app_url) and is_simulated(url):
             app_url, url = _one_board(app_url, url)
+    profile = profile_for(url, args.profile)
     session = ControlSession(
         url,
         driving,
@@ -149,8 +151,13 @@ def run(args: argparse.Namespace) -> int:
         on_message,
         app_url=app_url,
         layout=layout,
-        drive=DriveType.from_cli_name(args.drive_type) if args.drive_type else None,
-        takeover_byte=profile_for(url, args.profile).takeover_byte,
+        drive=DriveType.from_cli_name(args.drive_type)
+        if args.drive_type
+        else None
+        if profile.drive_types
+        else DriveType.OMNI,
+        takeover_byte=profile.takeover_byte,
+        reads=control.SETTINGS in profile.control_modes,
     )
     return run_drive(session, interactive, sys.stdin, sys.stdout, keep_going=args.keep_going)
 

@@ -75,6 +75,12 @@ def velocity_for(motion: Motion, speed: int, drive: DriveType) -> dict[str, int]
     return {"y": duty(fy), "z": duty(fz)}
 
 
+NO_READS = (
+    "this board answers no reads (the reference firmware, docs/protocol.md §13): its "
+    "settings and wheels are not shown, and its velocities are not limited to max_speed"
+)
+
+
 class ControlSession(BaseSession):
     """A session on the control port, with the APP port of the same board if given."""
 
@@ -99,8 +105,11 @@ class ControlSession(BaseSession):
         layout: ALayout = VELOCITY,
         drive: DriveType | None = None,
         takeover_byte: int = TAKEOVER_BYTE,
+        reads: bool = True,
     ) -> None:
         super().__init__(url, driving, on_message)
+        self.reads = reads
+        """The board answers reads (the reference firmware does not: §13)."""
         self.host = ControlHost(url, tap=self._tap, drive=drive, takeover_byte=takeover_byte)
         self.url = self.host.url
         self.app: Host | None = None
@@ -137,7 +146,10 @@ class ControlSession(BaseSession):
         """Take the motion over with the zero velocity frame, then read the settings
         (the encoder report is turned on for the session once system_mode is known)."""
         self._send(lambda: self.host.stop())
-        self._query(SETTING_NAMES)
+        if self.reads:
+            self._query(SETTING_NAMES)
+        else:
+            self.say(NO_READS)
 
     def close(self) -> None:
         """`Z` on the APP port, then on UART2 the encoder report as it was and the zero

@@ -185,3 +185,14 @@ def test_the_uart2_consoles_help_fits_80_by_24_and_scrolls() -> None:
         wait_screen(r"settings\s+max_speed 500")
     finally:
         tmux("kill-session", "-t", SESSION)
+
+
+def test_the_uart2_console_drives_a_board_that_answers_no_reads() -> None:
+    """Issue 24.4: against a minibalance board the UART2 console failed at its start,
+    reading settings the reference firmware never answers."""
+    script = b"wait 2\ndrive forward\nwait 0.5\nstatus\nquit\n"
+    done = run("drive", "sim://?profile=minibalance&port=uart2", "--uart2", stdin=script)
+    assert done.returncode == 0, done.stderr
+    assert "this board answers no reads" in done.stdout
+    assert re.search(r"in force\s+forward", done.stdout) and "drive omni" in done.stdout
+    assert re.search(r"errors 0", done.stdout), "its status bursts are no errors"
