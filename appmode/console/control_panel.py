@@ -7,6 +7,7 @@ from __future__ import annotations
 from appmode.console.control_session import STOP, ControlSession
 from appmode.console.panel_parts import (
     GLYPHS,
+    WIDTH,
     Fragments,
     columns,
     hold_mode,
@@ -37,6 +38,7 @@ def control_body(session: ControlSession) -> Fragments:
     drive = session.drive
     out.append(("", f" · drive {'? (reading)' if drive is None else drive.cli_name}\n"))
 
+    start = len(out)
     out.append(("bold", " in force "))
     if session.rotation is not None:
         left = state.values.get("pending_angle")
@@ -48,9 +50,10 @@ def control_body(session: ControlSession) -> Fragments:
         out.append(("reverse bold", f" {describe(state.in_force)} "))
     else:
         out.append(("", " stopped"))
-    out.append(
-        ("", f"   speed {session.speed} · r/R {session.angle:g}° · {hold_mode(session.driving)}\n")
-    )
+    keys = f"speed {session.speed} · r/R {session.angle:g}° · {hold_mode(session.driving)}"
+    shown = sum(len(text) for _, text, *_ in out[start:])
+    room = WIDTH - shown - 3
+    out.append(("", f"   {keys}\n" if len(keys) <= room else f"\n{' ' * 10}{keys}\n"))
 
     report = state.report
     if report is None:

@@ -196,3 +196,13 @@ def test_the_uart2_console_drives_a_board_that_answers_no_reads() -> None:
     assert "this board answers no reads" in done.stdout
     assert re.search(r"in force\s+forward", done.stdout) and "drive omni" in done.stdout
     assert re.search(r"errors 0", done.stdout), "its status bursts are no errors"
+
+
+def test_the_in_force_line_fits_80_columns_whatever_is_in_force() -> None:
+    """Issue 23.3: a long frame in force pushed the keys' line past 80 columns."""
+    script = b"speed 65535\nangle 359.5\nsend FFFE03FFFFFFFFFFFF07\nwait 0.3\nstatus\nstop\nquit\n"
+    done = run("drive", "--uart2", stdin=script)
+    assert done.returncode == 0, done.stderr
+    assert "position x=-65535 y=-65535 z=-65535" in done.stdout
+    assert "speed 65535 · r/R 359.5° · latched" in done.stdout
+    assert max(get_cwidth(line) for line in done.stdout.splitlines()) <= WIDTH
