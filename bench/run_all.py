@@ -58,7 +58,14 @@ def start_board(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
     )
     assert proc.stdout is not None
     count = int(args[args.index("--count") + 1]) if "--count" in args else 1
-    urls = [proc.stdout.readline().split("port: ")[1].strip() for _ in range(count)]
+    urls: list[str] = []
+    while len(urls) < count:  # each board prints `port: …`, then `uart2: …`
+        line = proc.stdout.readline()
+        if not line:
+            stop(proc)
+            raise RuntimeError(f"appmode board {' '.join(args)} ended before its ports")
+        if line.startswith("port: "):
+            urls.append(line.removeprefix("port: ").strip())
     return proc, urls
 
 
