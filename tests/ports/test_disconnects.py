@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import socket
 import struct
@@ -14,7 +15,14 @@ from pathlib import Path
 from appmode.host.client import Host
 from appmode.host.state import LinkStatus
 from appmode.protocol.app import Velocity
-from tests.support.processes import ROOT, BoardProcess, board_process, board_state, wait_for
+from tests.support.processes import (
+    ROOT,
+    BoardProcess,
+    board_process,
+    board_state,
+    run,
+    wait_for,
+)
 
 
 def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> None:
@@ -176,3 +184,16 @@ def test_a_board_survives_an_app_client_reset_while_uart2_data_arrives() -> None
             uart2.close()
         err = b.stop()
     assert "Traceback" not in err and "AssertionError" not in err
+
+
+def test_a_link_left_by_a_board_that_crashed_leads_nowhere(tmp_path: Path) -> None:
+    """Issue 23.6: the link pointed at /dev/pts/N, which another program may own once
+    the board is gone; it now points at the board's own descriptor of it (Linux)."""
+    link = tmp_path / "board"
+    board = BoardProcess("--pty", "--link", str(link), "--quiet")
+    assert os.path.realpath(link) == board.url
+    assert os.readlink(link) != board.url, "not /dev/pts/N: a path that dies with the board"
+    board.kill()  # no clean-up: the link stays
+    assert link.is_symlink() and not link.exists(), "it leads nowhere, not to /dev/pts/N"
+    done = run("monitor", str(link), "--count", "1")
+    assert done.returncode == 2 and "no such port" in done.stderr, done.stderr
