@@ -383,7 +383,7 @@ class Board:
             self._mode("encoder_report")
             and not self._mode("app_mode")
             and self._tick_ms % REPORT_MS == 0
-            and control.SETTINGS in self.profile.control_modes
+            and self.profile.answers_reads
         ):
             targets = self._encoders(self._wheel_targets())
             actuals = self._encoders(self._wheels())

@@ -12,9 +12,10 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from appmode.errors import AppmodeError
-from appmode.protocol import params
+from appmode.protocol import control, params
 from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
 from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
+from appmode.protocol.params import DriveType
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,6 +102,16 @@ class Profile:
     clamp, no lag), and until one does the motion freezes at the take-over; after each
     APP record UART2 carries what is left of the status the loop writes there. Else the
     sheet's frames (§8–§12)."""
+
+    @property
+    def answers_reads(self) -> bool:
+        """UART2 takes settings frames: reads are answered, the encoder report exists."""
+        return control.SETTINGS in self.control_modes
+
+    @property
+    def fixed_drive(self) -> DriveType | None:
+        """The drive type a host need not read: omni on a board without drive types."""
+        return None if self.drive_types else DriveType.OMNI
 
     def check(self, drive: bool, flash: bool) -> None:
         """AppmodeError when a board of this profile is asked for what it does not have."""

@@ -17,7 +17,6 @@ from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
 from appmode.protocol import control, params, reader, settings
 from appmode.protocol.control_view import settings_table
-from appmode.protocol.params import DriveType
 from appmode.protocol.render import line, view
 from appmode.text import counted, wrapped
 
@@ -45,7 +44,7 @@ def open_control_host(
     host = ControlHost(
         url,
         stop_on_close=stop_on_close,
-        drive=None if profile.drive_types else DriveType.OMNI,
+        drive=profile.fixed_drive,
         takeover_byte=profile.takeover_byte,
     )
     return with_recording(stack, host, record)
@@ -135,7 +134,7 @@ def run_send(
         host = open_control_host(stack, url, record, profile=profile)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         report_bit = params.MODE_BIT["encoder_report"]
-        report = report and control.SETTINGS in profile.control_modes
+        report = report and profile.answers_reads
         mode = host.read("system_mode") if report else report_bit
         if not mode & report_bit:  # on for the session, then as it was (before the stop)
             host.send_frame(control.setting("system_mode", mode | report_bit))

@@ -22,7 +22,6 @@ from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from appmode.errors import AppmodeError
 from appmode.ports.link import is_simulated
 from appmode.ports.sim import parse_sim_url
-from appmode.protocol import control
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 
 
@@ -151,13 +150,9 @@ def run(args: argparse.Namespace) -> int:
         on_message,
         app_url=app_url,
         layout=layout,
-        drive=DriveType.from_cli_name(args.drive_type)
-        if args.drive_type
-        else None
-        if profile.drive_types
-        else DriveType.OMNI,
+        drive=DriveType.from_cli_name(args.drive_type) if args.drive_type else profile.fixed_drive,
         takeover_byte=profile.takeover_byte,
-        reads=control.SETTINGS in profile.control_modes,
+        reads=profile.answers_reads,
     )
     return run_drive(session, interactive, sys.stdin, sys.stdout, keep_going=args.keep_going)
 

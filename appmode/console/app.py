@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import sys
 import time
 from collections.abc import Iterable
@@ -36,7 +37,7 @@ from prompt_toolkit.layout.dimension import Dimension
 from prompt_toolkit.layout.menus import CompletionsMenu
 from prompt_toolkit.output import Output
 
-from appmode.console.base import QUIT_WORDS, BaseSession, Quit, ShowHelp, ShowStatus, Step
+from appmode.console.base import LOG, QUIT_WORDS, BaseSession, Quit, ShowHelp, ShowStatus, Step
 from appmode.console.panel import status_fragments, status_text
 from appmode.console.panel_parts import ARROWS, KEY_GRID, WIDTH, Fragments
 from appmode.files import data_folder
@@ -101,7 +102,7 @@ def build_app(
     def log_lines() -> list[str]:
         """The messages in lines of the window's width, words whole."""
         width = messages.render_info.window_width if messages.render_info else WIDTH
-        return [part for text in session.messages for part in wrapped(text, width).split("\n")]
+        return [part for text in session.messages for part in _lines(text, width)]
 
     def shown() -> list[str]:
         """The log up to its newest line, or to `view.back` lines before it."""
@@ -229,6 +230,13 @@ def build_app(
         layout=layout, key_bindings=keys, full_screen=True, input=input, output=output
     )
     return app
+
+
+@functools.lru_cache(maxsize=2 * LOG)
+def _lines(text: str, width: int) -> tuple[str, ...]:
+    """A message in lines of `width` columns, words whole (each is wrapped once: the
+    log is drawn many times a second while a key is held)."""
+    return tuple(wrapped(text, width).split("\n"))
 
 
 def _key_command(session: BaseSession, line: str) -> None:

@@ -21,6 +21,7 @@ EVENTS = (
 )
 """The control port's event types: what these views show."""
 BoardOrHost = control.HostEvent | control.Reply | control.EncoderReport | control.Status
+"""An event of either direction that these views show."""
 KINDS = dict(
     zip(
         EVENTS,
@@ -46,9 +47,7 @@ def hex_text(raw: bytes) -> str:
     return raw.hex(" ").upper()
 
 
-def to_json(
-    event: control.HostEvent | control.Reply | control.EncoderReport | control.Status,
-) -> dict[str, Any]:
+def to_json(event: BoardOrHost) -> dict[str, Any]:
     """One JSON-ready object: `kind`, its values, and `raw` as hex pairs."""
     body: dict[str, Any] = {"kind": KINDS[type(event)]}
     if isinstance(event, control.VelocityFrame):
@@ -72,9 +71,7 @@ def to_json(
     return {**body, "raw": hex_text(event.raw)}
 
 
-def describe(
-    event: control.HostEvent | control.Reply | control.EncoderReport | control.Status,
-) -> str:
+def describe(event: BoardOrHost) -> str:
     """A short human description."""
     if isinstance(event, control.VelocityFrame):
         what = f"velocity {event.a} {event.b} {event.c}"
