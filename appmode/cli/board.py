@@ -45,6 +45,14 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="serve UART2 on a real serial port (?baud=N to change 115200)",
     )
     board.add_argument(
+        "--baud",
+        type=number_type(300, 4_000_000, whole=True),
+        metavar="N",
+        help="the APP port's bit rate (default 9600): a car whose Bluetooth module is set "
+        "to another rate. It paces the port; on a pty, a client that opens it at another "
+        "rate reads garbled bytes, as from a real UART (the UART2 pty likewise at 115200)",
+    )
+    board.add_argument(
         "--count",
         type=number_type(1, 1000, whole=True),
         default=1,
@@ -102,4 +110,5 @@ def run(args: argparse.Namespace) -> int:
         profile=args.profile,
         listen2=args.listen2,
         device2=args.port2,
+        baud=args.baud,
     )

@@ -58,3 +58,17 @@ def _waiting(fd: int) -> int:
     read by it yet)."""
     (count,) = struct.unpack("i", fcntl.ioctl(fd, termios.FIONREAD, b"\0\0\0\0"))
     return int(count)
+
+
+SPEEDS = {
+    getattr(termios, name): int(name[1:])
+    for name in dir(termios)
+    if name[0] == "B" and name[1:].isdigit() and int(name[1:]) > 0
+}
+"""termios speed codes by their bit rates."""
+
+
+def client_baud(fd: int) -> int | None:
+    """The bit rate the program at the other end of pty `fd` set to send at (tcsetattr),
+    None when termios has no name for it."""
+    return SPEEDS.get(termios.tcgetattr(fd)[5])

@@ -31,6 +31,7 @@ from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
 from appmode.line.faults import Faults, FaultSpec
+from appmode.line.uart import misread
 from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
 from appmode.ports.link import BAUD, NO_PTY, explain_open_error, parse_device
 from appmode.protocol import params
@@ -85,9 +86,17 @@ class PtyEndpoint:
     closes, and the path stays the same for the next client.
     """
 
-    def __init__(self, sel: selectors.BaseSelector, log: Log, link: str | None = None) -> None:
+    def __init__(
+        self,
+        sel: selectors.BaseSelector,
+        log: Log,
+        link: str | None = None,
+        baud: int | None = None,
+    ) -> None:
         try:  # POSIX only: imported where a pty is made, so Windows can serve on TCP
             import tty
+
+            from appmode.ports.newpty import client_baud
         except ImportError:
             raise AppmodeError(
                 f"{NO_PTY}: serve on TCP with --listen HOST:PORT and --listen2 HOST:PORT"
@@ -108,6 +117,9 @@ class PtyEndpoint:
             ) from None
         tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
         os.set_blocking(self._master, False)
+        self.baud = baud
+        """The line rate of the UART this pty stands for; None: bytes pass at any rate."""
+        self._client_baud = client_baud
         self._out = Outbox()
         self.url = os.ttyname(self._slave)
         self._link = link
@@ -127,12 +139,22 @@ class PtyEndpoint:
 
     def _read(self, size: int) -> bytes:
         try:
-            return os.read(self._master, size)
+            data = os.read(self._master, size)
         except (BlockingIOError, InterruptedError):
             return b""
+        return self._misread(data, to_board=True)
 
     def write(self, data: bytes) -> None:
-        self._out.send(data, lambda chunk: os.write(self._master, chunk))
+        self._out.send(self._misread(data, to_board=False), lambda c: os.write(self._master, c))
+
+    def _misread(self, data: bytes, *, to_board: bool) -> bytes:
+        """With a line rate, what each side reads when the client set another one."""
+        if self.baud is None or not data:
+            return data
+        client = self._client_baud(self._slave)
+        if client is None:  # a rate termios cannot name: take it as matching
+            return data
+        return misread(data, client, self.baud) if to_board else misread(data, self.baud, client)
 
     @property
     def backlog(self) -> int:
@@ -170,9 +192,18 @@ def _symlink(target: str, link: str) -> None:
 class TcpEndpoint:
     """A TCP listener serving one client at a time; others are refused while it stays."""
 
-    def __init__(self, sel: selectors.BaseSelector, log: Log, host: str, port: int) -> None:
+    def __init__(
+        self,
+        sel: selectors.BaseSelector,
+        log: Log,
+        host: str,
+        port: int,
+        baud: int | None = None,
+    ) -> None:
         self._sel = sel
         self._log = log
+        self.baud = baud
+        """The line rate it is paced at; None: the port's own."""
         try:
             self._listener = socket.create_server((host, port))
         except OSError as exc:
@@ -270,7 +301,7 @@ class SerialEndpoint:
         except (serial.SerialException, OSError, ValueError) as exc:
             raise AppmodeError(explain_open_error(path, exc)) from None
         self.url = path
-        self.baud = baud
+        self.baud: int | None = baud
         self._sel = sel
         sel.register(self._port.fileno(), selectors.EVENT_READ, self._read)
 
@@ -436,7 +467,7 @@ class BoardServer:
             if self._recorder is not None:
                 self._recorder.follow(int(board.params[SYSTEM_MODE]), 0.0)
             bauds = {
-                name: getattr(endpoint, "baud", BAUD if name == APP else UART2_BAUD)
+                name: endpoint.baud or (BAUD if name == APP else UART2_BAUD)
                 for name, endpoint in pair.items()
             }
             wire = Wire(
@@ -600,6 +631,7 @@ def run_board(
     profile: str = "sheet",
     listen2: str | None = None,
     device2: str | None = None,
+    baud: int | None = None,
 ) -> int:
     """The `appmode board` command: build the board(s) and serve until interrupted."""
 
@@ -622,19 +654,19 @@ def run_board(
     make: MakeEndpoint
     if listen is not None:
         host, port = parse_listen(listen)
-        make = partial(_tcp, host=host, port=port)
+        make = partial(_tcp, host=host, port=port, baud=baud)
     elif device is not None:
-        make = partial(_serial, device=device, baud=BAUD)
+        make = partial(_serial, device=device, baud=baud or BAUD)
     else:
-        make = partial(_pty, link=link)
+        make = partial(_pty, link=link, baud=baud)
     make2: MakeEndpoint
     if listen2 is not None:
         host, port = parse_listen(listen2, "--listen2")
-        make2 = partial(_tcp, host=host, port=port)
+        make2 = partial(_tcp, host=host, port=port, baud=None)
     elif device2 is not None:
         make2 = partial(_serial, device=device2, baud=UART2_BAUD)
     else:
-        make2 = partial(_pty, link=None)
+        make2 = partial(_pty, link=None, baud=UART2_BAUD if baud else None)
     kind = DriveType.from_cli_name(drive) if drive else None
     rules = profile_named(profile)
     rules.check(drive=kind is not None, flash=flash is not None)
@@ -648,6 +680,8 @@ def run_board(
         f"simulated board{'s' if count > 1 else ''}, {rules.name} profile, {body}, "
         f"{'paced at the line rate' if pace else 'not paced'}"
     )
+    if baud is not None:
+        banner += f", APP port at {baud} bps (a pty read at another rate garbles, as a UART)"
     needs = [f"profile={profile}"] if rules is not SHEET else []
     needs += [f"drive={drive}"] if drive else []
     try:
@@ -670,12 +704,14 @@ def run_board(
     return 0
 
 
-def _pty(sel: selectors.BaseSelector, log: Log, *, link: str | None) -> Endpoint:
-    return PtyEndpoint(sel, log, link)
+def _pty(sel: selectors.BaseSelector, log: Log, *, link: str | None, baud: int | None) -> Endpoint:
+    return PtyEndpoint(sel, log, link, baud)
 
 
-def _tcp(sel: selectors.BaseSelector, log: Log, *, host: str, port: int) -> Endpoint:
-    return TcpEndpoint(sel, log, host, port)
+def _tcp(
+    sel: selectors.BaseSelector, log: Log, *, host: str, port: int, baud: int | None
+) -> Endpoint:
+    return TcpEndpoint(sel, log, host, port, baud)
 
 
 def _serial(sel: selectors.BaseSelector, log: Log, *, device: str, baud: int) -> Endpoint:
