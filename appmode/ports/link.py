@@ -19,6 +19,7 @@ from urllib.parse import parse_qs, urlsplit
 import serial
 
 from appmode.errors import AppmodeError
+from appmode.ports.holders import holders
 from appmode.protocol import params
 
 if TYPE_CHECKING:
@@ -94,21 +95,48 @@ def parse_device(url: str, baud: int = BAUD) -> tuple[str, int]:
     return path, baud
 
 
+RFCOMM_BIND = (
+    "pair the car's Bluetooth module once (bluetoothctl: scan on, pair MAC, trust MAC; "
+    "the PIN is often 1234), then bind it: sudo rfcomm bind 0 MAC 1"
+)
+LOST_ERRNOS = {
+    getattr(errno, name)
+    for name in ("EHOSTDOWN", "ECONNREFUSED", "ETIMEDOUT", "EHOSTUNREACH", "ECONNRESET")
+    if hasattr(errno, name)
+}
+"""What opening a bound rfcomm port fails with when the module does not answer."""
+
+
+def is_rfcomm(where: str) -> bool:
+    return "rfcomm" in where.lower()
+
+
 def explain_open_error(where: str, exc: Exception) -> str:
     code = getattr(exc, "errno", None)
     text = str(exc)
     if code == errno.ENOENT or "No such file" in text:
+        if is_rfcomm(where):
+            return f"no such port {where}: the Bluetooth serial port is not bound: {RFCOMM_BIND}"
         return (
             f"no such port {where}: check the adapter is plugged in (and paired, for "
             f"Bluetooth); list ports with: appmode ports"
         )
-    if code == errno.EACCES or "Permission denied" in text:
+    if is_rfcomm(where) and code in LOST_ERRNOS:
         return (
-            f"permission denied opening {where}: add yourself to the dialout group "
-            f"(sudo usermod -aG dialout $USER) and log in again"
+            f"the car's Bluetooth module did not answer on {where} "
+            f"({getattr(exc, 'strerror', None) or text}): switch the car on and bring it "
+            f"in range; a phone still connected to it keeps it: disconnect the phone"
+        )
+    if code == errno.EACCES or "Permission denied" in text:
+        group = _group_of(where)
+        return (
+            f"permission denied opening {where}: add yourself to the {group} group "
+            f"(sudo usermod -aG {group} $USER) and log in again"
         )
     if code == errno.EBUSY or "exclusively lock" in text or "busy" in text.lower():
-        return f"{where} is busy: another program has it open; close that program and retry"
+        held = holders(where)
+        who = f"held by {', '.join(map(str, held))}" if held else "another program has it open"
+        return f"{where} is busy: {who}; close that program and retry"
     if "Connection refused" in text:
         return (
             f"nothing is listening at {where}: start the board (appmode board --listen "
@@ -120,6 +148,17 @@ def explain_open_error(where: str, exc: Exception) -> str:
         return f"{where} is not a device this program can open (no such device or address)"
     reason = getattr(exc, "strerror", None) or text  # pyserial repeats errno and path
     return f"cannot open {where}: {reason}"
+
+
+def _group_of(path: str) -> str:
+    """The group that may open a device (dialout on most Linux systems, uucp on some)."""
+    try:
+        import grp  # POSIX only
+
+        name = grp.getgrgid(os.stat(path).st_gid).gr_name
+    except (ImportError, OSError, KeyError):
+        return "dialout"
+    return "dialout" if name == "root" else name
 
 
 def new_pty() -> PtyPort:
