@@ -460,12 +460,7 @@ class Board:
             self._outbox += data
         if profile.firmware_uart2:  # written once the record has gone out
             self._burst_ms = at + math.ceil(len(data) * profile.byte_ms)
-        if profile.period_ms is not None:
-            self._record_ms = at + profile.period_ms
-        else:
-            wire = len(data) * profile.byte_ms
-            step = profile.pause_step_ms
-            self._record_ms = at + step * math.ceil(wire / step - 1e-9) + profile.pause_ms
+        self._record_ms = at + profile.record_period_ms(len(data))
 
     def _whole(self, value: float) -> int:
         return math.trunc(value) if self.profile.truncate else round(value)

@@ -7,6 +7,7 @@ reference firmware as measured (§13). A third board is a third row.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -102,6 +103,13 @@ class Profile:
     clamp, no lag), and until one does the motion freezes at the take-over; after each
     APP record UART2 carries what is left of the status the loop writes there. Else the
     sheet's frames (§8–§12)."""
+
+    def record_period_ms(self, size: int) -> int:
+        """Milliseconds from a record of `size` bytes to the next (§3.4, §13)."""
+        if self.period_ms is not None:
+            return self.period_ms
+        step = self.pause_step_ms
+        return step * math.ceil(size * self.byte_ms / step - 1e-9) + self.pause_ms
 
     @property
     def answers_reads(self) -> bool:

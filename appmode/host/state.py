@@ -14,6 +14,7 @@ from appmode.host.query import Outcome, ParamQuery, QueryFailed
 from appmode.protocol import app, params
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import motion_text
+from appmode.text import counted
 
 RATE_WINDOW = 2.0
 DEGRADED_WINDOW = 5.0
@@ -218,10 +219,21 @@ class HostState:
 
     def _step(self, data: bytes, outcome: Outcome | None) -> Outcome | None:
         self._outbox += data
-        if outcome is not None:
+        query = self.query
+        if outcome is not None and query is not None:
             self.query = None
             garbled = self.stats.errors - self._errors_at_start
-            if isinstance(outcome, QueryFailed) and garbled:
+            where = query.where
+            if isinstance(outcome, QueryFailed) and not self.stats.records:
+                outcome = QueryFailed(
+                    f"nothing came from {where}: {outcome.text.split(': ', 1)[-1]}"
+                    if not self.stats.bytes_in
+                    else f"what answers at {where} is not a board: "
+                    f"{counted(self.stats.bytes_in, 'byte')} came and no record: another "
+                    f"program's port (a pty path may have been reused) or a wrong baud "
+                    f"rate; find the car with: appmode doctor"
+                )
+            elif isinstance(outcome, QueryFailed) and garbled:
                 outcome = QueryFailed(
                     f"{outcome.text} ({garbled} garbled records or bytes "
                     f"came meanwhile: the link is noisy)"
