@@ -16,6 +16,7 @@ from appmode.cli import (
     conform,
     decode,
     demo,
+    doctor,
     drive,
     dump,
     monitor,
@@ -46,6 +47,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     dump,
     plot,
     ports,
+    doctor,
 )
 """Each command's module: `register(sub)` adds its arguments, `run(args)` does the job."""
 

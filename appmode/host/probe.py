@@ -1,0 +1,372 @@
+"""What answers on a port, found by listening: `appmode doctor`'s probe.
+
+A port is listened to at 9600 bps for APP records; when it carries bytes that are not
+records (a wrong rate reads as such: `line/uart.py`) the other common rates are tried,
+and 115200 for the control port's traffic (UART2: encoder reports, the reference
+firmware's status bursts). The only bytes ever sent are `{Q:P}` frames to a port that
+streams APP records, to read its parameters: never a drive letter, and nothing to a
+silent port, where a control port would count them toward its take-over (§8.3). The
+firmware is told from its record period (§3.4, §13: 50 ms on the sheet, about 60 ms on
+the reference firmware).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import shlex
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import serial
+
+from appmode.board.profiles import PROFILES, Profile
+from appmode.errors import AppmodeError
+from appmode.host.client import Host
+from appmode.line.wire import APP_BAUD, UART2_BAUD
+from appmode.ports.link import is_network, is_simulated, open_link, parse_device
+from appmode.protocol import app, control, params
+
+RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
+"""The rates tried, in order: the APP port's, the control port's, then a Bluetooth
+module's other settings."""
+LISTEN = 1.0
+"""Seconds of listening at 9600 bps: about 17 records of either firmware."""
+LISTEN_OTHER = 0.5
+"""Seconds of listening at each other rate."""
+STARTING = 2.5
+"""Seconds of listening at most while a board prints its start-up text (the reference
+firmware's first record comes 1.4 s after power-up)."""
+ENOUGH = 3
+"""Records (or control-port bursts) that show what a port carries."""
+STARTED = 8
+"""Records after a board's start-up text that give its period."""
+PERIOD_FIT = 0.1
+"""How far (as a fraction) a measured record period may be from a firmware's."""
+READ_TRIES = 2
+"""Rounds of `{Q:P}` for the parameters (each asks for two agreeing C records)."""
+SAMPLE = 48
+"""Bytes of text kept to show what a port that is not a board sent."""
+
+Progress = Callable[[str], None]
+
+
+@dataclass
+class Heard:
+    """What came at one rate."""
+
+    baud: int
+    seconds: float = 0.0
+    size: int = 0
+    record_times: list[float] = field(default_factory=list)
+    record_sizes: list[int] = field(default_factory=list)
+    uart2_bytes: int = 0
+    uart2_bursts: int = 0
+    reports: int = 0
+    outside: int = 0
+    """Bytes decoded outside records."""
+    printable: int = 0
+    sample: bytearray = field(default_factory=bytearray)
+
+    @property
+    def records(self) -> int:
+        return len(self.record_times)
+
+    @property
+    def carries_app(self) -> bool:
+        """APP records: at least ENOUGH, and more of the bytes than what is neither a
+        record nor text (a board's start-up text, a record caught half way)."""
+        noise = self.size - sum(self.record_sizes) - self.printable
+        return self.records >= ENOUGH and sum(self.record_sizes) >= noise
+
+    @property
+    def carries_uart2(self) -> bool:
+        return self.uart2_bursts >= ENOUGH and 10 * self.uart2_bytes >= 8 * self.size
+
+    @property
+    def text(self) -> bool:
+        """Mostly printable text outside records: a program that talks, or a board's
+        start-up text, not a board at a wrong rate (whose bytes are mostly not text)."""
+        other = self.outside
+        return other >= 8 and 10 * self.printable >= 9 * other
+
+    @property
+    def period_ms(self) -> float | None:
+        """The mean time from one record to the next."""
+        if self.records < ENOUGH:
+            return None
+        return 1000 * (self.record_times[-1] - self.record_times[0]) / (self.records - 1)
+
+    def feed(
+        self,
+        data: bytes,
+        at: float,
+        app_decoder: app.BoardDecoder,
+        uart2_decoder: control.BoardDecoder,
+    ) -> None:
+        """Count what `data`, come at `at` s, holds."""
+        self.size += len(data)
+        for event in app_decoder.feed(data):
+            if isinstance(event, app.RECORDS) and event.terminated:
+                self.record_times.append(at)
+                self.record_sizes.append(len(event.raw))
+            elif not isinstance(event, app.RECORDS):
+                self.outside += len(event.raw)
+                printable = bytes(b for b in event.raw if 0x20 <= b < 0x7F or b in (9, 10, 13))
+                self.printable += len(printable)
+                if len(printable) == len(event.raw):
+                    self.sample += printable[: SAMPLE - len(self.sample)]
+        for burst in uart2_decoder.feed(data):
+            if isinstance(burst, (control.EncoderReport, control.Status, control.Reply)):
+                self.uart2_bursts += 1
+                self.uart2_bytes += len(burst.raw)
+                self.reports += isinstance(burst, control.EncoderReport)
+
+
+@dataclass
+class Finding:
+    """The verdict on one port."""
+
+    url: str
+    kind: str
+    """`app`, `uart2` (a car's port), `silent`, `noise`, `text`, or `unopened`."""
+    verdict: str
+    """One line: what this is."""
+    fix: str
+    """What to do next: the command that drives it, or what to fix."""
+    baud: int | None = None
+    profile: str | None = None
+    period_ms: float | None = None
+    values: tuple[int, ...] | None = None
+    heard: list[Heard] = field(default_factory=list)
+
+    @property
+    def is_car(self) -> bool:
+        return self.kind in ("app", "uart2")
+
+    def to_json(self) -> dict[str, object]:
+        return {
+            "port": self.url,
+            "kind": self.kind,
+            "car": self.is_car,
+            "verdict": self.verdict,
+            "fix": self.fix,
+            "baud": self.baud,
+            "profile": self.profile,
+            "record_period_ms": None if self.period_ms is None else round(self.period_ms, 1),
+            "params": None
+            if self.values is None
+            else {p.name: v for p, v in zip(params.PARAMS, self.values, strict=True)},
+            "heard": [
+                {
+                    "baud": h.baud,
+                    "seconds": round(h.seconds, 2),
+                    "bytes": h.size,
+                    "records": h.records,
+                    "uart2_bursts": h.uart2_bursts,
+                }
+                for h in self.heard
+            ],
+        }
+
+
+def firmware(heard: Heard) -> Profile | None:
+    """The profile whose record period fits what was heard, if one does."""
+    measured = heard.period_ms
+    if measured is None:
+        return None
+    for profile in PROFILES.values():
+        sizes = heard.record_sizes[:-1] or heard.record_sizes
+        expected = sum(profile.record_period_ms(size) for size in sizes) / len(sizes)
+        if abs(measured - expected) <= PERIOD_FIT * expected:
+            return profile
+    return None
+
+
+def listen(
+    url: str, baud: int, seconds: float, stop: threading.Event
+) -> tuple[Heard, serial.SerialBase]:
+    """What comes on `url` at `baud` in `seconds` (up to STARTING while a board prints
+    its start-up text); the port stays open for a read that follows."""
+    port = open_link(url, timeout=0.02, baud=baud)
+    heard = Heard(baud)
+    app_decoder, uart2_decoder = app.BoardDecoder(), control.BoardDecoder(wheels=None)
+    start = time.monotonic()
+    try:
+        while not stop.is_set():
+            starting = heard.text and heard.records < STARTED
+            if time.monotonic() - start >= (STARTING if starting else seconds):
+                break
+            data = port.read(max(1, port.in_waiting))
+            if data:
+                heard.feed(data, time.monotonic() - start, app_decoder, uart2_decoder)
+    except BaseException:
+        close_quietly(port)
+        raise
+    heard.seconds = time.monotonic() - start
+    return heard, port
+
+
+def probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
+    """Listen to `url` and say what it is (never raises AppmodeError: that is a finding)."""
+    try:
+        return _probe(url, stop, progress)
+    except (AppmodeError, serial.SerialException, OSError) as exc:
+        what, _, fix = str(exc).partition(": ")
+        return Finding(url, "unopened", f"cannot be opened: {what}", fix or what)
+
+
+def _probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
+    fixed = is_network(url) or is_simulated(url)  # no line rate to get wrong
+    path, given = (url, 0) if fixed else parse_device(url, 0)
+    rates = RATES[:1] if fixed else (given, *(r for r in RATES if r != given)) if given else RATES
+    heard: list[Heard] = []
+    for baud in rates:
+        if stop.is_set():
+            break
+        progress(f"listening at {baud} bps" if not fixed else "listening")
+        one, port = listen(path, baud, LISTEN_OTHER if heard else LISTEN, stop)
+        heard.append(one)
+        if one.carries_app:
+            return _car(url, path, one, port, heard, fixed, progress)
+        close_quietly(port)
+        if one.carries_uart2 and (baud == UART2_BAUD or fixed):
+            return _control_port(path, one, heard, fixed)
+        if len(heard) == 2 and not any(h.size for h in heard):
+            break  # silent at the APP port's rate and at the control port's
+    uart2 = next((h for h in heard if h.carries_uart2), None)  # at a rate of its own
+    if uart2 is not None:
+        return _control_port(path, uart2, heard, fixed)
+    return _no_board(url, heard, fixed)
+
+
+def _with_baud(url: str, baud: int, usual: int, fixed: bool) -> str:
+    return url if fixed or baud == usual else f"{url}?baud={baud}"
+
+
+def _car(
+    url: str,
+    path: str,
+    one: Heard,
+    port: serial.SerialBase,
+    heard: list[Heard],
+    fixed: bool,
+    progress: Progress,
+) -> Finding:
+    profile = firmware(one)
+    ports = [port]
+
+    def reopen(target: str) -> serial.SerialBase:
+        return ports.pop() if ports else open_link(target, timeout=0.02, baud=one.baud)
+
+    progress(f"reading the parameters at {one.baud} bps")
+    layout = (profile or PROFILES["sheet"]).a_layout
+    values: tuple[int, ...] | None = None
+    failure = ""
+    host = Host(path, opener=reopen, stop_on_close=False, layout=layout)
+    try:
+        values = host.read_params(tries=READ_TRIES)
+    except AppmodeError as exc:
+        failure = str(exc)
+    finally:
+        host.close()
+    target = _with_baud(path, one.baud, APP_BAUD, fixed)
+    rate = "" if fixed else f" at {one.baud} bps"
+    if profile is None:
+        what = f"unknown firmware (a record every {one.period_ms:.0f} ms)"
+    else:
+        what = f"{profile.name} firmware (a record every {one.period_ms:.0f} ms)"
+    named = profile is not None and profile.name != "sheet" and not is_simulated(url)
+    drive = f"appmode drive {shlex.quote(target)}" + (
+        f" --profile {profile.name}" if named and profile is not None else ""
+    )
+    if values is None:
+        return Finding(
+            url,
+            "app",
+            f"a car's APP port{rate}, {what}; its parameters did not come",
+            f"{failure}; drive it with: {drive}",
+            one.baud,
+            profile.name if profile else None,
+            one.period_ms,
+            None,
+            heard,
+        )
+    shown = ", ".join(f"{p.name}={v}" for p, v in zip(params.PARAMS, values, strict=True))
+    note = (
+        ""
+        if fixed or one.baud == APP_BAUD
+        else f" (its Bluetooth module or UART runs at {one.baud}, not 9600)"
+    )
+    return Finding(
+        url,
+        "app",
+        f"this is a car: APP port{rate}{note}, {what}, parameters {shown}",
+        f"drive it with: {drive}",
+        one.baud,
+        profile.name if profile else None,
+        one.period_ms,
+        values,
+        heard,
+    )
+
+
+def _control_port(url: str, one: Heard, heard: list[Heard], fixed: bool) -> Finding:
+    rate = "" if fixed else f" at {one.baud} bps"
+    what = "encoder reports" if one.reports else "the reference firmware's status bursts (§13.1)"
+    target = _with_baud(url, one.baud, UART2_BAUD, fixed)
+    return Finding(
+        url,
+        "uart2",
+        f"this is a car's control port (UART2){rate}: it sends {what}",
+        f"drive it with: appmode drive {shlex.quote(target)} --uart2 (it takes the motion "
+        "over from the APP port)",
+        one.baud,
+        None,
+        None,
+        None,
+        heard,
+    )
+
+
+def _no_board(url: str, heard: list[Heard], fixed: bool) -> Finding:
+    tried = " or ".join(f"{h.baud}" for h in heard)
+    spent = sum(h.seconds for h in heard)
+    if not any(h.size for h in heard):
+        where = "" if fixed else f" at {tried} bps"
+        return Finding(
+            url,
+            "silent",
+            f"silent: nothing came in {spent:.1f} s{where}",
+            "check that the car is on and wired TX to RX (or paired, for Bluetooth); a "
+            "control port (UART2) with its encoder report off is silent until spoken to: "
+            f"appmode params {shlex.quote(url)} --uart2 reads it (and takes the motion over)",
+            heard=heard,
+        )
+    talk = next((h for h in heard if h.text), None)
+    if talk is not None:
+        sample = bytes(talk.sample).decode("ascii", "replace").split()
+        return Finding(
+            url,
+            "text",
+            f"not a board: it sends text at {talk.baud} bps ({' '.join(sample)[:40]!r}…), "
+            "no records",
+            "name the car's port instead (appmode ports lists them); a pty "
+            "path may now be another program's: restart the board, or use board --link",
+            talk.baud,
+            heard=heard,
+        )
+    return Finding(
+        url,
+        "noise",
+        f"bytes but no records at {', '.join(str(h.baud) for h in heard)} bps",
+        "not a board, or at a rate appmode does not try: check the wiring (TX to RX, a "
+        "common ground) and the module's rate",
+        heard=heard,
+    )
+
+
+def close_quietly(port: serial.SerialBase) -> None:
+    with contextlib.suppress(serial.SerialException, OSError):
+        port.close()

@@ -1,0 +1,222 @@
+"""Issue 23.1: `appmode doctor` finds the car, port by port, and says what to fix."""
+
+from __future__ import annotations
+
+import json
+import os
+import pty
+import shutil
+import subprocess
+import sys
+import time
+import tty
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import pytest
+import serial
+
+from appmode.board.profiles import MINIBALANCE, SHEET
+from appmode.cli import main as cli_main
+from appmode.host import probe
+from appmode.protocol import app, params
+from tests.support.processes import ROOT, appmode_cmd, board_process, run
+
+
+def doctor(*urls: str, wrap: list[str] | None = None) -> tuple[int, list[dict[str, Any]], str]:
+    """`appmode doctor --json URLS`: its exit status, one finding per port, its stderr."""
+    done = subprocess.run(
+        [*(wrap or []), *appmode_cmd("doctor", "--json", *urls)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=ROOT,
+        check=False,
+    )
+    found = [json.loads(line) for line in done.stdout.splitlines()]
+    assert [f["port"] for f in found] == list(urls), done.stderr
+    return done.returncode, found, done.stderr
+
+
+@contextmanager
+def silent_pty() -> Iterator[str]:
+    """A pseudo-terminal nobody writes to."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    try:
+        yield os.ttyname(slave)
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+def test_a_minibalance_car_a_car_at_the_wrong_rate_and_a_silent_port_in_under_10_s() -> None:
+    with (
+        board_process("--pty", "--profile", "minibalance", "-q") as mini,
+        board_process("--pty", "--baud", "38400", "-q") as fast,
+        silent_pty() as quiet,
+    ):
+        start = time.monotonic()
+        status, (car, other, nothing, uart2), _ = doctor(mini.url, fast.url, quiet, mini.uart2)
+        took = time.monotonic() - start
+    assert took < 10
+    assert status == 0
+    assert car["kind"] == "app" and car["baud"] == 9600 and car["profile"] == "minibalance"
+    assert tuple(car["params"].values()) == MINIBALANCE.defaults
+    assert car["fix"] == f"drive it with: appmode drive {mini.url} --profile minibalance"
+    # the other car's module runs at 38400: garbled at 9600 and 115200, records at 38400
+    assert other["kind"] == "app" and other["baud"] == 38400 and other["profile"] == "sheet"
+    assert [h["baud"] for h in other["heard"]] == [9600, 115200, 38400]
+    assert other["heard"][0]["bytes"] > 0 and other["heard"][0]["records"] == 0
+    assert tuple(other["params"].values()) == SHEET.defaults
+    assert other["fix"] == f"drive it with: appmode drive '{fast.url}?baud=38400'"
+    assert "runs at 38400, not 9600" in other["verdict"]
+    assert nothing["kind"] == "silent" and not nothing["car"]
+    assert [h["baud"] for h in nothing["heard"]] == [9600, 115200]
+    assert "check that the car is on" in nothing["fix"]
+    # the reference firmware's UART2 carries its status bursts at 115200
+    assert uart2["kind"] == "uart2" and uart2["baud"] == 115200
+    assert "status bursts" in uart2["verdict"]
+
+
+def test_it_sends_only_parameter_reads_and_nothing_to_a_silent_port(tmp_path: Any) -> None:
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "-q") as board:
+        status, (found, quiet), _ = doctor(board.url, board.uart2)
+    assert status == 0 and found["kind"] == "app" and quiet["kind"] == "silent"
+    lines = record.read_text().splitlines()
+    sent = [line.split(" ", 2)[2] for line in lines if " > " in line or " 2> " in line]
+    assert sent and set(sent) == {"{Q:P}"}, sent  # no letter, nothing on UART2
+
+
+def test_text_is_not_a_board_and_params_says_so() -> None:
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    path = os.ttyname(slave)
+    talk = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import os,sys,time\nwhile True:\n"
+            f" os.write({master}, b'Debian GNU/Linux 12 login: '); time.sleep(0.2)",
+        ],
+        pass_fds=(master,),
+    )
+    try:
+        status, (found,), _ = doctor(path)
+        done = run("params", path)
+    finally:
+        talk.kill()
+        talk.wait()
+        os.close(master)
+        os.close(slave)
+    assert status == 1 and found["kind"] == "text"
+    assert "not a board: it sends text at 9600 bps ('Debian GNU/Linux" in found["verdict"]
+    assert done.returncode == 2
+    assert f"what answers at {path} is not a board:" in done.stderr
+    assert "a pty path may have been reused" in done.stderr
+    assert "appmode doctor" in done.stderr
+
+
+def test_a_busy_port_names_the_process_that_holds_it() -> None:
+    with board_process("--pty", "-q") as board, serial.Serial(board.url, exclusive=True):
+        status, (found,), _ = doctor(board.url)
+    assert status == 1 and found["kind"] == "unopened"
+    assert found["verdict"] == f"cannot be opened: {board.url} is busy"
+    assert f"(pid {os.getpid()}, holding its lock)" in found["fix"]
+
+
+def test_a_port_without_permission_says_which_group_to_join() -> None:
+    with silent_pty() as path:
+        if os.geteuid() == 0:  # root opens anything: take away the capabilities that do it
+            setpriv = shutil.which("setpriv")
+            assert setpriv, "the test needs setpriv (util-linux) when run as root"
+            os.chown(path, 65534, 65534)
+            os.chmod(path, 0o600)
+            wrap = [setpriv, "--bounding-set", "-dac_override,-dac_read_search,-fowner", "--"]
+        else:
+            os.chmod(path, 0)
+            wrap = []
+        status, (found,), _ = doctor(path, wrap=wrap)
+    assert status == 1 and found["kind"] == "unopened"
+    assert found["verdict"] == f"cannot be opened: permission denied opening {path}"
+    assert found["fix"].startswith("add yourself to the ")
+    assert "sudo usermod -aG" in found["fix"]
+
+
+def test_a_missing_rfcomm_port_gets_the_bluetooth_steps() -> None:
+    status, (found,), _ = doctor("/dev/rfcomm97")
+    assert status == 1 and found["verdict"] == "cannot be opened: no such port /dev/rfcomm97"
+    assert "rfcomm bind 0 MAC 1" in found["fix"] and "bluetoothctl" in found["fix"]
+    assert "plugged in" not in found["fix"]
+
+
+def test_the_embedded_boards_of_both_profiles() -> None:
+    status, (sheet, mini), _ = doctor("sim://", "sim://?profile=minibalance")
+    assert status == 0
+    assert sheet["profile"] == "sheet" and sheet["fix"] == "drive it with: appmode drive sim://"
+    assert tuple(sheet["params"].values()) == SHEET.defaults
+    # it boots when opened: its start-up text, then records from 1.4 s
+    assert mini["profile"] == "minibalance" and mini["baud"] == 9600
+    assert tuple(mini["params"].values()) == MINIBALANCE.defaults
+
+
+def test_the_text_verdicts_fit_80_columns() -> None:
+    with silent_pty() as quiet:
+        done = run("doctor", "sim://", quiet, "/dev/rfcomm97")
+    assert done.returncode == 0
+    lines = done.stdout.splitlines()
+    assert max(map(len, lines)) <= 80
+    assert lines[0].startswith("ok sim://: this is a car: APP port, sheet firmware (a record")
+    assert "-- /dev/rfcomm97: cannot be opened: no such port /dev/rfcomm97" in lines
+    assert "   drive it with: appmode drive sim://" in lines
+
+
+def test_progress_shows_on_a_terminal_and_is_cleared() -> None:
+    master, slave = pty.openpty()
+    with silent_pty() as quiet:
+        done = subprocess.run(
+            appmode_cmd("doctor", quiet),
+            stdout=subprocess.PIPE,
+            stderr=slave,
+            cwd=ROOT,
+            timeout=60,
+            check=False,
+        )
+    os.close(slave)
+    shown = os.read(master, 65536).decode()
+    os.close(master)
+    assert done.returncode == 1
+    assert f"doctor: 0 of 1 port checked · {quiet}: listening at 9600 bps" in shown
+    assert f"{quiet}: listening at 115200 bps" in shown
+    assert shown.endswith("\r\x1b[K")
+
+
+def test_no_ports_at_all_says_how_to_connect_one(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr("appmode.ports.listing.serial_ports", list)
+    assert cli_main.main(["doctor"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("no serial ports found: plug in the USB-UART adapter")
+
+
+def timed_records(period_ms: float, records: list[bytes]) -> probe.Heard:
+    heard = probe.Heard(9600)
+    decoders = app.BoardDecoder(), probe.control.BoardDecoder(wheels=None)
+    for i, record in enumerate(records):
+        heard.feed(record, i * period_ms / 1000, *decoders)
+    return heard
+
+
+def test_the_firmware_is_told_by_its_record_period() -> None:
+    a, b = app.encode(app.Velocity(0, 0, 0, 0)), app.encode(app.Attitude(0, 0, 0, 100))
+    assert probe.firmware(timed_records(50, [a, b] * 8)) is SHEET
+    assert probe.firmware(timed_records(60, [a, b] * 8)) is MINIBALANCE
+    assert probe.firmware(timed_records(100, [a, b] * 8)) is None
+    assert probe.firmware(timed_records(50, [a, b])) is None  # too few to tell
+    c = app.encode(app.ParamsRecord(params.DEFAULTS))
+    # a long record keeps the reference loop waiting longer (§13): still that firmware
+    mixed = timed_records(MINIBALANCE.record_period_ms(len(c)), [c] * 6)
+    assert probe.firmware(mixed) is MINIBALANCE
