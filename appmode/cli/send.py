@@ -122,6 +122,7 @@ def run_send(
         for event in host.events(listen):
             show(host, event, out, as_json)
         stop_text = host.state.end.stop_text  # what the stop below will do
+        sent_at = host.now()  # the stop goes first; confirming it takes a while after
         stop = host.close()
         for note in host.notes:
             print(f"appmode: WARNING: {note}", file=sys.stderr)
@@ -129,5 +130,5 @@ def run_send(
             print("appmode: the link is down: the final Z was not sent", file=sys.stderr)
             return 1
         if not as_json:
-            out.write(line(host.now(), ">", stop, stop_text) + "\n")
+            out.write(line(sent_at, ">", stop, stop_text) + "\n")
     return 0

@@ -20,7 +20,7 @@ from appmode.protocol import settings
 from appmode.protocol.control_view import describe
 from appmode.protocol.directions import STOP_LETTER
 
-SILENT_HINT = "check the baud rate (115200), the wiring, and that the car is on"
+SILENT_HINT = "check the wiring and that the car is on; appmode doctor finds its port"
 
 
 def control_body(session: ControlSession) -> Fragments:

@@ -29,7 +29,7 @@ STALE = 0.5
 """Seconds without a record after which the panel shows how long it has been."""
 SILENT = 2.0
 """Seconds after opening with nothing received after which the panel says what to check."""
-SILENT_HINT = "check the baud rate (9600), that the car is on, and Bluetooth is paired"
+SILENT_HINT = "is the car on (and paired)? appmode doctor finds its port and baud rate"
 
 
 def _size(count: int) -> str:

@@ -273,10 +273,8 @@ def _car(
         host.close()
     target = _with_baud(path, one.baud, APP_BAUD, fixed)
     rate = "" if fixed else f" at {one.baud} bps"
-    if profile is None:
-        what = f"unknown firmware (a record every {one.period_ms:.0f} ms)"
-    else:
-        what = f"{profile.name} firmware (a record every {one.period_ms:.0f} ms)"
+    period = f"a record every {5 * round((one.period_ms or 0) / 5)} ms"  # to 5 ms: a rhythm
+    what = f"{profile.name if profile else 'unknown'} firmware ({period})"
     named = profile is not None and profile.name != "sheet" and not is_simulated(url)
     drive = f"appmode drive {shlex.quote(target)}" + (
         f" --profile {profile.name}" if named and profile is not None else ""

@@ -681,7 +681,7 @@ def run_board(
         f"{'paced at the line rate' if pace else 'not paced'}"
     )
     if baud is not None:
-        banner += f", APP port at {baud} bps (a pty read at another rate garbles, as a UART)"
+        banner += f", APP port at {baud} bps"
     needs = [f"profile={profile}"] if rules is not SHEET else []
     needs += [f"drive={drive}"] if drive else []
     try:

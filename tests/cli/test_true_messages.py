@@ -90,7 +90,7 @@ def test_script_mode_against_a_port_that_never_answers_fails(tmp_path: Path) -> 
         os.close(master)
         os.close(slave)
     assert done.returncode == 1
-    assert "appmode: error: no parameters" in done.stderr, done.stderr
+    assert "appmode: error: nothing came from" in done.stderr, done.stderr
 
 
 def test_a_c_record_is_described_in_a_line_not_230_columns() -> None:

@@ -81,10 +81,10 @@ def test_a_silent_port_is_not_called_up() -> None:
     finally:
         os.close(master)
         os.close(slave)
-    assert "port open, nothing received" in text and "check the baud rate" in text
+    assert "port open, nothing received" in text and "appmode doctor" in text
     assert "link up" not in text
-    hint = next(line for line in text.splitlines() if "check the baud rate" in line)
-    assert hint.strip().endswith("and Bluetooth is paired") and len(hint) <= 80, "issue 23.3"
+    hint = next(line for line in text.splitlines() if "appmode doctor" in line)
+    assert hint.strip().endswith("appmode doctor finds its port and baud rate") and len(hint) <= 80
 
 
 def test_old_readings_are_shown_with_their_age() -> None:

@@ -1,0 +1,250 @@
+"""Issue 23.5: every `$ …` example of the README runs, in order, and prints what the
+README shows.
+
+Boards the README starts (`$ appmode board …`) are started, and the pty names it shows
+stand for theirs. An example's output matches when its lines come in order (`…` alone
+on a line stands for any lines, `…` in a line for any text there). On a line of
+readings from a board in real time (a timed `0.123 <` line, the console's velocity row)
+a number may differ from the README's by 20 % (at least 3, or 0.1 with decimals): a
+speed read at a slightly other moment; elsewhere a duration may differ by 0.1 s or
+20 %, and every other number is exact.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+import selectors
+import shlex
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from tests.support.processes import ROOT
+
+README = ROOT / "README.md"
+
+NOT_RUN = {
+    "appmode ports": "lists this machine's serial ports, which differ from machine to machine",
+    "cd examples/pytest_host && pytest -n 2": "tests/testing/test_plugin.py runs that project",
+    "appmode conform bad.transcript": "an illustration of a failure: bad.transcript is an "
+    "edited copy of a suite transcript, not shipped",
+    "appmode drive /dev/pts/1 --uart2": "a full-screen console: tests/console drives it in tmux",
+    "appmode drive /dev/pts/0 /dev/pts/1": "a full-screen console: tests/console drives it in tmux",
+}
+"""Examples not run here, and why."""
+
+SWITCH = 2.0
+"""Seconds between starting a board and the next command: the README's board logs show
+a person switching to another shell."""
+NUMBER = re.compile(r"(-?\d+(?:\.\d+)?)")
+LIVE = re.compile(r"\s*(\d+\.\d{3} |velocity |attitude |link up |APP port: )")
+PTY = re.compile(r"/dev/pts/\d+")
+
+
+@dataclass
+class Example:
+    line: int
+    command: str
+    expected: list[str]
+
+
+def examples() -> list[Example]:
+    """The README's `$ …` commands, each with the lines shown after it in its block."""
+    found: list[Example] = []
+    block = False
+    current: Example | None = None
+    for number, line in enumerate(README.read_text().splitlines(), 1):
+        if line.startswith("```"):
+            block, current = not block, None
+        elif block and line.startswith("$ "):
+            current = Example(number, line[2:], [])
+            found.append(current)
+        elif current is not None:
+            current.expected.append(line)
+    return found
+
+
+def _tokens(line: str) -> list[str]:
+    """Numbers, `…` and the words between them, whitespace runs as one space."""
+    parts = re.split(r"(-?\d+(?:\.\d+)?|…)", " ".join(line.split()))
+    return [part for part in parts if part]
+
+
+def _same_number(expected: str, actual: str, live: bool) -> bool:
+    if not NUMBER.fullmatch(actual):
+        return False
+    if not live and "." not in expected:
+        return expected == actual
+    e, a = float(expected), float(actual)
+    slack = max(0.1 if "." in expected else 3.0, 0.2 * abs(e))
+    return abs(e - a) <= slack
+
+
+def is_live(line: str) -> bool:
+    """A line of readings taken in real time: a timed line, the console's readings."""
+    return LIVE.match(line) is not None
+
+
+def line_matches(expected: str, actual: str, timed: bool) -> bool:
+    """`…` in a line stands for any text; numbers as the module says."""
+    want, got = _tokens(expected), "".join(_tokens(actual))
+    live = timed and is_live(expected)
+
+    @functools.cache
+    def match(i: int, at: int) -> bool:
+        if i == len(want):
+            return at == len(got)
+        token = want[i]
+        if token == "…":
+            return any(match(i + 1, k) for k in range(at, len(got) + 1))
+        if NUMBER.fullmatch(token):
+            number = NUMBER.match(got, at)
+            return (
+                number is not None
+                and _same_number(token, number.group(0), live)
+                and match(i + 1, number.end())
+            )
+        return got.startswith(token, at) and match(i + 1, at + len(token))
+
+    return match(0, 0)
+
+
+def output_matches(expected: list[str], actual: list[str], timed: bool) -> int | None:
+    """None when `actual` matches; else the index of the first expected line that no
+    way of matching got past."""
+    reached = 0
+
+    @functools.cache
+    def match(i: int, j: int) -> bool:
+        nonlocal reached
+        reached = max(reached, i)
+        if i == len(expected):
+            return j == len(actual)
+        if expected[i].strip() == "…":
+            return any(match(i + 1, k) for k in range(j, len(actual) + 1))
+        return (
+            j < len(actual) and line_matches(expected[i], actual[j], timed) and match(i + 1, j + 1)
+        )
+
+    return None if match(0, 0) else reached
+
+
+class Boards:
+    """The boards the README starts, and the names it shows for their ptys."""
+
+    def __init__(self, cwd: Path) -> None:
+        self.cwd = cwd
+        self.procs: list[subprocess.Popen[str]] = []
+        self.names: dict[str, str] = {}  # README name → this run's pty
+
+    def start(self, example: Example) -> list[str]:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", *shlex.split(example.command)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=self.cwd,
+        )
+        self.procs.append(proc)
+        assert proc.stdout is not None and proc.stderr is not None
+        port, uart2 = _line(proc.stdout), proc.stdout.readline().rstrip("\n")
+        shown = [port, uart2, _line(proc.stderr)]
+        for want, got in zip(example.expected[:2], shown[:2], strict=True):
+            self.names[want.split(": ", 1)[1]] = got.split(": ", 1)[1]
+        time.sleep(SWITCH)
+        return shown
+
+    def to_run(self, command: str) -> str:
+        return PTY.sub(lambda m: self.names.get(m.group(0), m.group(0)), command)
+
+    def as_shown(self, text: str) -> str:
+        mine = {actual: shown for shown, actual in self.names.items()}
+        return PTY.sub(lambda m: mine.get(m.group(0), m.group(0)), text)
+
+    def stop(self) -> None:
+        for proc in self.procs:
+            proc.terminate()
+            proc.communicate(timeout=10)
+
+
+def _line(stream: object) -> str:
+    sel = selectors.DefaultSelector()
+    sel.register(stream, selectors.EVENT_READ)  # type: ignore[arg-type]
+    assert sel.select(20), "the board printed nothing in 20 s"
+    return stream.readline().rstrip("\n")  # type: ignore[attr-defined,no-any-return]
+
+
+def run_shell(command: str, cwd: Path) -> str:
+    env = dict(os.environ, PYTHONUNBUFFERED="1", COLUMNS="80")
+    prelude = f'appmode() {{ {shlex.quote(sys.executable)} -m appmode "$@"; }}\n'
+    prelude += f'python() {{ {shlex.quote(sys.executable)} "$@"; }}\n'
+    done = subprocess.run(
+        ["bash", "-c", prelude + command],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        cwd=cwd,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    return done.stdout
+
+
+def test_every_readme_example_runs_and_prints_what_the_readme_shows(tmp_path: Path) -> None:
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    boards = Boards(tmp_path)
+    failures: list[str] = []
+    ran = set()
+    try:
+        for example in examples():
+            if example.command in NOT_RUN:
+                continue
+            ran.add(example.command)
+            if example.command.startswith("appmode board"):
+                out = "\n".join(boards.start(example))
+                expected = example.expected[:3]
+            else:
+                out = run_shell(boards.to_run(example.command), tmp_path)
+                expected = example.expected
+            shown = boards.as_shown(out).splitlines()
+            timed = not example.command.startswith("printf") or "decode" not in example.command
+            failed = output_matches(expected, shown, timed)
+            if failed is not None:
+                where = expected[failed] if failed < len(expected) else "(the end)"
+                failures.append(
+                    f"README.md:{example.line}: $ {example.command}\n  no match for: {where}\n"
+                    + "\n".join(f"  | {line}" for line in shown)
+                )
+    finally:
+        boards.stop()
+    assert not failures, "\n\n".join(failures)
+    listed = {e.command for e in examples()}
+    assert set(NOT_RUN) <= listed, "NOT_RUN names an example the README no longer has"
+    assert ran, "no example ran"
+
+
+def test_the_matcher_tells_a_right_output_from_a_wrong_one() -> None:
+    shown = ["  0.048 < {A0:130:0:0}$    velocity x=0 y=130 z=0", "…", "  0.301 > Z   stop"]
+    got = ["  0.052 < {A0:128:0:0}$ velocity x=0 y=128 z=0", "x", "y", "  0.300 > Z stop"]
+    assert output_matches(shown, got, timed=True) is None
+    assert output_matches(shown, got, timed=False) == 0  # exact numbers
+    assert output_matches(shown, [*got[:3], "  0.300 > A stop"], timed=True) == 2
+    assert output_matches(shown, [*got, "more"], timed=True) == 3  # the end is the end
+    assert line_matches(" 0  max_speed  800  0–65535  500", " 0 max_speed 800 0–65535 500", False)
+    assert not line_matches(" 0  max_speed  800", " 0  max_speed  500", True)
+    assert line_matches(
+        "the shipped suite: /…/appmode/suite", "the shipped suite: /a/b/appmode/suite", False
+    )
+    assert not line_matches(
+        "the shipped suite: /…/appmode/suite", "the suite: /a/appmode/suite", False
+    )
+    assert line_matches(
+        "  2.650 < {C800:10000:20:0:10:10:10:0:1}$    params max_speed=800 …",
+        "  2.650 < {C800:10000:20:0:10:10:10:0:1}$ params max_speed=800 max_position=10000",
+        True,
+    )
