@@ -12,6 +12,7 @@ from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, ALayout
 from appmode.protocol.params import DEFAULTS, PARAMS, value_error
+from appmode.text import counted
 
 RECORD_FIELDS: dict[str, tuple[str, ...]] = {
     "A": VELOCITY.fields,
@@ -164,7 +165,9 @@ def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
         return f"set {event.name} = {event.value}"
     if isinstance(event, (p.BadFrame, p.Malformed)):
         return f"error: {event.reason}"
-    return f"{len(event.raw)} undecodable byte(s)"
+    if event.raw and all(0x20 <= b < 0x7F or b in (0x0A, 0x0D) for b in event.raw):
+        return f"text, no record ({counted(len(event.raw), 'byte')})"
+    return f"{counted(len(event.raw), 'undecodable byte')}"
 
 
 def coalesce(events: Iterable[p.Event]) -> Iterator[p.Event]:
@@ -201,10 +204,18 @@ def view(
     return to_json(event, layout), describe(event, layout), None
 
 
+RAW_WIDTH = 34
+"""Columns of a line's bytes: a longer run of escaped bytes is cut there with `…`."""
+
+
 def line(time: float, direction: str, raw: bytes, text: str, shown: str | None = None) -> str:
     """`  1.234 < {A0:0:0:0}$   velocity …`: one event of a session, for people (its
-    bytes escaped, or as `shown`)."""
-    return f"{time:7.3f} {direction} {escape(raw) if shown is None else shown:<34} {text}"
+    bytes escaped, cut to RAW_WIDTH columns, or as `shown`)."""
+    if shown is None:
+        shown = escape(raw)
+        if len(shown) > RAW_WIDTH:
+            shown = shown[: RAW_WIDTH - 1] + "…"
+    return f"{time:7.3f} {direction} {shown:<{RAW_WIDTH}} {text}"
 
 
 def params_table(values: tuple[int, ...], defaults: tuple[int, ...] = DEFAULTS) -> str:

@@ -111,3 +111,12 @@ def test_each_parameter_table_says_what_its_numbers_are() -> None:
     helped = " ".join(run("params", "--help").stdout.split())
     assert "n is the index of the APP port's {n:value} frame (0-8)" in helped
     assert "SS is the setting's byte in the control port's FF FE 80 80 SS frame" in helped
+
+
+def test_a_boards_start_up_text_shows_as_text_in_80_columns() -> None:
+    done = run("demo", "--profile", "minibalance", "--fast")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert max(map(len, lines)) <= 80
+    assert "  0.500 < mpu_set_sensor\\x20complete\\x20...… text, no record (64 bytes)" in lines
+    assert not any("undecodable" in line for line in lines)
