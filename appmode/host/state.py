@@ -228,8 +228,9 @@ class HostState:
                 outcome = QueryFailed(
                     f"nothing came from {where}: {outcome.text.split(': ', 1)[-1]}"
                     if not self.stats.bytes_in
-                    else f"what answers at {where} is not a board: "
-                    f"{counted(self.stats.bytes_in, 'byte')} came and no record: another "
+                    else f"what answers at {where} is not a board: sent {{Q:P}} "
+                    f"{counted(query.sent, 'time')}; {counted(self.stats.bytes_in, 'byte')} "
+                    f"came back and no record: another "
                     f"program's port (a pty path may have been reused) or a wrong baud "
                     f"rate; find the car with: appmode doctor"
                 )

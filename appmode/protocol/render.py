@@ -131,7 +131,7 @@ def motion_text(record: p.Velocity, layout: ALayout = VELOCITY) -> str:
     return " ".join(shown)
 
 
-SHOWN_PARAMS = 2
+SHOWN_PARAMS = 1
 """Parameters a C record's description names (the record shows all nine; `params`
 prints them as a table, `--json` by name)."""
 
@@ -205,17 +205,24 @@ def view(
 
 
 RAW_WIDTH = 34
-"""Columns of a line's bytes: a longer run of escaped bytes is cut there with `…`."""
+"""Columns the bytes of a line are aligned to."""
+LINE_WIDTH = 80
+"""Columns a line fits in: the bytes' column narrows (and long bytes are cut with `…`)
+to leave the description room."""
+RAW_MIN = 16
+"""Columns of bytes always shown."""
 
 
 def line(time: float, direction: str, raw: bytes, text: str, shown: str | None = None) -> str:
     """`  1.234 < {A0:0:0:0}$   velocity …`: one event of a session, for people (its
-    bytes escaped, cut to RAW_WIDTH columns, or as `shown`)."""
+    bytes escaped, or as `shown`), in LINE_WIDTH columns where the description allows."""
+    head = f"{time:7.3f} {direction} "
+    room = max(RAW_MIN, LINE_WIDTH - len(head) - 1 - len(text))
     if shown is None:
         shown = escape(raw)
-        if len(shown) > RAW_WIDTH:
-            shown = shown[: RAW_WIDTH - 1] + "…"
-    return f"{time:7.3f} {direction} {shown:<{RAW_WIDTH}} {text}"
+    if len(shown) > room:
+        shown = shown[: room - 1] + "…"
+    return f"{head}{shown:<{min(RAW_WIDTH, max(room, len(shown)))}} {text}"
 
 
 def params_table(values: tuple[int, ...], defaults: tuple[int, ...] = DEFAULTS) -> str:

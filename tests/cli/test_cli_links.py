@@ -135,7 +135,7 @@ def test_monitor_over_tcp_for_a_duration() -> None:
         (["params", "/dev/ttyUSB97"], "no such port /dev/ttyUSB97"),
         (["board", "--listen", "nonsense"], "expected HOST:PORT or PORT"),
         (["board", "--port", "/dev/ttyUSB97"], "no such port /dev/ttyUSB97"),
-        (["params", "loop://"], "no parameters from loop://"),
+        (["params", "loop://"], "what answers at loop:// is not a board"),
     ],
 )
 def test_bad_input_is_one_line_on_stderr(args: list[str], message: str) -> None:

@@ -97,8 +97,8 @@ def test_a_c_record_is_described_in_a_line_not_230_columns() -> None:
     """Issue 23.3: demo, send and dump printed every parameter by name after the record."""
     done = run("send", "sim://", "{Q:P}", "wait:0.2")
     (c_line,) = [line for line in done.stdout.splitlines() if "< {C" in line]
-    assert c_line.endswith("params max_speed=500 max_position=10000 …")
-    assert len(c_line) < 90
+    assert c_line.endswith("params max_speed=500 …")
+    assert len(c_line) <= 80
 
 
 def test_each_parameter_table_says_what_its_numbers_are() -> None:
@@ -118,5 +118,9 @@ def test_a_boards_start_up_text_shows_as_text_in_80_columns() -> None:
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert max(map(len, lines)) <= 80
-    assert "  0.500 < mpu_set_sensor\\x20complete\\x20...… text, no record (64 bytes)" in lines
+    assert any(
+        line.startswith("  0.500 < mpu_set_sensor\\x20complete")
+        and line.endswith("… text, no record (64 bytes)")
+        for line in lines
+    )
     assert not any("undecodable" in line for line in lines)

@@ -74,9 +74,7 @@ def test_read_resends_on_timeout_then_fails_with_a_clear_error() -> None:
         assert state.tick(0.5 * k) is None and state.take_outbox() == b"{Q:P}"
     outcome = state.tick(2.0)
     assert isinstance(outcome, QueryFailed)
-    assert "no parameters from /dev/ttyUSB0: sent {Q:P} 4 times and no 2 C records" in (
-        outcome.text
-    )
+    assert "nothing came from /dev/ttyUSB0: sent {Q:P} 4 times and no 2 C records" in (outcome.text)
 
 
 def test_set_is_verified_by_agreeing_c_records_read_after_it() -> None:
