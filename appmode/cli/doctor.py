@@ -9,10 +9,13 @@ import sys
 import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
+from typing import TYPE_CHECKING
 
 from appmode.cli.options import Subparsers
-from appmode.host import probe
 from appmode.text import counted, wrapped
+
+if TYPE_CHECKING:  # imported by `run`: `appmode --help` does not load the host
+    from appmode.host import probe
 
 WORKERS = 8
 """Ports listened to at once."""
@@ -80,6 +83,7 @@ def _text(finding: probe.Finding) -> str:
 
 def _check(urls: list[str]) -> list[probe.Finding]:
     """Probe every port at once, showing progress on a terminal."""
+    from appmode.host import probe
     stop = threading.Event()
     doing = dict.fromkeys(urls, "waiting")
 

@@ -220,3 +220,19 @@ def test_the_firmware_is_told_by_its_record_period() -> None:
     # a long record keeps the reference loop waiting longer (§13): still that firmware
     mixed = timed_records(MINIBALANCE.record_period_ms(len(c)), [c] * 6)
     assert probe.firmware(mixed) is MINIBALANCE
+
+
+def test_the_command_line_loads_the_probe_only_to_run_it() -> None:
+    loaded = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from appmode.cli.main import build_parser; "
+            "build_parser(); print('appmode.host.probe' in sys.modules)",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        check=True,
+    )
+    assert loaded.stdout.strip() == "False"
