@@ -84,6 +84,7 @@ def _text(finding: probe.Finding) -> str:
 def _check(urls: list[str]) -> list[probe.Finding]:
     """Probe every port at once, showing progress on a terminal."""
     from appmode.host import probe
+
     stop = threading.Event()
     doing = dict.fromkeys(urls, "waiting")
 

@@ -95,6 +95,7 @@ def parse_device(url: str, baud: int = BAUD) -> tuple[str, int]:
     return path, baud
 
 
+LIST_PORTS = "list ports with: appmode ports"
 RFCOMM_BIND = (
     "pair the car's Bluetooth module once (bluetoothctl: scan on, pair MAC, trust MAC; "
     "the PIN is often 1234), then bind it: sudo rfcomm bind 0 MAC 1"
@@ -114,12 +115,14 @@ def is_rfcomm(where: str) -> bool:
 def explain_open_error(where: str, exc: Exception) -> str:
     code = getattr(exc, "errno", None)
     text = str(exc)
+    if is_simulated(where):  # the simulated board's own message: what, then the fix
+        return text
     if code == errno.ENOENT or "No such file" in text:
         if is_rfcomm(where):
             return f"no such port {where}: the Bluetooth serial port is not bound: {RFCOMM_BIND}"
         return (
             f"no such port {where}: check the adapter is plugged in (and paired, for "
-            f"Bluetooth); list ports with: appmode ports"
+            f"Bluetooth); {LIST_PORTS}"
         )
     if is_rfcomm(where) and code in LOST_ERRNOS:
         return (
@@ -146,8 +149,11 @@ def explain_open_error(where: str, exc: Exception) -> str:
         return f"unknown host in {where}: check the address"
     if code == errno.ENXIO or "No such device or address" in text:
         return f"{where} is not a device this program can open (no such device or address)"
+    if code in (errno.ENOTTY, errno.EISDIR) or "Inappropriate ioctl" in text:
+        what = "a folder" if code == errno.EISDIR else "not a terminal device"
+        return f"{where} is not a serial port ({what}): name the car's port; {LIST_PORTS}"
     reason = getattr(exc, "strerror", None) or text  # pyserial repeats errno and path
-    return f"cannot open {where}: {reason}"
+    return f"cannot open {where} ({reason}): check the name; {LIST_PORTS}"
 
 
 def _group_of(path: str) -> str:

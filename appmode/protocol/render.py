@@ -165,6 +165,8 @@ def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
         return f"set {event.name} = {event.value}"
     if isinstance(event, (p.BadFrame, p.Malformed)):
         return f"error: {event.reason}"
+    if event.raw.endswith(b"}$") and b"{" not in event.raw:
+        return f"a record's end, its start missed ({counted(len(event.raw), 'byte')})"
     if event.raw and all(0x20 <= b < 0x7F or b in (0x0A, 0x0D) for b in event.raw):
         return f"text, no record ({counted(len(event.raw), 'byte')})"
     return f"{counted(len(event.raw), 'undecodable byte')}"
