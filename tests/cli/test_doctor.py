@@ -236,3 +236,17 @@ def test_the_command_line_loads_the_probe_only_to_run_it() -> None:
         check=True,
     )
     assert loaded.stdout.strip() == "False"
+
+
+def test_a_file_or_a_folder_is_not_a_serial_port(tmp_path: Any) -> None:
+    plain = tmp_path / "notes.txt"
+    plain.write_text("hello\n")
+    status, (file, folder, sim), _ = doctor(str(plain), str(tmp_path), "sim://?bogus=1")
+    assert status == 1
+    assert (
+        file["verdict"] == f"cannot be opened: {plain} is not a serial port (not a terminal device)"
+    )
+    assert folder["verdict"] == f"cannot be opened: {tmp_path} is not a serial port (a folder)"
+    assert file["fix"] == "name the car's port; list ports with: appmode ports"
+    assert sim["verdict"] == "cannot be opened: unknown sim:// option 'bogus'"
+    assert plain.read_text() == "hello\n"  # opened, never written
