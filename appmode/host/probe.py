@@ -25,7 +25,7 @@ from appmode.board.profiles import PROFILES, Profile
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.line.wire import APP_BAUD, UART2_BAUD
-from appmode.ports.link import is_network, is_simulated, open_link, parse_device
+from appmode.ports.link import is_simulated, open_link, parse_device
 from appmode.protocol import app, control, params
 
 RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
@@ -130,7 +130,7 @@ class Finding:
 
     url: str
     kind: str
-    """`app`, `uart2` (a car's port), `silent`, `noise`, `text`, or `unopened`."""
+    """`app`, `uart2` (a car's port), `silent`, `noise`, `text`, `unopened` or `lost`."""
     verdict: str
     """One line: what this is."""
     fix: str
@@ -212,13 +212,21 @@ def probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
     """Listen to `url` and say what it is (never raises AppmodeError: that is a finding)."""
     try:
         return _probe(url, stop, progress)
-    except (AppmodeError, serial.SerialException, OSError) as exc:
+    except AppmodeError as exc:  # opening it failed: the message says what, then the fix
         what, _, fix = str(exc).partition(": ")
         return Finding(url, "unopened", f"cannot be opened: {what}", fix or what)
+    except (serial.SerialException, OSError) as exc:
+        return Finding(
+            url,
+            "lost",
+            f"it opened, then failed while listening ({exc})",
+            "the device went away: check the cable or adapter (or the program that "
+            "served this pty), then run appmode doctor again",
+        )
 
 
 def _probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
-    fixed = is_network(url) or is_simulated(url)  # no line rate to get wrong
+    fixed = "://" in url  # TCP, sim://, loop://: no line rate of ours to get wrong
     path, given = (url, 0) if fixed else parse_device(url, 0)
     rates = RATES[:1] if fixed else (given, *(r for r in RATES if r != given)) if given else RATES
     heard: list[Heard] = []
@@ -331,8 +339,8 @@ def _control_port(url: str, one: Heard, heard: list[Heard], fixed: bool) -> Find
 def _no_board(url: str, heard: list[Heard], fixed: bool) -> Finding:
     tried = " or ".join(f"{h.baud}" for h in heard)
     spent = sum(h.seconds for h in heard)
+    where = "" if fixed else f" at {tried} bps"
     if not any(h.size for h in heard):
-        where = "" if fixed else f" at {tried} bps"
         return Finding(
             url,
             "silent",
@@ -348,8 +356,8 @@ def _no_board(url: str, heard: list[Heard], fixed: bool) -> Finding:
         return Finding(
             url,
             "text",
-            f"not a board: it sends text at {talk.baud} bps ({' '.join(sample)[:40]!r}…), "
-            "no records",
+            f"not a board: it sends text{'' if fixed else f' at {talk.baud} bps'} "
+            f"({' '.join(sample)[:40]!r}…), no records",
             "name the car's port instead (appmode ports lists them); a pty "
             "path may now be another program's: restart the board, or use board --link",
             talk.baud,
@@ -358,7 +366,7 @@ def _no_board(url: str, heard: list[Heard], fixed: bool) -> Finding:
     return Finding(
         url,
         "noise",
-        f"bytes but no records at {', '.join(str(h.baud) for h in heard)} bps",
+        f"bytes but no records{where}",
         "not a board, or at a rate appmode does not try: check the wiring (TX to RX, a "
         "common ground) and the module's rate",
         heard=heard,

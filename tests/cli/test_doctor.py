@@ -8,6 +8,7 @@ import pty
 import shutil
 import subprocess
 import sys
+import threading
 import time
 import tty
 from collections.abc import Iterator
@@ -250,3 +251,18 @@ def test_a_file_or_a_folder_is_not_a_serial_port(tmp_path: Any) -> None:
     assert file["fix"] == "name the car's port; list ports with: appmode ports"
     assert sim["verdict"] == "cannot be opened: unknown sim:// option 'bogus'"
     assert plain.read_text() == "hello\n"  # opened, never written
+
+
+def test_a_port_that_goes_away_while_listened_to_is_said_so() -> None:
+    master, slave = pty.openpty()
+    path = os.ttyname(slave)
+    closing = threading.Timer(0.3, os.close, (master,))
+    closing.start()
+    try:
+        found = probe.probe(path, threading.Event(), lambda text: None)
+    finally:
+        closing.join()
+        os.close(slave)
+    assert found.kind == "lost" and not found.is_car
+    assert found.verdict.startswith("it opened, then failed while listening")
+    assert "the device went away" in found.fix
