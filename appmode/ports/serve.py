@@ -40,9 +40,6 @@ from appmode.protocol.transcript import Recorder
 
 Log = Callable[[str], None]
 T = TypeVar("T")
-OUTBOX = 4096
-RETRY_WRITE = 0.002
-"""Seconds before writing again what the OS would not take."""
 RUN = {APP: 0.004, UART2: 0.002}
 """Seconds of wire time written at most at once to a paced client: bytes trickle in as
 from a real UART (a C record over 32 ms at 9600 bps), not a record at a time. On UART2
@@ -54,29 +51,29 @@ the rest waits in the pty or socket, and a writer faster than 9600 bps is held b
 by a real line."""
 
 
-class Outbox:
-    """Bytes the OS would not take yet (a full pty or socket buffer): kept, in order, and
-    retried; beyond OUTBOX bytes the oldest are dropped, as when nobody reads a UART."""
+class Overrun:
+    """Writes what the OS takes; what it will not take (a full pty or socket buffer:
+    nobody reads) is dropped, as a UART drops what nobody reads, never retried. The log
+    says when dropping starts and how much was dropped when reading resumes."""
 
-    def __init__(self) -> None:
-        self._data = bytearray()
+    def __init__(self, log: Log, where: str) -> None:
+        self._log = log
+        self._where = where
+        self.dropped = 0
+        """Bytes dropped in the current run of drops."""
 
-    def __len__(self) -> int:
-        return len(self._data)
-
-    def clear(self) -> None:
-        self._data.clear()
-
-    def send(self, data: bytes, write: Callable[[bytes], int]) -> None:
-        self._data += data
-        if len(self._data) > OUTBOX:
-            del self._data[: len(self._data) - OUTBOX]
-        while self._data:
+    def write(self, data: bytes, write: Callable[[bytes], int]) -> None:
+        while data:
             try:
-                written = write(bytes(self._data))
-            except (BlockingIOError, InterruptedError):
+                data = data[write(data) :]
+            except BlockingIOError:
+                if not self.dropped:
+                    self._log(f"nobody reads {self._where}: what the board sends is dropped")
+                self.dropped += len(data)
                 return
-            del self._data[:written]
+        if self.dropped:
+            self._log(f"{self._where} is read again; {self.dropped} bytes were dropped")
+            self.dropped = 0
 
 
 class PtyEndpoint:
@@ -120,8 +117,8 @@ class PtyEndpoint:
         self.baud = baud
         """The line rate of the UART this pty stands for; None: bytes pass at any rate."""
         self._client_baud = client_baud
-        self._out = Outbox()
         self.url = os.ttyname(self._slave)
+        self._out = Overrun(log, self.url)
         self._link = link
         self._link_target = _lasting_path(self._slave, self.url)
         if link is not None:
@@ -145,7 +142,7 @@ class PtyEndpoint:
         return self._misread(data, to_board=True)
 
     def write(self, data: bytes) -> None:
-        self._out.send(self._misread(data, to_board=False), lambda c: os.write(self._master, c))
+        self._out.write(self._misread(data, to_board=False), lambda c: os.write(self._master, c))
 
     def _misread(self, data: bytes, *, to_board: bool) -> bytes:
         """With a line rate, what each side reads when the client set another one."""
@@ -155,10 +152,6 @@ class PtyEndpoint:
         if client is None:  # a rate termios cannot name: take it as matching
             return data
         return misread(data, client, self.baud) if to_board else misread(data, self.baud, client)
-
-    @property
-    def backlog(self) -> int:
-        return len(self._out)
 
     def close(self) -> None:
         link = self._link
@@ -217,7 +210,7 @@ class TcpEndpoint:
         bound_host, bound_port = self._listener.getsockname()[:2]
         self.url = f"socket://{bound_host}:{bound_port}"
         self._client: socket.socket | None = None
-        self._out = Outbox()
+        self._out = Overrun(log, "the TCP client")
         self._paused = False
         sel.register(self._listener, selectors.EVENT_READ, self._accept)
 
@@ -266,16 +259,12 @@ class TcpEndpoint:
             return
         client = self._client
         try:
-            self._out.send(data, client.send)
+            self._out.write(data, client.send)
         except OSError as exc:
             self._drop(f"client connection lost ({exc.strerror})")
 
-    @property
-    def backlog(self) -> int:
-        return len(self._out)
-
     def _drop(self, why: str) -> None:
-        self._out.clear()
+        self._out.dropped = 0
         if self._client is not None:
             if not self._paused:
                 self._sel.unregister(self._client)
@@ -320,8 +309,6 @@ class SerialEndpoint:
         if data:
             self._port.write(data)
 
-    backlog = 0  # pyserial's write blocks until the OS has the bytes
-
     def close(self) -> None:
         self._port.close()
 
@@ -345,7 +332,6 @@ class Served:
     endpoints: dict[str, Endpoint]
     wire: Wire
     paused: dict[str, bool]
-    last_write: float = float("-inf")
     faults: tuple[Faults, Faults] | None = None
     """A faulty link: (to the board, to the host), applied to every port's bytes."""
 
@@ -374,8 +360,6 @@ class Served:
                 if first is not None and last is not None and last - first < RUN[name]:
                     mine = min(mine, last)
             due = min(due, mine)
-        if any(e.backlog for e in self.endpoints.values()):
-            due = min(due, self.last_write + RETRY_WRITE)
         return due
 
     def pump(self, now: float) -> None:
@@ -384,9 +368,8 @@ class Served:
             out = self.wire.ports[name].to_host.take(now)
             if out and self.faults is not None:
                 out = self.faults[1].apply(out)
-            if out or endpoint.backlog:
+            if out:
                 endpoint.write(out)
-                self.last_write = now
 
     def receive(self, data: bytes, now: float, port: str) -> None:
         self.pump(now)  # what was due before these bytes came
