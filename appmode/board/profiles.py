@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from appmode.errors import AppmodeError
-from appmode.protocol import control, params
+from appmode.protocol import params
 from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
 from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
 from appmode.protocol.params import DriveType
@@ -114,7 +114,9 @@ class Profile:
     @property
     def answers_reads(self) -> bool:
         """UART2 takes settings frames: reads are answered, the encoder report exists."""
-        return control.SETTINGS in self.control_modes
+        from appmode.protocol.control import SETTINGS  # the codec, only when asked
+
+        return SETTINGS in self.control_modes
 
     @property
     def fixed_drive(self) -> DriveType | None:

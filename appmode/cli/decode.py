@@ -5,19 +5,22 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Iterable, Iterator
-from typing import BinaryIO, TextIO
+from typing import TYPE_CHECKING, BinaryIO, TextIO
 
 from appmode.cli.options import Subparsers, add_profile, layout_for
 from appmode.errors import AppmodeError
-from appmode.protocol import app
-from appmode.protocol.layouts import VELOCITY, ALayout
-from appmode.protocol.render import coalesce, json_line
+
+if TYPE_CHECKING:  # the codec is imported when the command runs: start-up stays short
+    from appmode.protocol import app
+    from appmode.protocol.layouts import ALayout
 
 CHUNK = 65536
 
 
 def decode_chunks(chunks: Iterable[bytes], source: str) -> Iterator[app.Event]:
     """Events of a stream from the host (`host`) or the board (`board`)."""
+    from appmode.protocol import app
+
     decoder = app.HostDecoder() if source == "host" else app.BoardDecoder()
     for chunk in chunks:
         yield from decoder.feed(chunk)
@@ -44,9 +47,15 @@ def run_decode(
     out: TextIO,
     source: str,
     name: str = "standard input",
-    layout: ALayout = VELOCITY,
+    layout: ALayout | None = None,
 ) -> int:
-    """Write one JSON object a line; returns the number of undecodable runs."""
+    """Write one JSON object a line (A records as `layout` reads them, by default the
+    sheet's); returns the number of undecodable runs."""
+    from appmode.protocol import app
+    from appmode.protocol.layouts import VELOCITY
+    from appmode.protocol.render import coalesce, json_line
+
+    layout = layout or VELOCITY
     errors = 0
     write = out.write
     for event in coalesce(decode_chunks(read_chunks(stream, name, out), source)):

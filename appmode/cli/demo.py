@@ -8,7 +8,6 @@ import time
 from collections.abc import Callable
 from typing import TextIO
 
-from appmode.board.firmware import Board
 from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.cli.options import Subparsers, add_profile
 from appmode.protocol import app
@@ -40,6 +39,8 @@ def run_demo(
     With `sleep=None` the route runs on virtual time, as fast as it can. On a profile whose
     motors are off after power-up the route starts once they are on.
     """
+    from appmode.board.firmware import Board  # here: start-up stays short
+
     board = Board(drive=drive if profile.drive_types else None, profile=profile)
     layout = profile.a_layout
     decoder = app.BoardDecoder()

@@ -20,8 +20,6 @@ from appmode.cli.options import (
 )
 from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from appmode.errors import AppmodeError
-from appmode.ports.link import is_simulated
-from appmode.ports.sim import parse_sim_url
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 
 
@@ -107,6 +105,7 @@ def run(args: argparse.Namespace) -> int:
     from appmode.console.control_session import ControlSession
     from appmode.console.hold import HoldToDrive
     from appmode.console.session import Session
+    from appmode.ports.link import is_simulated  # here: start-up stays short
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
@@ -170,6 +169,8 @@ def _with_options(url: str, **options: str | None) -> str:
 def _one_board(app_url: str, uart2_url: str) -> tuple[str, str]:
     """Two sim:// URLs as the two ports of one simulated board (its options given on
     the first, or the same on both)."""
+    from appmode.ports.sim import parse_sim_url
+
     try:
         app_options, uart2_options = (
             {k: v for k, v in parse_sim_url(u).items() if k not in ("port", "share")}

@@ -5,10 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 from contextlib import ExitStack
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
-from appmode.cli import control_port
-from appmode.cli.hostio import open_host, show
 from appmode.cli.options import (
     DAY,
     Subparsers,
@@ -21,10 +19,12 @@ from appmode.cli.options import (
     profile_for,
 )
 from appmode.errors import AppmodeError
-from appmode.host.client import Event
 from appmode.protocol import app
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.text import counted
+
+if TYPE_CHECKING:
+    from appmode.host.client import Event
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -73,6 +73,8 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.uart2:
+        from appmode.cli import control_port  # here: start-up stays short
+
         if args.filter is not None:
             raise AppmodeError("--filter picks APP records: not with --uart2")
         return control_port.run_monitor(
@@ -114,6 +116,8 @@ def run_monitor(
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none
     (`appmode record`)."""
+    from appmode.cli.hostio import open_host, show
+
     seen = 0
     with ExitStack() as stack:
         host = open_host(stack, url, record, stop_on_close=stop_on_exit, layout=layout)

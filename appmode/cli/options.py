@@ -6,14 +6,14 @@ import argparse
 import contextlib
 import math
 from collections.abc import Callable
-from typing import Any, TypeAlias
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 from serial import SerialException
 
 from appmode.board.profiles import PROFILE_NAMES, PROFILES, SHEET, Profile
-from appmode.ports.sim import parse_sim_url
-from appmode.protocol.app import stop_again
-from appmode.protocol.layouts import ALayout
+
+if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
+    from appmode.protocol.layouts import ALayout
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
@@ -80,12 +80,16 @@ def profile_for(url: str | None, name: str | None) -> Profile:
     """The profile `--profile NAME` names, else a sim:// URL's, else the sheet."""
     if name is None and url is not None and url.lower().startswith("sim://"):
         with contextlib.suppress(SerialException):
+            from appmode.ports.sim import parse_sim_url
+
             name = parse_sim_url(url).get("profile")
     return PROFILES.get(name or "sheet", SHEET)
 
 
 def stop_again_for(url: str | None, name: str | None) -> bytes:
     """What a host sends when its stop did not take, on `profile_for(url, name)`."""
+    from appmode.protocol.app import stop_again
+
     return stop_again(frames_take_letters=not profile_for(url, name).steer_in_frames)
 
 

@@ -9,8 +9,6 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.board.profiles import SHEET, Profile
-from appmode.cli import control_port
-from appmode.cli.hostio import open_host
 from appmode.cli.options import (
     Subparsers,
     add_profile,
@@ -20,7 +18,6 @@ from appmode.cli.options import (
     profile_for,
 )
 from appmode.errors import AppmodeError
-from appmode.host import saves
 from appmode.protocol import params
 from appmode.protocol.render import params_table
 
@@ -89,6 +86,8 @@ def run(args: argparse.Namespace) -> int:
                 "--verify-saved is for the APP port: over --uart2, restart the board and "
                 "read the settings again"
             )
+        from appmode.cli import control_port  # here: start-up stays short
+
         store = next((op for op in ("load", "defaults", "save") if getattr(args, op)), None)
         return control_port.run_params(
             args.url, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
@@ -135,6 +134,9 @@ def run_params(
 ) -> int:
     """Read the parameters; set each (verified by reading back), save, and print them;
     or check them against what was saved (`verify`)."""
+    from appmode.cli.hostio import open_host
+    from appmode.host import saves
+
     changes = [parse_assignment(text) for text in assignments]  # all checked first
     saved = saves.recall(url) if verify else None
     if verify and saved is None:

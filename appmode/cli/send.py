@@ -7,8 +7,6 @@ import sys
 from contextlib import ExitStack
 from typing import TextIO
 
-from appmode.cli import control_port
-from appmode.cli.hostio import open_host, show
 from appmode.cli.options import (
     DAY,
     Subparsers,
@@ -22,8 +20,6 @@ from appmode.cli.options import (
     stop_again_for,
 )
 from appmode.host import control_tokens
-from appmode.host.tokens import Wait, parse_token
-from appmode.protocol.app import HostDecoder
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import describe, line
 
@@ -63,6 +59,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     if args.uart2:
+        from appmode.cli import control_port  # here: start-up stays short
+
         return control_port.run_send(
             args.url,
             args.tokens,
@@ -103,6 +101,10 @@ def run_send(
     """Send the tokens in order, printing what comes back; `Z` is always sent last (and
     with `stop_again`, confirmed on the board's A records). `frames_stop`: every frame
     stops this board's car (§13)."""
+    from appmode.cli.hostio import open_host, show
+    from appmode.host.tokens import Wait, parse_token
+    from appmode.protocol.app import HostDecoder
+
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:
         host = open_host(

@@ -91,3 +91,28 @@ def test_the_errors_the_docs_name_are_importable_from_appmode() -> None:
 
     assert issubclass(appmode.TranscriptError, appmode.AppmodeError)
     assert {"AppmodeError", "TranscriptError"} <= set(appmode.__all__)
+
+
+def test_the_command_line_loads_a_commands_machinery_only_to_run_it() -> None:
+    """Issue 28.2: `appmode --help` imported every command's host, board and probe."""
+    heavy = (
+        "appmode.host.client",
+        "appmode.host.probe",
+        "appmode.cli.hostio",
+        "appmode.cli.control_port",
+        "appmode.board.firmware",
+        "appmode.ports.sim",
+        "appmode.console.app",
+    )
+    loaded = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from appmode.cli.main import build_parser; build_parser(); "
+            f"print([m for m in {heavy!r} if m in sys.modules])",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert loaded.stdout.strip() == "[]"

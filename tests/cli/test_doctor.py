@@ -223,22 +223,6 @@ def test_the_firmware_is_told_by_its_record_period() -> None:
     assert probe.firmware(mixed) is MINIBALANCE
 
 
-def test_the_command_line_loads_the_probe_only_to_run_it() -> None:
-    loaded = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            "import sys; from appmode.cli.main import build_parser; "
-            "build_parser(); print('appmode.host.probe' in sys.modules)",
-        ],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        check=True,
-    )
-    assert loaded.stdout.strip() == "False"
-
-
 def test_a_file_or_a_folder_is_not_a_serial_port(tmp_path: Any) -> None:
     plain = tmp_path / "notes.txt"
     plain.write_text("hello\n")
