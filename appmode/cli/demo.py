@@ -12,7 +12,6 @@ from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.cli.options import Subparsers, add_profile
 from appmode.protocol import app
 from appmode.protocol.params import DRIVE_NAMES, DriveType
-from appmode.protocol.render import describe, line
 
 ROUTE: tuple[tuple[float, app.Command], ...] = (
     (0.00, app.ReadParams()),
@@ -40,6 +39,7 @@ def run_demo(
     motors are off after power-up the route starts once they are on.
     """
     from appmode.board.firmware import Board  # here: start-up stays short
+    from appmode.protocol.render import describe, line
 
     board = Board(drive=drive if profile.drive_types else None, profile=profile)
     layout = profile.a_layout

@@ -8,13 +8,14 @@ import shutil
 import sys
 import threading
 import time
-from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 from appmode.cli.options import Subparsers
 from appmode.text import counted, wrapped
 
 if TYPE_CHECKING:  # imported by `run`: `appmode --help` does not load the host
+    from concurrent.futures import Future, ThreadPoolExecutor
+
     from appmode.host import probe
 
 WORKERS = 8
