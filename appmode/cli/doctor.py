@@ -14,7 +14,7 @@ from appmode.cli.options import Subparsers
 from appmode.text import counted, wrapped
 
 if TYPE_CHECKING:  # imported by `run`: `appmode --help` does not load the host
-    from concurrent.futures import Future, ThreadPoolExecutor
+    from concurrent.futures import Future
 
     from appmode.host import probe
 
@@ -84,6 +84,8 @@ def _text(finding: probe.Finding) -> str:
 
 def _check(urls: list[str]) -> list[probe.Finding]:
     """Probe every port at once, showing progress on a terminal."""
+    from concurrent.futures import ThreadPoolExecutor
+
     from appmode.host import probe
 
     stop = threading.Event()
