@@ -2,7 +2,7 @@
 
 Decoder throughput, CPU cost of `appmode board` and `appmode drive`, boards one process
 serves, board-model steps, console key-to-byte latency, 60 s floods, paced throughput,
-{Q:P} round trip and replay timing. `--quick` shortens the long ones.
+{Q:P} round trip, replay timing and start-up. `--quick` shortens the long ones.
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ import link_roundtrip
 import minibalance
 import replay_timing
 import serial
+import startup
 import uart2
 from common import board, cpu_seconds, percentile, wakeup_floor, wakeups
 
@@ -113,6 +114,20 @@ def bench_decode_command(quick: bool) -> list[Row]:
             f"{r['mb'] / r['loop']:.2f} MB/s; appmode {r['speedup']:.2f}x",
             ">= 1.5x the loop",
         )
+    ]
+
+
+def bench_startup(runs: int) -> list[Row]:
+    base = startup.median_ms(startup.COMMANDS["miniterm --help"], runs)
+    return [
+        (
+            f"start-up: {name}",
+            f"{ms:.1f} ms, {ms / base:.1f}x miniterm --help ({base:.1f} ms)",
+            "<= 1.5x miniterm",
+        )
+        for name, command in startup.COMMANDS.items()
+        if not name.startswith("miniterm")
+        for ms in [startup.median_ms(command, runs)]
     ]
 
 
@@ -434,6 +449,7 @@ def main() -> None:
         ("board model", bench_model_steps),
         ("key latency", lambda: bench_key_latency(100 if quick else 300)),
         ("decode command", lambda: bench_decode_command(quick)),
+        ("start-up", lambda: bench_startup(5 if quick else 15)),
         ("board CPU", lambda: bench_board_cpu(10 if quick else 30)),
         ("drive CPU", lambda: bench_drive_cpu(10 if quick else 30)),
         ("200 boards", lambda: [bench_many_boards(200, 5 if quick else 15)]),

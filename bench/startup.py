@@ -1,0 +1,72 @@
+"""Start-up: how long `appmode` takes to answer before it does any work, beside
+pyserial's own command-line tool, `python -m serial.tools.miniterm --help`.
+
+Each command runs N times as a process (stdin /dev/null, output discarded); the median
+is printed with its ratio to miniterm's. With `--importtime MODULE_COUNT`, the modules
+that `appmode --help` spends most on (`python -X importtime`, cumulative µs) follow.
+Target (issue 28.2): within 1.5x miniterm for --help, decode, send, params.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import time
+
+COMMANDS = {
+    "miniterm --help": ["-m", "serial.tools.miniterm", "--help"],
+    "appmode --help": ["-m", "appmode", "--help"],
+    "appmode decode </dev/null": ["-m", "appmode", "decode"],
+    "appmode send --help": ["-m", "appmode", "send", "--help"],
+    "appmode params --help": ["-m", "appmode", "params", "--help"],
+}
+
+
+def median_ms(args: list[str], runs: int) -> float:
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        subprocess.run(
+            [sys.executable, *args],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            check=False,
+        )
+        times.append(time.perf_counter() - start)
+    return statistics.median(times) * 1000
+
+
+def heaviest(count: int) -> list[tuple[int, str]]:
+    """The modules `appmode --help` imports, by cumulative microseconds."""
+    done = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "appmode", "--help"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    rows = []
+    for line in done.stderr.splitlines():
+        parts = line.split("|")
+        if len(parts) == 3 and parts[1].strip().isdigit():
+            rows.append((int(parts[1]), parts[2].strip()))
+    return sorted(rows, reverse=True)[:count]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=15, help="runs of each (default 15)")
+    parser.add_argument("--importtime", type=int, default=0, metavar="N", help="show N modules")
+    args = parser.parse_args()
+    base = median_ms(COMMANDS["miniterm --help"], args.runs)
+    for name, command in COMMANDS.items():
+        ms = base if name.startswith("miniterm") else median_ms(command, args.runs)
+        print(f"{name:28} {ms:7.1f} ms  {ms / base:4.1f}x miniterm")
+    for micros, module in heaviest(args.importtime):
+        print(f"  {micros / 1000:7.1f} ms  {module}")
+
+
+if __name__ == "__main__":
+    main()
