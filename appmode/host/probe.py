@@ -27,6 +27,7 @@ from appmode.host.client import Host
 from appmode.line.wire import APP_BAUD, UART2_BAUD
 from appmode.ports.link import is_simulated, open_link, parse_device
 from appmode.protocol import app, control, params
+from appmode.protocol.escaping import text_part
 
 RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
 """The rates tried, in order: the APP port's, the control port's, then a Bluetooth
@@ -88,8 +89,7 @@ class Heard:
     def text(self) -> bool:
         """Mostly printable text outside records: a program that talks, or a board's
         start-up text, not a board at a wrong rate (whose bytes are mostly not text)."""
-        other = self.outside
-        return other >= 8 and 10 * self.printable >= 9 * other
+        return self.outside >= 8 and 10 * self.printable >= 9 * self.outside
 
     @property
     def period_ms(self) -> float | None:
@@ -113,7 +113,7 @@ class Heard:
                 self.record_sizes.append(len(event.raw))
             elif not isinstance(event, app.RECORDS):
                 self.outside += len(event.raw)
-                printable = bytes(b for b in event.raw if 0x20 <= b < 0x7F or b in (9, 10, 13))
+                printable = text_part(event.raw)
                 self.printable += len(printable)
                 if len(printable) == len(event.raw):
                     self.sample += printable[: SAMPLE - len(self.sample)]
@@ -283,10 +283,10 @@ def _car(
     rate = "" if fixed else f" at {one.baud} bps"
     period = f"a record every {5 * round((one.period_ms or 0) / 5)} ms"  # to 5 ms: a rhythm
     what = f"{profile.name if profile else 'unknown'} firmware ({period})"
-    named = profile is not None and profile.name != "sheet" and not is_simulated(url)
-    drive = f"appmode drive {shlex.quote(target)}" + (
-        f" --profile {profile.name}" if named and profile is not None else ""
-    )
+    flag = ""  # a sim:// URL names its own profile
+    if profile is not None and profile.name != "sheet" and not is_simulated(url):
+        flag = f" --profile {profile.name}"
+    drive = f"appmode drive {shlex.quote(target)}{flag}"
     if values is None:
         return Finding(
             url,
@@ -329,10 +329,7 @@ def _control_port(url: str, one: Heard, heard: list[Heard], fixed: bool) -> Find
         f"drive it with: appmode drive {shlex.quote(target)} --uart2 (it takes the motion "
         "over from the APP port)",
         one.baud,
-        None,
-        None,
-        None,
-        heard,
+        heard=heard,
     )
 
 

@@ -230,9 +230,8 @@ class HostState:
                     if not self.stats.bytes_in
                     else f"what answers at {where} is not a board: sent {{Q:P}} "
                     f"{counted(query.sent, 'time')}; {counted(self.stats.bytes_in, 'byte')} "
-                    f"came back and no record: another "
-                    f"program's port (a pty path may have been reused) or a wrong baud "
-                    f"rate; find the car with: appmode doctor"
+                    "came back and no record: another program's port (a pty path may have "
+                    "been reused) or a wrong baud rate; find the car with: appmode doctor"
                 )
             elif isinstance(outcome, QueryFailed) and garbled:
                 outcome = QueryFailed(

@@ -13,6 +13,12 @@ _TABLE[0x5C] = "\\\\"
 _TEXT_TABLE = {b: text for b, text in enumerate(_TABLE) if text != chr(b)}
 _PLAIN = re.compile(rb"[\x21-\x5b\x5d-\x7e]*")
 _TOKEN = re.compile(r"\\(?:x([0-9a-fA-F]{2})|(\\))|([\x21-\x5b\x5d-\x7e])")
+_NOT_TEXT = re.compile(rb"[^\x20-\x7e\t\r\n]")
+
+
+def text_part(data: bytes) -> bytes:
+    """The bytes of `data` a person reads as text: printable ASCII, tabs and line ends."""
+    return _NOT_TEXT.sub(b"", data)
 
 
 def escape(data: bytes) -> str:

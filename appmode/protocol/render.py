@@ -9,7 +9,7 @@ from typing import Any
 from appmode.protocol import app as p
 from appmode.protocol import control, control_view
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
-from appmode.protocol.escaping import escape
+from appmode.protocol.escaping import escape, text_part
 from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, ALayout
 from appmode.protocol.params import DEFAULTS, PARAMS, value_error
 from appmode.text import counted
@@ -167,7 +167,7 @@ def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
         return f"error: {event.reason}"
     if event.raw.endswith(b"}$") and b"{" not in event.raw:
         return f"a record's end, its start missed ({counted(len(event.raw), 'byte')})"
-    if event.raw and all(0x20 <= b < 0x7F or b in (0x0A, 0x0D) for b in event.raw):
+    if event.raw and text_part(event.raw) == event.raw:
         return f"text, no record ({counted(len(event.raw), 'byte')})"
     return f"{counted(len(event.raw), 'undecodable byte')}"
 
