@@ -368,24 +368,20 @@ def bench_links(quick: bool) -> list[Row]:
 
 
 def bench_replay(events: int) -> list[Row]:
-    times = [k * 0.01 for k in range(events)]
-    rows = []
-    for name, late in (
-        ("appmode replay", replay_timing.appmode_lateness(times)),
-        ("python-can MessageSync", replay_timing.python_can_lateness(times)),
-    ):
-        if late is None:
-            rows.append((f"{name}, {events} events at 10 ms", "python-can not installed", ""))
-            continue
-        ms = [x * 1000 for x in late]
-        rows.append(
-            (
-                f"{name}, {events} events at 10 ms",
-                f"median {statistics.median(ms):.3f}"
-                f" ms, p99 {percentile(ms, 99):.3f} ms, drift {ms[-1]:.3f} ms",
-                "p99 < 1 ms, no drift",
+    rows: list[Row] = []
+    for kind in replay_timing.LOADS:
+        result = replay_timing.measure(events, 0.01, kind)
+        if result is None:
+            return [(f"replay, {events} events at 10 ms", "python-can not installed", "")]
+        for name, s in result.items():
+            rows.append(
+                (
+                    f"{name}, {events} events at 10 ms, {kind}",
+                    f"median {s['median']:.3f} ms, p99 {s['p99']:.3f} ms, "
+                    f"drift {s['drift']:+.4f} ms/min",
+                    "p99 <= MessageSync's, no drift" if name == "appmode play" else "",
+                )
             )
-        )
     return rows
 
 

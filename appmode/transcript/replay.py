@@ -2,7 +2,10 @@
 
 Each send's deadline is computed from the start (start + t / speed), never by adding up
 sleeps, so a late send does not make every later one late (python-can's MessageSync
-idea). As the host, the replay ends with `Z`, like every host session.
+idea), and waited for by sleeping with exact wake-ups (`ports.wakeups`): a last stretch
+waited awake instead is ahead on an idle machine but, under load, the scheduler
+preempts a process that spins and it ends later (bench/replay_timing.py). As the host,
+the replay ends with `Z`, like every host session.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import serial
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.ports.link import new_pty, open_link
+from appmode.ports.wakeups import exact_wakeups
 from appmode.protocol.app import BoardDecoder, HostDecoder
 from appmode.protocol.render import describe, line
 from appmode.protocol.transcript import read_transcript
@@ -60,20 +64,21 @@ def play(
     period = max((t for t, _ in items), default=0.0)
     total = period * loops / speed
     lateness: list[float] = []
-    start = clock()
-    shown = start
-    for loop in range(loops):
-        for t, data in items:
-            deadline = start + (loop * period + t) / speed
-            while (left := deadline - clock()) > 0:
-                if idle is not None:
-                    idle()
-                if progress is not None and clock() - shown >= 0.2:
-                    shown = clock()
-                    progress(shown - start, total)
-                sleep(min(left, 0.05) if idle is not None or progress is not None else left)
-            write(data)
-            lateness.append(clock() - deadline)
+    with exact_wakeups():
+        start = clock()
+        shown = start
+        for loop in range(loops):
+            for t, data in items:
+                deadline = start + (loop * period + t) / speed
+                while (left := deadline - clock()) > 0:
+                    if idle is not None:
+                        idle()
+                    if progress is not None and clock() - shown >= 0.2:
+                        shown = clock()
+                        progress(shown - start, total)
+                    sleep(min(left, 0.05) if idle is not None or progress is not None else left)
+                write(data)
+                lateness.append(clock() - deadline)
     if progress is not None:
         progress(clock() - start, total)
     return lateness
