@@ -12,7 +12,10 @@ from __future__ import annotations
 import argparse
 import random
 import time
+from collections.abc import Callable
+from typing import Any, ClassVar
 
+from appmode.protocol import app, control, settings
 from appmode.protocol.app import RECORDS, Attitude, BoardDecoder, ParamsRecord, Velocity, encode
 
 
@@ -160,6 +163,177 @@ def garbage(megabytes: float = GARBAGE_MB, chunk: int = 4096) -> dict[str, float
     return rates
 
 
+# ------------------------------------------------ every decoder against its byte loop
+
+
+class HostByteAtATime:
+    """The board's way of reading the APP port: a handler per byte; outside a frame a
+    byte is one command; a frame is gathered to its `}` and then parsed."""
+
+    def __init__(self) -> None:
+        self.frame: bytearray | None = None
+        self.events: list[object] = []
+
+    def feed(self, data: bytes) -> None:
+        for byte in data:
+            frame = self.frame
+            if byte == 0x7B:
+                self.frame = bytearray(b"{")
+            elif frame is not None:
+                frame.append(byte)
+                if byte == 0x7D:
+                    self.events.append(app._parse_frame(bytes(frame)))
+                    self.frame = None
+                elif len(frame) > app.MAX_FRAME:
+                    self.frame = None
+            else:
+                self.events.append(app.SINGLE_BYTE[byte])
+
+
+class ControlBoardByteAtATime:
+    """A host's way of reading UART2's replies and 4-wheel encoder reports byte by byte."""
+
+    def __init__(self) -> None:
+        self.buf = bytearray()
+        self.need = 0
+        self.events: list[object] = []
+
+    def feed(self, data: bytes) -> None:
+        for byte in data:
+            if self.need:
+                self.buf.append(byte)
+                if len(self.buf) == self.need:
+                    self.need = 0
+                    self._done(bytes(self.buf))
+            elif byte == control.REPLY or byte == control.REPORT:
+                self.buf = bytearray([byte])
+                self.need = control.REPLY_LEN if byte == control.REPLY else 34
+
+    def _done(self, raw: bytes) -> None:
+        if raw[0] == control.REPLY:
+            read = settings.READ_BY_REPLY.get(raw[1])
+            signed = read is not None and read.signed
+            self.events.append(
+                control.Reply(raw[1], int.from_bytes(raw[2:], "big", signed=signed), raw)
+            )
+        elif raw[-1] == control.REPORT_END:
+            values = [int.from_bytes(raw[i : i + 4], "big", signed=True) for i in range(1, 33, 4)]
+            self.events.append(control.EncoderReport(tuple(values[0::2]), tuple(values[1::2]), raw))
+
+
+class ControlHostByteAtATime:
+    """The board's way of reading UART2 frames: sync on FF FE, the mode byte gives the
+    length, the frame is gathered and then parsed (a 3-motor omni car)."""
+
+    LENGTHS: ClassVar[dict[int, int]] = dict.fromkeys(control.MODES, control.FRAME)
+
+    def __init__(self) -> None:
+        self.buf = bytearray()
+        self.need = 0
+        self.events: list[object] = []
+
+    def feed(self, data: bytes) -> None:
+        for byte in data:
+            buf = self.buf
+            if self.need:
+                buf.append(byte)
+                if len(buf) == self.need:
+                    self.events.append(control._parse(bytes(buf), 3))
+                    self.need = 0
+                    buf.clear()
+            elif len(buf) == 2:
+                length = self.LENGTHS.get(byte)
+                buf.append(byte)
+                if length is None:
+                    buf.clear()
+                else:
+                    self.need = length
+            elif len(buf) == 1:
+                if byte == 0xFE:
+                    buf.append(byte)
+                elif byte != 0xFF:
+                    buf.clear()
+            elif byte == 0xFF:
+                buf.append(byte)
+
+
+def _noisy(parts: list[bytes], rng: random.Random, noise: float) -> bytes:
+    data = bytearray(b"".join(parts))
+    for i in range(len(data)):
+        if rng.random() < noise:
+            data[i] = rng.randrange(256)
+    return bytes(data)
+
+
+def streams(size: int) -> dict[str, bytes]:
+    """Each port's traffic in each direction (1 % noise), and garbage of every kind."""
+    rng = random.Random(7)
+    host = [b"A", b"B", b"E", b"Z", b"J", b"{Q:P}", b"{1:100}", b"{7:50}", b"{Q:W}"]
+    replies = [control.encode(control.Reply(0x41, rng.randrange(1000))) for _ in range(50)]
+    reports = [
+        control.encode(control.EncoderReport((1, -2, 3, -4), (5, -6, 7, -8))) for _ in range(50)
+    ]
+    frames = [
+        control.encode(control.VelocityFrame(rng.randrange(500), rng.randrange(500), 0))
+        for _ in range(50)
+    ] + [control.encode(control.read("speed_a"))]
+    return {
+        "APP board stream": make_stream(size, 0.01)[0],
+        "APP host stream": _noisy([rng.choice(host) for _ in range(size // 4)], rng, 0.01),
+        "UART2 replies/reports": _noisy(
+            [rng.choice(replies + reports) for _ in range(size // 20)], rng, 0.01
+        ),
+        "UART2 frames": _noisy([rng.choice(frames) for _ in range(size // 10)], rng, 0.01),
+        "random bytes": random.Random(3).randbytes(size),
+        **{f"only {b!r}": b * size for b in (b"{", b"}", b"$", b"#", b"\xff", b"\xfe", b"7")},
+        "'{A' and digits": b"{A" + b"1" * (size - 2),
+    }
+
+
+DECODERS: dict[str, tuple[Callable[[], Any], Callable[[], Any]]] = {
+    "APP board decoder": (BoardDecoder, ByteAtATime),
+    "APP host decoder": (app.HostDecoder, HostByteAtATime),
+    "UART2 board decoder": (control.BoardDecoder, ControlBoardByteAtATime),
+    "UART2 host decoder": (control.HostDecoder, ControlHostByteAtATime),
+}
+
+
+def _seconds(make: Callable[[], Any], data: bytes, chunk: int) -> float:
+    decoder = make()
+    start = time.perf_counter()
+    for i in range(0, len(data), chunk):
+        decoder.feed(data[i : i + chunk])
+    return time.perf_counter() - start
+
+
+def against_byte_loops(megabytes: float, chunk: int = 4096) -> dict[str, list[tuple[str, float]]]:
+    """For each decoder: (input, its speed over its byte loop's) on every input, the best
+    of three runs each."""
+    inputs = streams(int(megabytes * 1e6))
+    out: dict[str, list[tuple[str, float]]] = {}
+    for name, (ours, loop) in DECODERS.items():
+        out[name] = [
+            (
+                what,
+                min(_seconds(loop, data, chunk) for _ in range(3))
+                / min(_seconds(ours, data, chunk) for _ in range(3)),
+            )
+            for what, data in inputs.items()
+        ]
+    return out
+
+
+def one_call(small: float = 4.0, large: float = 32.0) -> tuple[float, float]:
+    """MB/s of one BoardDecoder.feed of a `small` and of a `large` MB stream."""
+    rates = []
+    for megabytes in (small, large):
+        data, _ = make_stream(int(megabytes * 1e6), 0.01)
+        start = time.perf_counter()
+        BoardDecoder().feed(data)
+        rates.append(len(data) / (time.perf_counter() - start) / 1e6)
+    return rates[0], rates[1]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--megabytes", type=float, default=10.0)
@@ -178,6 +352,11 @@ def main() -> None:
     print(f"speed-up {r['speedup']:.1f}x (targets: >= 8 MB/s, >= 2x)")
     for name, rate in garbage().items():
         print(f"garbage, {GARBAGE_MB:.0f} MB of {name}: {rate:6.2f} MB/s")
+    small, large = one_call()
+    print(f"one feed() call: 4 MB at {small:.2f} MB/s, 32 MB at {large:.2f} MB/s")
+    print("each decoder against its byte loop, 1 MB of each input (x = loop time / ours):")
+    for name, rows in against_byte_loops(1.0).items():
+        print(f"  {name}: " + ", ".join(f"{what} {x:.2f}x" for what, x in rows))
 
 
 if __name__ == "__main__":

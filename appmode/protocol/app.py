@@ -10,10 +10,12 @@ stream is split into `feed` calls.
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass, field
 
 from appmode.protocol import params
+from appmode.protocol.bulk import linear
 from appmode.protocol.directions import BUTTON_PAGE, LETTERS, PAGE_LETTERS
 
 LBRACE, RBRACE, DOLLAR, COLON = 0x7B, 0x7D, 0x24, 0x3A
@@ -126,8 +128,9 @@ def _separator_warning(separator: int) -> str | None:
 
 
 # ---------------------------------------------------------------- board → host records
-# Records are not frozen: a frozen dataclass costs four times as much to build, and the
-# decoder builds hundreds of thousands a second. Treat them as immutable all the same.
+# Records, and what a decoder reports of bytes that are none, are not frozen: a frozen
+# dataclass costs three to four times as much to build, and the decoders build hundreds
+# of thousands a second (bench/decoder.py). Treat them as immutable all the same.
 
 
 @dataclass(slots=True)
@@ -188,7 +191,7 @@ class OtherRecord:
     raw: bytes = _raw()
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Malformed:
     """Bytes from `{` that do not make a record: truncated, over-long or ill-formed."""
 
@@ -196,7 +199,7 @@ class Malformed:
     reason: str
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Garbage:
     """A run of bytes outside any record."""
 
@@ -289,7 +292,33 @@ SINGLE_BYTE = _single_byte_events()
 """What each byte means outside a frame (§2.1), by value."""
 
 
+_BRACES = re.compile(rb"\{{2,%d}" % (MAX_RUN + 1))
+
+
+def _brace_run(buf: bytes | bytearray, pos: int, hold: bool) -> int | None:
+    """At a `{` followed by `{`: how many of the run's braces to report together, each an
+    open frame or record the next `{` interrupted; the run's last brace opens the next one.
+    Up to MAX_RUN at a time; None to hold a run that more bytes may lengthen."""
+    run = _BRACES.match(buf, pos)
+    assert run is not None
+    count = run.end() - pos - 1
+    if count < MAX_RUN and run.end() == len(buf) and hold:
+        return None
+    return count
+
+
+def _interrupted(what: str, count: int) -> str:
+    return f"{what} interrupted by '{{'" if count == 1 else f"{count} {what}s interrupted by '{{'"
+
+
+_FRAMES = re.compile(rb"(\{[^{}]{0,%d}\})" % (MAX_FRAME - 2))
+"""A whole frame of up to MAX_FRAME bytes: what the general way would read as one."""
+
+
+@functools.lru_cache(maxsize=4096)
 def _parse_frame(raw: bytes) -> HostEvent:
+    """What one frame means; frames repeat (a host reads and sets the same few), and
+    their events are immutable, so one is built once for each."""
     body = raw[1:-1]
     if len(body) == 3 and body[0] == 0x51 and body[2] in b"PW":  # Q?P / Q?W
         if body[2] == 0x50:
@@ -315,50 +344,79 @@ class HostDecoder:
     """Most bytes ever held between calls."""
 
     def __init__(self) -> None:
-        self._buf = bytearray()
+        self._buf = b""
         self._skip_len = 0  # bytes of an over-long frame already reported
 
     @property
     def buffered(self) -> int:
         return len(self._buf)
 
+    @linear
     def feed(self, data: bytes) -> list[HostEvent]:
-        buf = self._buf
-        buf += data
+        buf = self._buf + data if self._buf else bytes(data)
         out: list[HostEvent] = []
-        pos, n = 0, len(buf)
-        single = SINGLE_BYTE
-        while pos < n:
+        general, parse, single = self._general, _parse_frame, SINGLE_BYTE
+        pos = 0
+        # split scans in C: [gap, frame, gap, frame, …, gap]; a gap of single bytes is
+        # read here, others go the general way, the last one held where it may continue
+        parts = _FRAMES.split(buf)
+        for i in range(0, len(parts) - 1, 2):
+            gap, frame = parts[i], parts[i + 1]
+            if gap:
+                if self._skip_len or LBRACE in gap:
+                    pos = general(buf, pos, pos + len(gap), out)
+                else:
+                    out += [single[b] for b in gap]
+                    pos += len(gap)
+            out.append(parse(frame))
+            pos += len(frame)
+        pos = general(buf, pos, len(buf), out)
+        self._buf = buf[pos:]
+        return out
+
+    def _general(self, buf: bytes, pos: int, end: int, out: list[HostEvent]) -> int:
+        """Decode buf[pos:end], which holds no whole frame of up to MAX_FRAME bytes;
+        at the end of `buf`, stop where more bytes could change the outcome. Returns
+        where it stopped."""
+        n, single = len(buf), SINGLE_BYTE
+        while pos < end:
             if self._skip_len:
                 skipped = self._skip(buf, pos, n, out)
                 if skipped is None:
                     break
                 pos = skipped
                 continue
-            byte = buf[pos]
-            if byte != LBRACE:
-                out.append(single[byte])
-                pos += 1
+            if buf[pos] != LBRACE:
+                brace = buf.find(b"{", pos, end)
+                stop = end if brace < 0 else brace
+                out += [single[b] for b in buf[pos:stop]]  # each byte means one thing
+                pos = stop
+                continue
+            if pos + 1 < n and buf[pos + 1] == LBRACE:
+                count = _brace_run(buf, pos, True)
+                if count is None:
+                    break
+                out.append(BadFrame(buf[pos : pos + count], _interrupted("frame", count)))
+                pos += count
                 continue
             limit = min(n, pos + MAX_FRAME)
             close = buf.find(b"}", pos + 1, limit)
             reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
             if reopen >= 0:
-                out.append(BadFrame(bytes(buf[pos:reopen]), "frame interrupted by '{'"))
+                out.append(BadFrame(buf[pos:reopen], _interrupted("frame", 1)))
                 pos = reopen
             elif close >= 0:
-                out.append(_parse_frame(bytes(buf[pos : close + 1])))
+                out.append(_parse_frame(buf[pos : close + 1]))
                 pos = close + 1
             elif n - pos >= MAX_FRAME:
                 self._skip_len = MAX_FRAME
-                out.append(BadFrame(bytes(buf[pos : pos + MAX_FRAME]), _overlong(MAX_FRAME)))
+                out.append(BadFrame(buf[pos : pos + MAX_FRAME], _overlong(MAX_FRAME)))
                 pos += MAX_FRAME
             else:
                 break
-        del buf[:pos]
-        return out
+        return pos
 
-    def _skip(self, buf: bytearray, pos: int, n: int, out: list[HostEvent]) -> int | None:
+    def _skip(self, buf: bytes, pos: int, n: int, out: list[HostEvent]) -> int | None:
         """Discard the rest of an over-long frame, up to its `}` or the next `{`.
 
         Returns the new position, or None to wait for more bytes.
@@ -376,7 +434,7 @@ class HostDecoder:
             return None
         self._skip_len += stop - pos
         if stop > pos:
-            out.append(BadFrame(bytes(buf[pos:stop]), _overlong(self._skip_len, done)))
+            out.append(BadFrame(buf[pos:stop], _overlong(self._skip_len, done)))
         if done:
             self._skip_len = 0
         return stop
@@ -396,8 +454,8 @@ class HostDecoder:
             else ("unterminated frame at end of stream")
         )
         self._skip_len = 0
-        raw = bytes(self._buf)
-        self._buf.clear()
+        raw = self._buf
+        self._buf = b""
         return [BadFrame(raw, reason)]
 
 
@@ -519,6 +577,7 @@ class BoardDecoder:
     def buffered(self) -> int:
         return len(self._buf)
 
+    @linear
     def feed(self, data: bytes) -> list[BoardEvent]:
         buf = self._buf + data if self._buf else bytes(data)
         out: list[BoardEvent] = []
@@ -556,11 +615,18 @@ class BoardDecoder:
                 out.append(Garbage(buf[pos:start]))
                 pos = start
                 continue
+            if pos + 1 < n and buf[pos + 1] == LBRACE:
+                count = _brace_run(buf, pos, hold)
+                if count is None:
+                    break
+                out.append(Malformed(buf[pos : pos + count], _interrupted("record", count)))
+                pos += count
+                continue
             limit = min(n, pos + MAX_RECORD)
             close = buf.find(b"}", pos + 1, limit)
             reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
             if reopen >= 0:
-                out.append(Malformed(buf[pos:reopen], "record interrupted by '{'"))
+                out.append(Malformed(buf[pos:reopen], _interrupted("record", 1)))
                 pos = reopen
             elif close >= 0:
                 if close + 1 == n and hold:
@@ -575,7 +641,7 @@ class BoardDecoder:
             elif hold:
                 break
             else:
-                out.append(Malformed(buf[pos:n], "record interrupted by '{'"))
+                out.append(Malformed(buf[pos:n], _interrupted("record", 1)))
                 pos = n
         return pos
 

@@ -10,10 +10,13 @@ to exactly one event's `raw`, whatever the split into `feed` calls.
 
 from __future__ import annotations
 
+import functools
+import re
 from dataclasses import dataclass, field
 
 from appmode.errors import InvalidValue
 from appmode.protocol import app, params, settings
+from appmode.protocol.bulk import linear
 from appmode.protocol.params import DriveType
 from appmode.protocol.settings import Read, Setting, StoreOp
 
@@ -119,7 +122,7 @@ class BadFrame:
     reason: str
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Garbage:
     """Bytes outside any frame or reply, an unknown mode's header, or a truncated frame."""
 
@@ -131,9 +134,11 @@ HostFrame = VelocityFrame | MotorFrame | PositionFrame | SetSetting | StoreFrame
 HostEvent = HostFrame | BadFrame | Garbage
 
 # ---------------------------------------------------------------- board → host
+# Not frozen, like the APP records and for the same reason (protocol/app.py): treat them
+# as immutable all the same.
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Reply:
     """`23 NN b3 b2 b1 b0`: the answer to a read (§11)."""
 
@@ -151,7 +156,7 @@ class Reply:
         return read.name if read else f"0x{self.id:02X}"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class EncoderReport:
     """`24 …  19`: target and actual speed of each wheel (§12)."""
 
@@ -160,7 +165,7 @@ class EncoderReport:
     raw: bytes = _raw()
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Status:
     """`FF …`: what reaches the host of the 12-byte status the reference firmware writes
     after each APP record (§13.1): `FF`, then up to two bytes (`FE` and the gyro's low
@@ -390,6 +395,7 @@ class HostDecoder:
     def buffered(self) -> int:
         return len(self._buf) + (self._app.buffered if self._app else 0)
 
+    @linear
     def feed(self, data: bytes) -> list[HostEvent | app.HostEvent]:
         if self._app is not None:
             return list(self._app.feed(data))
@@ -456,6 +462,22 @@ def _report_length(buf: bytes, pos: int) -> int | None:
     return _REPORT_3 if buf[pos + _REPORT_3 - 1] == REPORT_END else _REPORT_4
 
 
+_FFS = re.compile(rb"\xff{2,%d}" % (MAX_RUN + 1))
+_OUTSIDE = "bytes outside any reply or report"
+_FF_RUN = "a run of FF, no status burst (an idle line read at a wrong baud rate)"
+
+
+@functools.cache
+def _starts(wheels: int | None) -> re.Pattern[bytes]:
+    """Where a run of bytes outside any reply or report ends: a reply's or a status
+    burst's first byte, or a report's whose `19` is in place or has yet to come (`wait`)
+    (found in C, not byte by byte: a flood of `24` is one run, not a report per byte)."""
+    lengths = [2 + 8 * w for w in ((wheels,) if wheels else (3, 4))]
+    ends = b"|".join(rb"(?=.{%d}\x19)" % (length - 2) for length in lengths)
+    room = max(lengths) - 1
+    return re.compile(rb"[\x23\xff]|\x24(?:%s|(?P<wait>)(?!.{%d}))" % (ends, room), re.DOTALL)
+
+
 class BoardDecoder:
     """board→host bytes → `#` replies, encoder reports (§11, §12) and the reference
     firmware's status bursts (§13.1); while `app_mode`
@@ -475,6 +497,15 @@ class BoardDecoder:
         return self._app is not None
 
     @property
+    def wheels(self) -> int | None:
+        return self._wheels
+
+    @wheels.setter
+    def wheels(self, wheels: int | None) -> None:
+        self._wheels = wheels
+        self._start = _starts(wheels)
+
+    @property
     def buffered(self) -> int:
         return len(self._buf) + (self._app.buffered if self._app else 0)
 
@@ -486,6 +517,7 @@ class BoardDecoder:
         self._app = app.BoardDecoder() if on else None
         return out
 
+    @linear
     def feed(self, data: bytes) -> list[BoardEvent]:
         if self._app is not None:
             return list(self._app.feed(data))
@@ -503,6 +535,15 @@ class BoardDecoder:
                 signed = read is not None and read.signed
                 out.append(Reply(raw[1], int.from_bytes(raw[2:], "big", signed=signed), raw))
                 pos += REPLY_LEN
+                continue
+            if byte == HEADER[0] and pos + 1 < n and buf[pos + 1] == HEADER[0]:
+                run = _FFS.match(buf, pos)
+                assert run is not None
+                if run.end() - pos <= MAX_RUN and run.end() == n:
+                    break  # the run may go on: hold it
+                end = run.end() - 1  # its last FF may start a burst
+                out.append(Garbage(buf[pos:end], _FF_RUN))
+                pos = end
                 continue
             if byte == HEADER[0]:
                 end = buf.find(HEADER[:1], pos + 1, pos + STATUS_MAX)
@@ -526,13 +567,16 @@ class BoardDecoder:
                     out.append(EncoderReport(tuple(values[0::2]), tuple(values[1::2]), raw))
                     pos += report_len
                     continue
-            end = pos + 1
-            limit = min(n, pos + MAX_RUN)
-            while end < limit and buf[end] not in (REPLY, REPORT, HEADER[0]):
-                end += 1
+            start = self._start.search(buf, pos + 1)
+            end = n if start is None else start.start()
+            while end - pos > MAX_RUN:  # runs of MAX_RUN bytes up to the next start
+                out.append(Garbage(buf[pos : pos + MAX_RUN], _OUTSIDE))
+                pos += MAX_RUN
+            if start is not None and start.group("wait") is not None:
+                break  # whether the run ends at this `24` is not known yet: hold it
             if end == n and n - pos < MAX_RUN:
                 break  # the run may go on: hold it
-            out.append(Garbage(buf[pos:end], "bytes outside any reply or report"))
+            out.append(Garbage(buf[pos:end], _OUTSIDE))
             pos = end
         self._buf = buf[pos:]
         return out
@@ -542,6 +586,8 @@ class BoardDecoder:
         if self._app is not None:
             return list(self._app.flush())
         raw, self._buf = self._buf, b""
+        if raw.startswith(b"\xff\xff"):  # a run of FF, held whole
+            return [Garbage(raw[:-1], _FF_RUN), Status(raw[-1:])]
         if raw.startswith(HEADER[:1]):
             return [Status(raw)]
         return [Garbage(raw, "truncated reply or report at end of stream")] if raw else []

@@ -115,6 +115,14 @@ def test_s3_long_garbage_is_reported_in_bounded_runs() -> None:
     assert [len(e.raw) for e in events] == [64, 64, 64, 8, 11]
 
 
+def test_s3_a_run_of_braces_is_reported_in_bounded_runs_not_brace_by_brace() -> None:
+    events = assert_split_invariant(BoardDecoder, b"x" + b"{" * 150 + b"{A0:0:0:0}$")
+    assert [len(e.raw) for e in events] == [1, 64, 64, 22, 11]
+    assert events[1] == Malformed(b"{" * 64, "64 records interrupted by '{'")
+    assert events[-1] == Velocity(0, 0, 0, 0)
+    assert decode_whole(BoardDecoder, b"{{A0:0:0:0}$")[0].reason == "record interrupted by '{'"
+
+
 ints = st.integers(-(2**31), 2**31 - 1)
 records = st.one_of(
     st.builds(Velocity, ints, ints, ints, st.just(0)),

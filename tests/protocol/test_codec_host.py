@@ -140,6 +140,13 @@ def test_s2_2_brace_inside_a_frame_restarts_the_frame() -> None:
     assert events[1] == SetParam(1, 9)
 
 
+def test_s2_2_a_run_of_braces_is_reported_in_bounded_runs_not_brace_by_brace() -> None:
+    events = assert_split_invariant(HostDecoder, b"A" + b"{" * 70 + b"{Q:P}")
+    assert [len(e.raw) for e in events] == [1, 64, 6, 5]
+    assert events[1] == BadFrame(b"{" * 64, "64 frames interrupted by '{'")
+    assert events[-1] == ReadParams()
+
+
 def test_stream_is_split_invariant() -> None:
     data = b"JA\x01{Q:P}xx{0:800}{8:5}B{Q\x03W}Z{0:" + b"9" * 60 + b"}K{1:2"
     events = assert_split_invariant(HostDecoder, data)

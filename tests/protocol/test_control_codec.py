@@ -21,6 +21,7 @@ from appmode.protocol.control import (
     PositionFrame,
     Reply,
     SetSetting,
+    Status,
     StoreFrame,
     VelocityFrame,
     encode,
@@ -236,6 +237,33 @@ def test_a_megabyte_of_garbage_decodes_in_linear_time(data: bytes) -> None:
         events = [*decoder.feed(data), *decoder.flush()]
         assert b"".join(e.raw for e in events) == data
         assert time.perf_counter() - start < 20.0
+
+
+def test_a_run_of_ff_is_garbage_in_bounded_runs_and_its_last_ff_may_start_a_burst() -> None:
+    tail = b"\xff\x00\x00" + encode(Reply(1, 5))
+    events = assert_split_invariant(BoardDecoder, b"\xff" * 69 + tail)
+    assert [len(e.raw) for e in events] == [64, 5, 3, 6]
+    assert [type(e) for e in events] == [Garbage, Garbage, Status, Reply]
+    assert decode_whole(BoardDecoder, b"\xff" * 3)[-1] == Status(b"\xff")
+
+
+def test_a_flood_of_24_is_garbage_in_bounded_runs_and_a_report_after_it_decodes() -> None:
+    report = EncoderReport((1, 2, 3, 4), (5, 6, 7, 8))
+    events = assert_split_invariant(BoardDecoder, b"$" * 100 + encode(report))
+    assert events[-1] == report
+    assert all(isinstance(e, Garbage) and len(e.raw) <= 64 for e in events[:-1])
+
+
+protocol_bytes = st.lists(st.sampled_from(b"\xff\xfe\x24\x23\x19\x00"), max_size=300).map(bytes)
+
+
+@given(protocol_bytes, st.lists(st.integers(1, 40), min_size=1, max_size=20))
+def test_runs_of_the_protocols_own_bytes_keep_every_byte_in_one_event(
+    data: bytes, cuts: list[int]
+) -> None:
+    for wheels in (4, 3, None):
+        make = partial(BoardDecoder, wheels)
+        assert_any_bytes_ok(make, data, cuts, limit=BoardDecoder(wheels).limit)
 
 
 @pytest.mark.parametrize("wheels", [3, 4])
