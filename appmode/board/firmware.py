@@ -35,6 +35,7 @@ SLOT = 0.05
 """The sheet profile's time between records."""
 APP_BYTE = 10 / 9600
 """A byte's time on the APP port's wire."""
+_APP_MODE, _ENCODER_REPORT = params.MODE_BIT["app_mode"], params.MODE_BIT["encoder_report"]
 MAX_CATCH_UP = 200
 """Ticks run one by one when the board falls behind; beyond that it skips ahead."""
 MAX_RAMP = 2000
@@ -123,6 +124,8 @@ class Board:
         self._command: control.HostFrame | None = None  # the last motion frame obeyed
         self._position_goal: tuple[float, float, float] | None = None
         self._target_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+        self._target_for: tuple[object, ...] | None = None  # what _target was worked out for
+        self._target_is: tuple[float, float, float] = (0.0, 0.0, 0.0)  # and what it was
         self._reads: list[settings.Read] = []
         self._out2 = bytearray()
         self._frames = control.HostDecoder(self.drive_type)
@@ -142,11 +145,12 @@ class Board:
         Records go out on UART3, or on UART2 in APP mode (§12); replies and encoder
         reports on UART2."""
         uart3, uart2 = float(self._record_ms), self._burst_ms
-        if self._mode("app_mode"):
+        mode = int(self.params[params.SYSTEM_MODE])
+        if mode & _APP_MODE:
             uart3, uart2 = uart2, uart3
         if self._reads:
             uart2 = min(uart2, self._tick_ms)
-        elif self._mode("encoder_report") and not self._mode("app_mode"):
+        elif mode & _ENCODER_REPORT and not mode & _APP_MODE:
             uart2 = min(uart2, -(-self._tick_ms // REPORT_MS) * REPORT_MS)
         return self._boot + uart3 / 1000, self._boot + uart2 / 1000
 
@@ -179,8 +183,31 @@ class Board:
                     self._control(1)
                 self._uart2_tick()
                 self._tick_ms += TICK_MS
+                self._rest(due)
             else:
                 self._send_record()
+
+    def _rest(self, due: int) -> None:
+        """Run at once the control ticks up to the next other event (by `due`) while the
+        car rests and stays at rest: all such a tick does is drain the battery (exact:
+        Vehicle.rest drains it tick by tick). An idle car costs no 100 Hz step."""
+        vehicle = self.vehicle
+        if (
+            vehicle.vx
+            or vehicle.vy
+            or vehicle.vz
+            or any(self._target_velocity)
+            or self.uart2_control
+            or self._reads
+            or self._mode("encoder_report")
+        ):
+            return
+        last = min(due, self._record_ms, self._copy_ms - 1, self._burst_ms - 1)
+        if last < self._tick_ms or self._powered(self._tick_ms) != self._powered(int(last)):
+            return  # no tick before the next event, or the motors' power comes on
+        ticks = int(last - self._tick_ms) // TICK_MS + 1
+        vehicle.rest(ticks, TICK)
+        self._tick_ms += ticks * TICK_MS
 
     # ------------------------------------------------------------ I/O-free edges
 
@@ -375,14 +402,15 @@ class Board:
     def _uart2_tick(self) -> None:
         """What UART2 sends in a control tick: the replies to reads received since the
         last tick (§11), and the encoder report every REPORT_MS while bit 6 is set (§12)."""
-        for read in self._reads:
-            value = self._read_value(read)
-            self._out2 += control.encode(control.Reply(read.reply_id, value))
-        self._reads.clear()
+        if self._reads:
+            for read in self._reads:
+                value = self._read_value(read)
+                self._out2 += control.encode(control.Reply(read.reply_id, value))
+            self._reads.clear()
         if (
-            self._mode("encoder_report")
+            self._tick_ms % REPORT_MS == 0
+            and self._mode("encoder_report")
             and not self._mode("app_mode")
-            and self._tick_ms % REPORT_MS == 0
             and self.profile.answers_reads
         ):
             targets = self._encoders(self._wheel_targets())
@@ -419,11 +447,17 @@ class Board:
         return encoders[index] if index < len(encoders) else 0  # no wheel D on an omni
 
     def _target(self, speed: float) -> tuple[float, float, float]:
-        if self._mode("motor_reverse"):
-            speed = -speed
-        return target_velocity(
-            self.page, self.direction, speed, self.drive_type.differential, self.profile.buttons
-        )
+        """The velocity the APP port's direction asks for; worked out again only when
+        what it depends on changed (it is asked 100 times a second)."""
+        key = (self.page, self.direction, speed, self.params[params.SYSTEM_MODE])
+        if key != self._target_for:
+            self._target_for = key
+            if self._mode("motor_reverse"):
+                speed = -speed
+            self._target_is = target_velocity(
+                self.page, self.direction, speed, self.drive_type.differential, self.profile.buttons
+            )
+        return self._target_is
 
     def _pushes(self) -> tuple[int | None, ...]:
         """Which way a ramping board pushes x, y, z this tick (vehicle.ramp): with no

@@ -63,12 +63,24 @@ class Vehicle:
 
     def step(self, target: tuple[float, float, float], dt: float) -> None:
         """Advance by `dt` seconds toward the target velocity (x, y, z)."""
+        if not (self.vx or self.vy or self.vz or any(target)):  # at rest, staying so
+            self.rest(1, dt)
+            return
         alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
         old_x, old_y = self.vx, self.vy
         self.vx = _approach(self.vx, target[0], alpha)
         self.vy = _approach(self.vy, target[1], alpha)
         self.vz = _approach(self.vz, target[2], alpha)
         self._move(old_x, old_y, dt)
+
+    def rest(self, steps: int, dt: float) -> None:
+        """`steps` steps of `dt` at rest: what `step` and `ramp` do then, step by step
+        (the battery's idle drain; no tilt)."""
+        self.pitch = self.roll = 0.0
+        centivolts = self.centivolts
+        for _ in range(steps):
+            centivolts = max(0.0, centivolts - IDLE_DRAIN * dt)
+        self.centivolts = centivolts
 
     def ramp(
         self,

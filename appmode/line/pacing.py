@@ -72,28 +72,38 @@ class Line:
 
     def take(self, now: float) -> bytes:
         """Every byte delivered by `now`."""
-        return b"".join(data for _, data in self.take_timed(now))
+        return b"".join(data[first:end] for _, data, first, end in self._delivered(now))
 
     def take_timed(self, now: float) -> list[tuple[float, bytes]]:
         """Bytes delivered by `now`, each run with its delivery time.
 
         On a paced line a run is one byte; on an instantaneous line, one burst.
         """
-        out: list[tuple[float, bytes]] = []
+        step = self.byte_time
+        spans = self._delivered(now)
+        if step == 0.0:
+            return [(start, data[first:end]) for start, data, first, end in spans]
+        return [
+            (start + (i + 1) * step, data[i : i + 1])
+            for start, data, first, end in spans
+            for i in range(first, end)
+        ]
+
+    def _delivered(self, now: float) -> list[tuple[float, bytes, int, int]]:
+        """The bytes delivered by `now`, as (burst start, burst, first, end) spans; the
+        line lets go of them."""
+        out: list[tuple[float, bytes, int, int]] = []
         step = self.byte_time
         while self._bursts:
             start, data = self._bursts[0]
             if step == 0.0:
                 if start > now:
                     break
-                out.append((start, data[self._taken :]))
-                self._bursts.popleft()
-                self._queued -= len(data)
-                self._taken = 0
-                continue
-            due = min(len(data), int((now - start) / step + 1e-9))
-            for i in range(self._taken, due):
-                out.append((start + (i + 1) * step, data[i : i + 1]))
+                due = len(data)
+            else:
+                due = min(len(data), int((now - start) / step + 1e-9))
+            if due > self._taken:
+                out.append((start, data, self._taken, due))
             if due < len(data):
                 self._taken = max(self._taken, due)
                 break

@@ -113,8 +113,9 @@ class Wire:
             line.push(data, when)
 
     def _deliver(self, now: float) -> None:
-        app = self.ports[APP].to_board.take_timed(now)
-        uart2 = self.ports[UART2].to_board.take_timed(now)
+        to_app, to_uart2 = self.ports[APP].to_board, self.ports[UART2].to_board
+        app = to_app.take_timed(now) if to_app else []
+        uart2 = to_uart2.take_timed(now) if to_uart2 else []
         if not uart2:
             for when, data in app:
                 self.board.receive(data, when)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import heapq
 import math
 import os
 import random
@@ -26,7 +27,7 @@ from typing import TypeVar
 import serial
 
 from appmode.board.firmware import Board
-from appmode.board.profiles import SHEET, profile_named
+from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
@@ -34,7 +35,7 @@ from appmode.line.faults import Faults, FaultSpec
 from appmode.line.uart import misread
 from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
 from appmode.ports.link import BAUD, NO_PTY, explain_open_error, parse_device
-from appmode.protocol import params
+from appmode.protocol import app, params
 from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder
 
@@ -334,6 +335,9 @@ class Served:
     paused: dict[str, bool]
     faults: tuple[Faults, Faults] | None = None
     """A faulty link: (to the board, to the host), applied to every port's bytes."""
+    phase: float = 0.0
+    """Where in each RUN this board's grid points fall (0…1): boards served together
+    spread over the grid, so that a pass does not run them all at once."""
 
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
@@ -351,7 +355,8 @@ class Served:
                 if line is not None:
                     mine = min(mine, line)
             if step and mine < math.inf:
-                mine = math.ceil(mine / RUN[name] - 1e-9) * RUN[name]
+                run, offset = RUN[name], self.phase * RUN[name]
+                mine = math.ceil((mine - offset) / run - 1e-9) * run + offset
             if name == UART2 and step:
                 # a reply is due within its tick: run the board at the slot, and write a
                 # burst shorter than a run whole when its last stop bit is done
@@ -415,7 +420,12 @@ class BoardServer:
         self._sel = selectors.DefaultSelector()
         self._endpoints: list[Endpoint] = []
         self._served: list[Served] = []
-        self._by_endpoint: dict[int, tuple[Served, str]] = {}
+        self._by_endpoint: dict[int, tuple[int, str]] = {}
+        self._due: list[float] = []  # each board's next wake-up, as queued
+        self._queue: list[tuple[float, int]] = []  # (due, board): a heap; stale entries skipped
+        self.lateness: list[float] | None = None
+        """When a list: how late each board ran after its wake-up was due (s), appended
+        (bench/many_boards.py measures the timing grid with it)."""
         self._recorder: Recorder | None = None
         self._stopped = False
         self._wake_read, self._wake_write = socket.socketpair()
@@ -459,10 +469,18 @@ class BoardServer:
                 self._recorder,
                 bauds.get(UART2, UART2_BAUD) if pace else None,
             )
-            one = Served(pair, wire, dict.fromkeys(pair, False), faults=self._faulty())
+            one = Served(
+                pair,
+                wire,
+                dict.fromkeys(pair, False),
+                faults=self._faulty(),
+                phase=len(self._served) / len(boards),
+            )
             self._served.append(one)
+            self._due.append(math.nan)
             for name, endpoint in pair.items():
-                self._by_endpoint[id(endpoint)] = (one, name)
+                self._by_endpoint[id(endpoint)] = (len(self._served) - 1, name)
+            self._reschedule(len(self._served) - 1)
 
     def _faulty(self) -> tuple[Faults, Faults] | None:
         spec = self._faults
@@ -485,6 +503,7 @@ class BoardServer:
         with self.lock:
             wire = self._served[index].wire
             wire.run(self.now())
+            self._reschedule(index)
             return see(wire.board)
 
     def now(self) -> float:
@@ -504,6 +523,7 @@ class BoardServer:
                 old.tap,
                 old.ports[UART2].to_host.baud,
             )
+            self._reschedule(index)
         self._wake()
 
     def stop(self) -> None:
@@ -531,26 +551,51 @@ class BoardServer:
                     reader(0)
                     continue
                 with self.lock:
-                    one, name = self._by_endpoint[id(reader.__self__)]
+                    index, name = self._by_endpoint[id(reader.__self__)]
+                    one = self._served[index]
                     data = reader(max(1, INPUT_BACKLOG - len(one.wire.ports[name].to_board)))
                     if data:
                         one.receive(data, self.now(), name)
+                        self._log_notes(one)
                         one.throttle()
+                        self._reschedule(index)
+
+    def _log_notes(self, one: Served) -> None:
+        for note in one.wire.board.take_notes():
+            self.log(f"{note.time:10.3f}  {note.port} {note.level:<8} {note.text}")
+
+    def _reschedule(self, index: int) -> None:
+        """Queue board `index` at its next wake-up (an entry queued before is left stale)."""
+        due = self._served[index].wakeup()
+        if due == self._due[index]:
+            return  # queued already
+        self._due[index] = due
+        if due < math.inf:
+            heapq.heappush(self._queue, (due, index))
+        if len(self._queue) > 4 * len(self._due) + 64:  # stale entries pile up: rebuild
+            self._queue = [(d, i) for i, d in enumerate(self._due) if d < math.inf]
+            heapq.heapify(self._queue)
 
     def _step(self) -> float:
-        """Run every board that is due; when the next one is."""
+        """Run every board that is due (only those: a heap orders them); when the next
+        one is."""
         now = self.now()
-        wake = math.inf
-        for one in self._served:
-            due = one.wakeup()
-            if due <= now:
-                one.pump(now)
-                for note in one.wire.board.take_notes():
-                    self.log(f"{note.time:10.3f}  {note.port} {note.level:<8} {note.text}")
-                one.throttle()
-                due = one.wakeup()
-            wake = min(wake, due)
-        return wake
+        queue, ran = self._queue, []
+        while queue and queue[0][0] <= now:
+            due, index = heapq.heappop(queue)
+            if due != self._due[index]:
+                continue  # stale
+            self._due[index] = math.nan
+            if self.lateness is not None:
+                self.lateness.append(now - due)
+            one = self._served[index]
+            one.pump(now)
+            self._log_notes(one)
+            one.throttle()
+            ran.append(index)
+        for index in ran:
+            self._reschedule(index)
+        return self._queue[0][0] if self._queue else math.inf
 
     def close(self) -> None:
         """Close every port, then the recording (what its decoders hold is written)."""
@@ -597,6 +642,13 @@ def serve(
         server.run()
     finally:
         server.close()
+
+
+def switched_on(count: int, profile: Profile) -> list[float]:
+    """When each of `count` boards served together is switched on: one by one over a
+    record period, as cars are, so that their records do not all fall due at once."""
+    period = profile.record_period_ms(len(app.encode(app.Velocity(0, 0, 0, 0)))) / 1000
+    return [i * period / count for i in range(count)]
 
 
 def run_board(
@@ -653,7 +705,10 @@ def run_board(
     kind = DriveType.from_cli_name(drive) if drive else None
     rules = profile_named(profile)
     rules.check(drive=kind is not None, flash=flash is not None)
-    boards = [Board(open_store(flash), drive=kind, profile=rules) for _ in range(count)]
+    boards = [
+        Board(open_store(flash), drive=kind, profile=rules, now=on)
+        for on in switched_on(count, rules)
+    ]
     body = (
         f"{boards[0].drive_type.cli_name} drive, flash {flash or 'in memory'}"
         if rules.drive_types

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from appmode.board.firmware import SLOT, Board
+from appmode.board.profiles import MINIBALANCE, SHEET, Profile
 from appmode.board.store import JsonFileStore, MemoryStore
 from appmode.board.vehicle import battery_percent, wrap_degrees
 from appmode.protocol import params
@@ -341,3 +342,26 @@ def test_property_board_is_deterministic(
         return bytes(out)
 
     assert run(polls) == run(polls) == run([])
+
+
+@pytest.mark.parametrize("profile", [SHEET, MINIBALANCE], ids=["sheet", "minibalance"])
+def test_an_idle_car_run_in_one_go_is_the_car_run_tick_by_tick(profile: Profile) -> None:
+    """Issue 28.5: the ticks of a resting car are run at once (its battery drains, nothing
+    else happens); what it sends and its battery are exactly those of a car run in steps
+    shorter than a tick, also when it drives between rests."""
+    script = [(5.0, b"A"), (6.0, b"Z"), (20.0, b"C"), (21.0, b"Z")]
+
+    def run(step: float) -> tuple[bytes, float]:
+        board, out, t, pending = Board(profile=profile), bytearray(), 0.0, list(script)
+        while t < 40.0:
+            t = min(t + step, 40.0)
+            while pending and pending[0][0] <= t:
+                when, data = pending.pop(0)
+                board.receive(data, when)
+            out += board.poll(t)
+        return bytes(out), board.vehicle.centivolts
+
+    fine = run(0.003)
+    assert run(0.5) == fine
+    assert run(0.047) == fine
+    assert fine[1] < Board(profile=profile).vehicle.centivolts  # the battery did drain

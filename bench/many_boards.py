@@ -1,0 +1,132 @@
+"""Boards per core: N paced boards served by one process, every pty read by a client.
+
+The server runs in a child process (`--serve`), which reports its own CPU time and how
+late each board ran after its wake-up was due (the 4 ms timing grid: its p99 is what a
+client sees as jitter); the parent reads every board's APP port and counts its records.
+Target: 1,000 boards within one core at 20 records/s each, grid p99 < 5 ms.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import time
+import tty
+from functools import partial
+
+from common import percentile
+
+from appmode.board.firmware import Board
+from appmode.board.profiles import SHEET
+from appmode.ports.serve import BoardServer, _pty, switched_on
+from appmode.protocol.app import RECORDS, BoardDecoder
+
+
+def serve(count: int) -> None:
+    """Serve `count` boards (both ports on ptys, as `appmode board --count`) until
+    SIGTERM; then print CPU seconds, wall seconds and the grid's lateness as JSON."""
+    make = partial(_pty, link=None, baud=None)
+    server = BoardServer(
+        [make] * count,
+        [Board(now=on) for on in switched_on(count, SHEET)],
+        pace=True,
+        log=lambda text: None,
+        make_uart2=[make] * count,
+    )
+    signal.signal(signal.SIGTERM, lambda *_: server.stop())
+    for i in range(count):
+        print(server.urls(i)["app"], flush=True)
+    sys.stdin.readline()  # the parent has opened every port: measure from here
+    server.lateness = []
+    cpu, wall = time.process_time(), time.monotonic()
+    try:
+        server.run()
+    finally:
+        late = [x * 1000 for x in server.lateness]
+        print(
+            json.dumps(
+                {
+                    "cpu": time.process_time() - cpu,
+                    "wall": time.monotonic() - wall,
+                    "p50": statistics.median(late),
+                    "p99": percentile(late, 99),
+                    "max": max(late),
+                }
+            ),
+            flush=True,
+        )
+        server.close()
+
+
+def measure(count: int, seconds: float) -> dict[str, float]:
+    """CPU share, records/s per board (min, median) and grid lateness (ms)."""
+    proc = subprocess.Popen(
+        [sys.executable, __file__, "--serve", str(count)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdin is not None and proc.stdout is not None
+    fds: list[int] = []
+    try:
+        for _ in range(count):
+            fd = os.open(proc.stdout.readline().strip(), os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+            tty.setraw(fd)
+            fds.append(fd)
+        decoders = [BoardDecoder() for _ in fds]
+        records = [0] * count
+        proc.stdin.write("go\n")
+        proc.stdin.flush()
+        start = time.monotonic()
+        while time.monotonic() - start < seconds:
+            time.sleep(0.1)
+            for k, fd in enumerate(fds):
+                with contextlib.suppress(BlockingIOError):
+                    data = os.read(fd, 65536)
+                    records[k] += sum(isinstance(e, RECORDS) for e in decoders[k].feed(data))
+        elapsed = time.monotonic() - start
+        proc.terminate()
+        report = json.loads(proc.stdout.readline())
+    finally:
+        for fd in fds:
+            os.close(fd)
+        proc.kill()
+        proc.wait()
+    rates = sorted(r / elapsed for r in records)
+    return {
+        "share": report["cpu"] / report["wall"] * 100,
+        "min": rates[0],
+        "median": statistics.median(rates),
+        "p50": report["p50"],
+        "p99": report["p99"],
+        "max": report["max"],
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("counts", nargs="*", type=int, default=[200, 500, 1000])
+    parser.add_argument("--seconds", type=float, default=15.0)
+    parser.add_argument("--serve", type=int, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.serve:
+        serve(args.serve)
+        return
+    for count in args.counts:
+        r = measure(count, args.seconds)
+        print(
+            f"{count:5d} boards: {r['share']:5.1f} % of a core; records/s per board min "
+            f"{r['min']:.1f}, median {r['median']:.1f}; grid lateness p50 {r['p50']:.2f} ms, "
+            f"p99 {r['p99']:.2f} ms, max {r['max']:.1f} ms",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
