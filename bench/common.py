@@ -10,7 +10,7 @@ import subprocess
 import sys
 import time
 import tty
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 
@@ -61,6 +61,33 @@ def wakeups(pid: int) -> int:
             if line.startswith("voluntary_ctxt_switches:"):
                 return int(line.split()[1])
     raise SystemExit(f"no voluntary_ctxt_switches in /proc/{pid}/status")
+
+
+def share_and_floor(
+    pid: int, seconds: float, read: Callable[[], int], rounds: int = 3
+) -> tuple[float, float, float, float]:
+    """Process `pid`'s CPU share (%) while `read()` is called every 50 ms, and its floor
+    (`wakeup_floor` at the same wake-up rate), measured in turn for `rounds` rounds of
+    `seconds` each so that both see the same machine; medians of the rounds. Also the
+    wake-ups a second and the bytes a second `read` returned."""
+    shares, floors, rates, volumes = [], [], [], []
+    for _ in range(rounds):
+        read()  # what came while the floor ran
+        start_cpu, start, woken, got = cpu_seconds(pid), time.monotonic(), wakeups(pid), 0
+        while time.monotonic() - start < seconds:
+            time.sleep(0.05)  # a client reading in batches: its wake-ups are not the board's
+            got += read()
+        elapsed = time.monotonic() - start
+        shares.append((cpu_seconds(pid) - start_cpu) / elapsed * 100)
+        rates.append((wakeups(pid) - woken) / elapsed)
+        volumes.append(got / elapsed)
+        floors.append(wakeup_floor(seconds, rates[-1]))
+    return (
+        statistics.median(shares),
+        statistics.median(floors),
+        statistics.median(rates),
+        statistics.median(volumes),
+    )
 
 
 def wakeup_floor(seconds: float, rate: float) -> float:

@@ -21,7 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import serial
-from common import cpu_seconds, percentile, wakeup_floor, wakeups
+from common import percentile, share_and_floor
 
 from appmode.protocol import control
 from appmode.protocol.params import DriveType
@@ -166,27 +166,22 @@ def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
         port.write(control.encode(report))
         port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
         time.sleep(0.5)
-        before, start = cpu_seconds(proc.pid), time.monotonic()
-        woken = wakeups(proc.pid)
-        received = 0
-        while time.monotonic() - start < seconds:
-            time.sleep(0.05)  # a client reading in batches: its wake-ups are not the board's
-            received += len(port.read(port.in_waiting)) + len(app_port.read(app_port.in_waiting))
-        used = cpu_seconds(proc.pid) - before
-        elapsed = time.monotonic() - start
-        rate = (wakeups(proc.pid) - woken) / elapsed
+        share, floor, rate, received = share_and_floor(
+            proc.pid,
+            seconds / 3,
+            lambda: len(port.read(port.in_waiting)) + len(app_port.read(app_port.in_waiting)),
+        )
         port.write(control.STOP)
-    reports = received / elapsed
     return [
         (
             "board serving both ports, encoder report on (mecanum, driving)",
-            f"{used / elapsed * 100:.2f} % of a core over {elapsed:.0f} s "
-            f"({reports:,.0f} bytes/s read from both ports)",
-            "< 2 % of a core",
+            f"{share:.2f} % of a core ({received:,.0f} bytes/s read from both ports); "
+            f"{share - floor:+.2f} % over its floor",
+            "< 2 % of a core; within 0.3 % of its floor",
         ),
         (
             "its floor: a bare loop, same wake-ups and pty writes",
-            f"{wakeup_floor(seconds, rate):.2f} % of a core ({rate:.0f} wake-ups/s)",
+            f"{floor:.2f} % of a core ({rate:.0f} wake-ups/s)",
             "",
         ),
     ]

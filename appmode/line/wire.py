@@ -91,12 +91,15 @@ class Wire:
     def run(self, now: float) -> None:
         """Run the board to `now`: its input delivered, what it sends on the lines."""
         board = self.board
-        if now - board.next_slot() > MAX_LAG:  # stalled (suspend, debugger): catch up at once
+        slot = board.next_slot()
+        if now - slot > MAX_LAG:  # stalled (suspend, debugger): catch up at once
             self._deliver(now)
             self._send(now)
-        while (slot := board.next_slot()) <= now:
+            slot = board.next_slot()
+        while slot <= now:
             self._deliver(slot)
             self._send(slot)
+            slot = board.next_slot()
         self._deliver(now)
 
     def _send(self, when: float) -> None:

@@ -345,12 +345,12 @@ class Served:
         time) and the bytes whose stop bit is done are written, never early, never more
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
-        slots = dict(zip(PORTS, wire.board.next_sends(), strict=True))
+        sends = wire.board.next_sends()
         due = math.inf
         for name in self.endpoints:
             port = wire.ports[name]
             step = port.to_host.byte_time
-            mine = slots[name] + step  # the port's next output: its first byte
+            mine = sends[PORTS.index(name)] + step  # the port's next output: its first byte
             for line in (port.to_board.next_due(), port.to_host.next_due()):
                 if line is not None:
                     mine = min(mine, line)
@@ -368,9 +368,11 @@ class Served:
         return due
 
     def pump(self, now: float) -> None:
-        self.wire.run(now)
+        wire = self.wire
+        wire.run(now)
         for name, endpoint in self.endpoints.items():
-            out = self.wire.ports[name].to_host.take(now)
+            line = wire.ports[name].to_host
+            out = line.take(now) if line else b""
             if out and self.faults is not None:
                 out = self.faults[1].apply(out)
             if out:
@@ -384,6 +386,9 @@ class Served:
 
     def throttle(self) -> None:
         """Read no more while INPUT_BACKLOG bytes wait for the simulated line."""
+        ports = self.wire.ports
+        if not (ports[APP].to_board or ports[UART2].to_board or any(self.paused.values())):
+            return  # nothing waits, nothing is paused
         for name, endpoint in self.endpoints.items():
             full = len(self.wire.ports[name].to_board) >= INPUT_BACKLOG
             if full != self.paused[name]:
@@ -561,6 +566,8 @@ class BoardServer:
                         self._reschedule(index)
 
     def _log_notes(self, one: Served) -> None:
+        if not one.wire.board.notes:
+            return
         for note in one.wire.board.take_notes():
             self.log(f"{note.time:10.3f}  {note.port} {note.level:<8} {note.text}")
 
