@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
+from appmode.board.names import PROFILE_NAMES
 from appmode.errors import AppmodeError
 from appmode.protocol import params
 from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
@@ -235,7 +236,8 @@ MINIBALANCE = Profile(
 )
 
 PROFILES: dict[str, Profile] = {p.name: p for p in (SHEET, MINIBALANCE)}
-PROFILE_NAMES: tuple[str, ...] = tuple(PROFILES)
+if tuple(PROFILES) != PROFILE_NAMES:
+    raise AssertionError("board/names.py must name the profiles of board/profiles.py")
 
 
 def profile_named(name: str) -> Profile:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile, add_record, file_name, number_type
 from appmode.protocol.params import DRIVE_NAMES
 
@@ -11,7 +12,7 @@ from appmode.protocol.params import DRIVE_NAMES
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     board = sub.add_parser(
         "board",
-        help="serve the simulated board on a pseudo-terminal, TCP or a serial port",
+        help=COMMANDS["board"],
         description="Serve the simulated board so that any serial program (the phone app "
         "through a Bluetooth module, miniterm, appmode itself) can talk to it. Prints "
         "'port: URL' (the APP port, UART3 at 9600 bps) and 'uart2: URL' (the control "

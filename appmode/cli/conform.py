@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile, file_name
 from appmode.errors import AppmodeError
 
@@ -12,7 +13,7 @@ from appmode.errors import AppmodeError
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     conform = sub.add_parser(
         "conform",
-        help="run transcripts as conformance tests against a board",
+        help=COMMANDS["conform"],
         description="Send each transcript's '>' lines at their times and match its '<' lines "
         "against what the board sends ('*' matches any field; unmentioned telemetry is "
         "ignored). Without --board: the embedded simulated board on virtual time (no "

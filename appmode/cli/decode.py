@@ -7,6 +7,7 @@ import sys
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, BinaryIO, TextIO
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile, layout_for
 from appmode.errors import AppmodeError
 
@@ -68,7 +69,7 @@ def run_decode(
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     decode = sub.add_parser(
         "decode",
-        help="decode a raw byte stream to JSON Lines",
+        help=COMMANDS["decode"],
         description="Decode raw bytes (a capture of the serial line) to JSON Lines: one "
         "object per record or command, and one per undecodable run of bytes.",
     )

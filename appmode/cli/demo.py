@@ -9,6 +9,7 @@ from collections.abc import Callable
 from typing import TextIO
 
 from appmode.board.profiles import SHEET, Profile, profile_named
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile
 from appmode.protocol import app
 from appmode.protocol.params import DRIVE_NAMES, DriveType
@@ -73,7 +74,7 @@ def run_demo(
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     demo = sub.add_parser(
         "demo",
-        help="drive the embedded simulated board through a short route, printing every record",
+        help=COMMANDS["demo"],
         description="Boot the simulated board, drive a scripted route (page switch, "
         "directions, stop, parameter set and read) and print each command and decoded record.",
     )

@@ -10,6 +10,7 @@ import threading
 import time
 from typing import TYPE_CHECKING
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers
 from appmode.text import counted, wrapped
 
@@ -27,7 +28,7 @@ REFRESH = 0.1
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     doctor = sub.add_parser(
         "doctor",
-        help="find the car: check each serial port and say how to drive it or what to fix",
+        help=COMMANDS["doctor"],
         description="Check serial ports for a car: open each (saying how to fix a "
         "permission, a busy port or an unbound Bluetooth port), listen at 9600 bps for "
         "APP records and at 115200 for the control port (UART2), try the other common "

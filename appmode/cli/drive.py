@@ -8,6 +8,7 @@ import sys
 
 from serial import SerialException
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     Subparsers,
     add_profile,
@@ -26,7 +27,7 @@ from appmode.protocol.params import DRIVE_NAMES, DriveType
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     drive = sub.add_parser(
         "drive",
-        help="drive and tune a car from the keyboard (the main job)",
+        help=COMMANDS["drive"],
         description="The driving console: a live status panel, arrow keys and a 3x3 key grid "
         "(q w e / a s d / z x c) to drive, space to stop, and a command line (:) for "
         "everything else. With no URL it drives the embedded simulated board. When stdin "

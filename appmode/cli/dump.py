@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     dump = sub.add_parser(
         "dump",
-        help="decode a transcript",
+        help=COMMANDS["dump"],
         description="Decode every command and record of a transcript: text, JSON Lines or CSV.",
     )
     dump.add_argument("file", type=file_name, metavar="FILE", help="the transcript")

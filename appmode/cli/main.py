@@ -5,51 +5,17 @@ from __future__ import annotations
 import argparse
 import contextlib
 import errno
+import importlib
 import os
 import sys
 from collections.abc import Callable, Sequence
 from types import ModuleType
 
 from appmode import __version__
-from appmode.cli import (
-    board,
-    conform,
-    decode,
-    demo,
-    doctor,
-    drive,
-    dump,
-    monitor,
-    params,
-    plot,
-    ports,
-    record,
-    replay,
-    send,
-    tap,
-)
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
 from appmode.host import signals
-
-COMMANDS: tuple[ModuleType, ...] = (
-    drive,
-    demo,
-    decode,
-    board,
-    send,
-    params,
-    monitor,
-    record,
-    conform,
-    replay,
-    tap,
-    dump,
-    plot,
-    ports,
-    doctor,
-)
-"""Each command's module: `register(sub)` adds its arguments, `run(args)` does the job."""
 
 OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
@@ -57,7 +23,9 @@ OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF
 Handler = Callable[[argparse.Namespace], int]
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser, with `command`'s arguments (its module loaded) and every other
+    command named with its help; with no command, every command's arguments."""
     parser = Parser(
         prog="appmode",
         description="Drive, emulate and test robot-car boards that speak the APP protocol "
@@ -66,9 +34,19 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"appmode {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
-    for command in COMMANDS:
-        command.register(sub).set_defaults(handler=command.run)
+    for name, help in COMMANDS.items():
+        if command is None or name == command:
+            module: ModuleType = importlib.import_module(f"appmode.cli.{name}")
+            module.register(sub).set_defaults(handler=module.run)
+        else:
+            sub.add_parser(name, help=help)  # its arguments are loaded when it runs
     return parser
+
+
+def command_in(argv: Sequence[str]) -> str:
+    """The command `argv` names (its first word that is no option), or "" for none: only
+    its module is loaded (`appmode --help` loads none)."""
+    return next((word for word in argv if not word.startswith("-")), "")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -83,8 +61,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    words = sys.argv[1:] if argv is None else argv
+    parser = build_parser(command_in(words))
+    args = parser.parse_args(words)
     handler: Handler = args.handler
     signals.install()
     try:

@@ -7,6 +7,7 @@ import sys
 from contextlib import ExitStack
 from typing import TYPE_CHECKING, TextIO
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     DAY,
     Subparsers,
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     mon = sub.add_parser(
         "monitor",
-        help="print decoded records as they arrive",
+        help=COMMANDS["monitor"],
         description="Print each record as it arrives (and each undecodable run of bytes), "
         "until Ctrl-C. Link losses are reported on stderr and the link is reopened. A "
         "monitor only listens: it writes nothing to the port unless --stop-on-exit.",

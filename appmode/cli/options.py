@@ -10,9 +10,10 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 
 from serial import SerialException
 
-from appmode.board.profiles import PROFILE_NAMES, PROFILES, SHEET, Profile
+from appmode.board.names import PROFILE_NAMES
 
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
+    from appmode.board.profiles import Profile
     from appmode.protocol.layouts import ALayout
 
 URL_FORMS = (
@@ -78,6 +79,8 @@ def add_profile(
 
 def profile_for(url: str | None, name: str | None) -> Profile:
     """The profile `--profile NAME` names, else a sim:// URL's, else the sheet."""
+    from appmode.board.profiles import PROFILES, SHEET
+
     if name is None and url is not None and url.lower().startswith("sim://"):
         with contextlib.suppress(SerialException):
             from appmode.ports.sim import parse_sim_url

@@ -9,6 +9,7 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.board.profiles import SHEET, Profile
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     Subparsers,
     add_profile,
@@ -25,7 +26,7 @@ from appmode.protocol.render import params_table
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     prm = sub.add_parser(
         "params",
-        help="read, set (verified) and save the nine parameters",
+        help=COMMANDS["params"],
         description="Read the nine parameters; with --set, set each and verify it by reading "
         "back; with --save, save them to the board's flash. Names: "
         + ", ".join(p.name for p in params.PARAMS)

@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     plot = sub.add_parser(
         "plot",
-        help="draw a transcript's telemetry (needs matplotlib)",
+        help=COMMANDS["plot"],
         description="Draw velocities, attitude and battery over time, with the commands "
         "marked, to a PNG. Needs matplotlib: pip install matplotlib.",
     )

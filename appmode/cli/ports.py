@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     return sub.add_parser(
         "ports",
-        help="list serial ports (USB-UART adapters, Bluetooth rfcomm)",
+        help=COMMANDS["ports"],
         description="List the serial ports of this machine (device, description, hardware "
         "id), marking those that look like a car's link: a USB-UART adapter or a "
         "Bluetooth serial port. Give the device to any command as its URL.",

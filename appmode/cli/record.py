@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.monitor import add_limits, run_monitor
 from appmode.cli.options import Subparsers, add_url, file_name
 
@@ -11,7 +12,7 @@ from appmode.cli.options import Subparsers, add_url, file_name
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     rec = sub.add_parser(
         "record",
-        help="log what a board sends to a transcript (passive)",
+        help=COMMANDS["record"],
         description="Write everything the board sends to a transcript, until Ctrl-C, "
         "--duration or --count. It only listens: nothing is written to the port (for a "
         "session that also sends, use --record on drive, send or tap). Read the result "

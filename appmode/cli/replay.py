@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import DAY, Subparsers, file_name, number_type
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     replay = sub.add_parser(
         "replay",
-        help="play one side of a transcript to a port",
+        help=COMMANDS["replay"],
         description="Play the host's lines ('>', driving a board) or the board's lines ('<', "
         "feeding an app) to a port, each at its time from the start. As the host the replay "
         "ends with Z.",

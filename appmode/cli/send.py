@@ -7,6 +7,7 @@ import sys
 from contextlib import ExitStack
 from typing import TextIO
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     DAY,
     Subparsers,
@@ -27,7 +28,7 @@ from appmode.protocol.render import describe, line
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     send = sub.add_parser(
         "send",
-        help="send letters and frames to a board and print what comes back",
+        help=COMMANDS["send"],
         description="Send tokens in order and print the records that come back. Tokens: "
         "letters (A-H drive, I J K pages, Z stop; 'JAZ' sends three), frames ({Q:P}, "
         "{Q:W}, {0:800}), escaped bytes (\\x01) and waits (wait:0.5). Z is always sent "

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import argparse
 
+from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     tap = sub.add_parser(
         "tap",
-        help="sit between an app and a board, recording both directions",
+        help=COMMANDS["tap"],
         description="Forward bytes both ways between the app side and the board side and "
         "record them, timestamped, as a transcript. APP may be 'pty': a new pseudo-terminal "
         "for the app to open (its path is printed as 'port: …'). On exit the board gets Z.",

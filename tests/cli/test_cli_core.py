@@ -116,3 +116,21 @@ def test_the_command_line_loads_a_commands_machinery_only_to_run_it() -> None:
         check=True,
     )
     assert loaded.stdout.strip() == "[]"
+    commands = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from appmode.cli.main import build_parser; "
+            "from appmode.cli.commands import COMMANDS; "
+            "build_parser(sys.argv[1]).parse_args(sys.argv[2:]); "
+            "print(sorted(m for m in COMMANDS if 'appmode.cli.' + m in sys.modules))",
+            "send",
+            "send",
+            "sim://",
+            "Z",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert commands.stdout.strip() == "['send']", "only the command that runs is loaded"
