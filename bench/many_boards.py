@@ -64,8 +64,10 @@ def serve(count: int) -> None:
         server.close()
 
 
-def measure(count: int, seconds: float) -> dict[str, float]:
-    """CPU share, records/s per board (min, median) and grid lateness (ms)."""
+def measure(count: int, seconds: float, read: bool = True) -> dict[str, float]:
+    """CPU share, records/s per board (min, median) and grid lateness (ms); with `read`
+    False nobody opens the boards' ports (their ptys fill, then what they send is
+    dropped: records/s are 0)."""
     proc = subprocess.Popen(
         [sys.executable, __file__, "--serve", str(count)],
         stdin=subprocess.PIPE,
@@ -76,11 +78,12 @@ def measure(count: int, seconds: float) -> dict[str, float]:
     fds: list[int] = []
     try:
         for _ in range(count):
-            fd = os.open(proc.stdout.readline().strip(), os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
-            tty.setraw(fd)
-            fds.append(fd)
+            url = proc.stdout.readline().strip()
+            if read:
+                fds.append(os.open(url, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK))
+                tty.setraw(fds[-1])
         decoders = [BoardDecoder() for _ in fds]
-        records = [0] * count
+        records = [0] * len(fds)
         proc.stdin.write("go\n")
         proc.stdin.flush()
         start = time.monotonic()
@@ -98,7 +101,7 @@ def measure(count: int, seconds: float) -> dict[str, float]:
             os.close(fd)
         proc.kill()
         proc.wait()
-    rates = sorted(r / elapsed for r in records)
+    rates = sorted(r / elapsed for r in records) if read else [0.0]
     return {
         "share": report["cpu"] / report["wall"] * 100,
         "min": rates[0],
@@ -113,13 +116,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("counts", nargs="*", type=int, default=[200, 500, 1000])
     parser.add_argument("--seconds", type=float, default=15.0)
+    parser.add_argument("--unread", action="store_true", help="nobody opens the ports")
     parser.add_argument("--serve", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.serve:
         serve(args.serve)
         return
     for count in args.counts:
-        r = measure(count, args.seconds)
+        r = measure(count, args.seconds, not args.unread)
         print(
             f"{count:5d} boards: {r['share']:5.1f} % of a core; records/s per board min "
             f"{r['min']:.1f}, median {r['median']:.1f}; grid lateness p50 {r['p50']:.2f} ms, "
