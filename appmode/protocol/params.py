@@ -83,6 +83,7 @@ _DRIVE_CLI_NAMES = {
 }
 DRIVE_NAMES: tuple[str, ...] = tuple(_DRIVE_CLI_NAMES.values())
 DRIVE_MASK = 0b111
+_DRIVES: dict[int, DriveType] = {drive.value: drive for drive in DriveType}
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,8 +112,7 @@ UNSAVED_MASK = sum(1 << b.bit for b in MODE_BITS if not b.saved)
 
 def drive_type(system_mode: int) -> DriveType | None:
     """The drive type in bits 0–2, or None when the field holds an invalid value (4–7)."""
-    value = system_mode & DRIVE_MASK
-    return DriveType(value) if value in DriveType._value2member_map_ else None
+    return _DRIVES.get(system_mode & DRIVE_MASK)
 
 
 def value_error(index: int, value: int) -> str | None:
