@@ -124,6 +124,7 @@ def drift_ms_per_min(lateness: list[float], spacing: float) -> float:
 LOADS: dict[str, list[list[str]]] = {
     "idle": [],
     "busy": [[sys.executable, "-c", "while True: pass"]] * 2,
+    "busy1": [[sys.executable, "-c", "while True: pass"]],
     "pytest": [[sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]],
 }
 
@@ -178,7 +179,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--events", type=int, default=10_000)
     parser.add_argument("--spacing", type=float, default=0.010, metavar="S")
-    parser.add_argument("--load", choices=LOADS, default="idle")
+    parser.add_argument("--load", choices=("idle", "busy", "pytest"), default="idle")
     parser.add_argument("--worker", choices=PLAYERS, help=argparse.SUPPRESS)
     parser.add_argument("--start", type=float, help=argparse.SUPPRESS)
     args = parser.parse_args()
