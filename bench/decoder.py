@@ -262,13 +262,17 @@ class HostByteAtATime:
                 self.events.append(app.SINGLE_BYTE[byte])
 
 
-class ControlBoardByteAtATime:
-    """A host's way of reading UART2's replies and 4-wheel encoder reports byte by byte."""
+class _Gathering:
+    """A byte loop that gathers `need` bytes into `buf`, then makes `events` of them."""
 
     def __init__(self) -> None:
         self.buf = bytearray()
         self.need = 0
         self.events: list[object] = []
+
+
+class ControlBoardByteAtATime(_Gathering):
+    """A host's way of reading UART2's replies and 4-wheel encoder reports byte by byte."""
 
     def feed(self, data: bytes) -> None:
         for byte in data:
@@ -293,16 +297,11 @@ class ControlBoardByteAtATime:
             self.events.append(control.EncoderReport(tuple(values[0::2]), tuple(values[1::2]), raw))
 
 
-class ControlHostByteAtATime:
+class ControlHostByteAtATime(_Gathering):
     """The board's way of reading UART2 frames: sync on FF FE, the mode byte gives the
     length, the frame is gathered and then parsed (a 3-motor omni car)."""
 
     LENGTHS: ClassVar[dict[int, int]] = dict.fromkeys(control.MODES, control.FRAME)
-
-    def __init__(self) -> None:
-        self.buf = bytearray()
-        self.need = 0
-        self.events: list[object] = []
 
     def feed(self, data: bytes) -> None:
         for byte in data:

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import functools
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from appmode.protocol import params
 from appmode.protocol.bulk import linear
@@ -292,19 +294,24 @@ SINGLE_BYTE = _single_byte_events()
 """What each byte means outside a frame (§2.1), by value."""
 
 
+E = TypeVar("E")
 _BRACES = re.compile(rb"\{{2,%d}" % (MAX_RUN + 1))
 
 
-def _brace_run(buf: bytes | bytearray, pos: int, hold: bool) -> int | None:
-    """At a `{` followed by `{`: how many of the run's braces to report together, each an
-    open frame or record the next `{` interrupted; the run's last brace opens the next one.
-    Up to MAX_RUN at a time; None to hold a run that more bytes may lengthen."""
+def _brace_run(
+    buf: bytes, pos: int, hold: bool, out: list[E], event: Callable[[bytes, str], E], what: str
+) -> int | None:
+    """At a `{` followed by `{`: the run's braces, each an open frame or record the next
+    `{` interrupted, reported as one `event(raw, reason)` up to MAX_RUN at a time (the
+    run's last brace opens the next one). Where it stopped, or None to hold a run that
+    more bytes may lengthen."""
     run = _BRACES.match(buf, pos)
     assert run is not None
     count = run.end() - pos - 1
     if count < MAX_RUN and run.end() == len(buf) and hold:
         return None
-    return count
+    out.append(event(buf[pos : pos + count], _interrupted(what, count)))
+    return pos + count
 
 
 def _interrupted(what: str, count: int) -> str:
@@ -393,11 +400,10 @@ class HostDecoder:
                 pos = stop
                 continue
             if pos + 1 < n and buf[pos + 1] == LBRACE:
-                count = _brace_run(buf, pos, True)
-                if count is None:
+                after = _brace_run(buf, pos, True, out, BadFrame, "frame")
+                if after is None:
                     break
-                out.append(BadFrame(buf[pos : pos + count], _interrupted("frame", count)))
-                pos += count
+                pos = after
                 continue
             limit = min(n, pos + MAX_FRAME)
             close = buf.find(b"}", pos + 1, limit)
@@ -616,11 +622,10 @@ class BoardDecoder:
                 pos = start
                 continue
             if pos + 1 < n and buf[pos + 1] == LBRACE:
-                count = _brace_run(buf, pos, hold)
-                if count is None:
+                after = _brace_run(buf, pos, hold, out, Malformed, "record")
+                if after is None:
                     break
-                out.append(Malformed(buf[pos : pos + count], _interrupted("record", count)))
-                pos += count
+                pos = after
                 continue
             limit = min(n, pos + MAX_RECORD)
             close = buf.find(b"}", pos + 1, limit)
