@@ -115,6 +115,7 @@ class PtyEndpoint:
             ) from None
         tty.setraw(self._slave)  # no echo, no line editing: bytes pass untouched
         os.set_blocking(self._master, False)
+        self._write_master = partial(os.write, self._master)
         self.baud = baud
         """The line rate of the UART this pty stands for; None: bytes pass at any rate."""
         self._client_baud = client_baud
@@ -143,7 +144,7 @@ class PtyEndpoint:
         return self._misread(data, to_board=True)
 
     def write(self, data: bytes) -> None:
-        self._out.write(self._misread(data, to_board=False), lambda c: os.write(self._master, c))
+        self._out.write(self._misread(data, to_board=False), self._write_master)
 
     def _misread(self, data: bytes, *, to_board: bool) -> bytes:
         """With a line rate, what each side reads when the client set another one."""
@@ -338,6 +339,9 @@ class Served:
     phase: float = 0.0
     """Where in each RUN this board's grid points fall (0…1): boards served together
     spread over the grid, so that a pass does not run them all at once."""
+    board_due: float = -math.inf
+    """When the board itself next has something to do, as `wakeup` last found: before
+    then a pump only writes what its lines deliver."""
 
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
@@ -346,6 +350,7 @@ class Served:
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
         sends = wire.board.next_sends()
+        self.board_due = min(sends)
         due = math.inf
         for name in self.endpoints:
             port = wire.ports[name]
@@ -369,7 +374,9 @@ class Served:
 
     def pump(self, now: float) -> None:
         wire = self.wire
-        wire.run(now)
+        ports = wire.ports
+        if now >= self.board_due or ports[APP].to_board or ports[UART2].to_board:
+            wire.run(now)
         for name, endpoint in self.endpoints.items():
             line = wire.ports[name].to_host
             out = line.take(now) if line else b""
