@@ -349,27 +349,36 @@ class Served:
         time) and the bytes whose stop bit is done are written, never early, never more
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
-        sends = wire.board.next_sends()
+        board = wire.board
+        sends = board.next_sends()
         self.board_due = min(sends)
         due = math.inf
-        for name in self.endpoints:
+        for index, name in enumerate(PORTS):
+            if name not in self.endpoints:
+                continue
             port = wire.ports[name]
-            step = port.to_host.byte_time
-            mine = sends[PORTS.index(name)] + step  # the port's next output: its first byte
-            for line in (port.to_board.next_due(), port.to_host.next_due()):
-                if line is not None:
-                    mine = min(mine, line)
+            to_host = port.to_host
+            step = to_host.byte_time
+            mine = sends[index] + step  # the port's next output: its first byte
+            first = to_host.next_due()
+            if first is not None and first < mine:
+                mine = first
+            received = port.to_board.next_due()
+            if received is not None and received < mine:
+                mine = received
             if step and mine < math.inf:
-                run, offset = RUN[name], self.phase * RUN[name]
+                run = RUN[name]
+                offset = self.phase * run
                 mine = math.ceil((mine - offset) / run - 1e-9) * run + offset
             if name == UART2 and step:
                 # a reply is due within its tick: run the board at the slot, and write a
                 # burst shorter than a run whole when its last stop bit is done
-                mine = min(mine, wire.board.next_reply())
-                first, last = port.to_host.next_due(), port.to_host.last_due()
+                mine = min(mine, board.next_reply())
+                last = to_host.last_due()
                 if first is not None and last is not None and last - first < RUN[name]:
                     mine = min(mine, last)
-            due = min(due, mine)
+            if mine < due:
+                due = mine
         return due
 
     def pump(self, now: float) -> None:
