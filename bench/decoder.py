@@ -134,7 +134,8 @@ class SameEventsByteLoop:
                 if len(record) == 1:
                     self.braces += 1
                 else:
-                    self.events.append(app.Malformed(bytes(record), "record interrupted by '{'"))
+                    reason = app._interrupted("record", 1)
+                    self.events.append(app.Malformed(bytes(record), reason))
                     self.record = bytearray(b"{")
                 continue
             if self.braces:
@@ -158,9 +159,7 @@ class SameEventsByteLoop:
     def _brace_run(self) -> None:
         while self.braces:
             count = min(self.braces, app.MAX_RUN)
-            reason = "record interrupted by '{'" if count == 1 else f"{count} records "
-            reason += "" if count == 1 else "interrupted by '{'"
-            self.events.append(app.Malformed(b"{" * count, reason))
+            self.events.append(app.Malformed(b"{" * count, app._interrupted("record", count)))
             self.braces -= count
 
     def _garbage(self) -> None:
