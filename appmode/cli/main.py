@@ -63,10 +63,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     words = sys.argv[1:] if argv is None else argv
     parser = build_parser(command_in(words))
-    args = parser.parse_args(words)
-    handler: Handler = args.handler
     signals.install()
     try:
+        try:
+            args = parser.parse_args(words)
+        except SystemExit as exc:
+            if exc.code:  # a usage error: argparse has said what, on stderr
+                raise
+            args = argparse.Namespace(handler=lambda _: 0)  # --help or --version: printed
+        handler: Handler = args.handler
         status = handler(args)
         sys.stdout.flush()  # here, where a full disk or a closed pipe can be reported
         return status

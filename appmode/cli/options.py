@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeAlias
 
@@ -13,6 +14,8 @@ from serial import SerialException
 from appmode.board.names import PROFILE_NAMES
 
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
+    from _typeshed import SupportsWrite
+
     from appmode.board.profiles import Profile
     from appmode.protocol.layouts import ALayout
 
@@ -108,6 +111,12 @@ class Parser(argparse.ArgumentParser):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
+
+    def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
+        """As argparse's, but a write that fails (a full disk, a closed pipe) is not passed
+        over: the command line reports it (help and usage are output too)."""
+        if message:
+            (file or sys.stderr).write(message)
 
 
 Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"

@@ -50,6 +50,18 @@ def test_a_full_disk_is_one_clear_error(capture: Path, from_stdin: bool) -> None
     )
 
 
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+@pytest.mark.parametrize("args", [("--help",), ("send", "--help"), ("--version",)])
+def test_help_to_a_full_disk_is_one_clear_error(args: tuple[str, ...]) -> None:
+    """It ended with status 0 and said nothing: the help was lost unnoticed."""
+    with open("/dev/full", "wb") as full:
+        done = subprocess.run(appmode_cmd(*args), stdout=full, stderr=subprocess.PIPE, cwd=ROOT)
+    assert done.returncode == 2
+    assert done.stderr.decode() == (
+        "appmode: error: cannot write the output: No space left on device\n"
+    )
+
+
 def test_closed_stdout_and_stdin(capture: Path) -> None:
     closed_out = subprocess.run(
         ["sh", "-c", 'exec "$@" >&-', "sh", *appmode_cmd("decode", str(capture))],
