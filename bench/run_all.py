@@ -255,8 +255,8 @@ def bench_key_latency(keys: int) -> list[Row]:
     from prompt_toolkit.output import DummyOutput
 
     from appmode.console.app import run_drive
-    from appmode.console.hold import HoldToDrive
-    from appmode.console.session import Session
+    from appmode.session.app_session import Session
+    from appmode.session.hold import HoldToDrive
 
     sent: list[float] = []
     typed: list[float] = []

@@ -19,9 +19,9 @@ from appmode.cli.options import (
     profile_for,
     stop_again_for,
 )
-from appmode.console.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES, DriveType
+from appmode.session.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -103,10 +103,10 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from appmode.console.app import run_drive
-    from appmode.console.control_session import ControlSession
-    from appmode.console.hold import HoldToDrive
-    from appmode.console.session import Session
     from appmode.ports.link import is_simulated  # here: start-up stays short
+    from appmode.session.app_session import Session
+    from appmode.session.control_session import ControlSession
+    from appmode.session.hold import HoldToDrive
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)

@@ -1,2 +1,2 @@
-"""The driving console: the prompt_toolkit application, the driving session, the status
-panel and hold-to-drive. Uses `host` and the layers below."""
+"""The terminal view of a driving session: the prompt_toolkit application, its key
+bindings and the status panel. The session itself is in `session/`."""

@@ -4,7 +4,6 @@ session holds both ports."""
 
 from __future__ import annotations
 
-from appmode.console.control_session import STOP, ControlSession
 from appmode.console.panel_parts import (
     GLYPHS,
     WIDTH,
@@ -19,6 +18,7 @@ from appmode.console.panel_parts import (
 from appmode.protocol import settings
 from appmode.protocol.control_view import describe
 from appmode.protocol.directions import STOP_LETTER
+from appmode.session.control_session import STOP, ControlSession
 
 SILENT_HINT = "check the wiring and that the car is on; appmode doctor finds its port"
 

@@ -3,9 +3,7 @@ APP port's here, the control port's in `control_panel`)."""
 
 from __future__ import annotations
 
-from appmode.console.base import BaseSession
 from appmode.console.control_panel import control_body
-from appmode.console.control_session import ControlSession
 from appmode.console.panel_parts import (
     GLYPHS,
     WIDTH,
@@ -17,11 +15,13 @@ from appmode.console.panel_parts import (
     link_line,
     telemetry,
 )
-from appmode.console.session import KEYS_HELP, Session
 from appmode.console.waves import waveform_lines
 from appmode.host.state import TRACE_SECONDS
 from appmode.protocol import params
 from appmode.protocol.directions import grid_for, letter_name
+from appmode.session.app_session import KEYS_HELP, Session
+from appmode.session.base import BaseSession
+from appmode.session.control_session import ControlSession
 
 
 def status_fragments(session: BaseSession, waveforms: bool = False) -> Fragments:

@@ -7,10 +7,10 @@ from collections.abc import Callable
 
 from prompt_toolkit.formatted_text import StyleAndTextTuples
 
-from appmode.console.base import BaseSession
-from appmode.console.hold import HoldToDrive
 from appmode.host.state import HostState, LinkStats
 from appmode.protocol import app
+from appmode.session.base import BaseSession
+from appmode.session.hold import HoldToDrive
 from appmode.text import counted
 
 Fragments = StyleAndTextTuples

@@ -6,8 +6,8 @@ import os
 from pathlib import Path
 
 from appmode.board.firmware import Board
-from appmode.console.session import COMMANDS
 from appmode.protocol import params
+from appmode.session.app_session import COMMANDS
 from appmode.text import counted, wrapped
 from tests.support.processes import run
 

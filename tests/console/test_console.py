@@ -14,8 +14,8 @@ from prompt_toolkit.input import create_pipe_input
 from prompt_toolkit.output import DummyOutput
 
 from appmode.console import app
-from appmode.console.hold import HoldToDrive
-from appmode.console.session import Session
+from appmode.session.app_session import Session
+from appmode.session.hold import HoldToDrive
 
 UP = "\x1b[A"
 CTRL_C = "\x03"

@@ -12,8 +12,6 @@ from collections.abc import Callable, Iterable
 from functools import partial
 from typing import ClassVar
 
-from appmode.console.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
-from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.control_client import ControlHost
@@ -28,6 +26,8 @@ from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
+from appmode.session.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.session.hold import HoldToDrive
 
 DEFAULT_SPEED = 300
 """Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""

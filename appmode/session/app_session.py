@@ -10,8 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import ClassVar
 
-from appmode.console.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
-from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.link import LinkLost
@@ -29,6 +27,8 @@ from appmode.protocol.directions import (
     letter_name,
 )
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.session.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.session.hold import HoldToDrive
 
 COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("params", "", "read the nine parameters"),

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from appmode.console.hold import HoldToDrive
+from appmode.session.hold import HoldToDrive
 
 
 def test_first_press_sends_and_times_out_after_the_first_timeout() -> None:

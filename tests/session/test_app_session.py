@@ -8,9 +8,9 @@ import os
 import time
 from pathlib import Path
 
-from appmode.console.hold import HoldToDrive
-from appmode.console.session import Session
 from appmode.protocol.transcript import Recorder
+from appmode.session.app_session import Session
+from appmode.session.hold import HoldToDrive
 from tests.support.processes import BoardProcess, run, sent_lines
 
 

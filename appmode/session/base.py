@@ -14,12 +14,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
-from appmode.console.hold import HoldToDrive
 from appmode.errors import AppmodeError
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.link import is_simulated
 from appmode.ports.sim import sim_directives
 from appmode.protocol.transcript import Recorder
+from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped
 
 if TYPE_CHECKING:
