@@ -38,11 +38,12 @@ from prompt_toolkit.layout.menus import CompletionsMenu
 from prompt_toolkit.output import Output
 
 from appmode.console.panel import status_fragments, status_text
-from appmode.console.panel_parts import ARROWS, KEY_GRID, WIDTH, Fragments
+from appmode.console.panel_parts import ARROWS, KEY_GRID, Fragments
 from appmode.files import data_folder
 from appmode.host import signals
 from appmode.host.tokens import Wait
 from appmode.session.base import LOG, QUIT_WORDS, BaseSession, Quit, ShowHelp, ShowStatus, Step
+from appmode.session.status import WIDTH
 from appmode.text import wrapped
 
 REFRESH = 0.02

@@ -14,7 +14,7 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.link import LinkLost
 from appmode.host.query import ParamQuery, QueryDone, QueryFailed
-from appmode.host.state import BoardWarning, LinkStatus
+from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.tokens import Wait, parse_token
 from appmode.protocol import params
 from appmode.protocol.app import HostDecoder, Move, Noise, Stop, SwitchPage
@@ -29,6 +29,7 @@ from appmode.protocol.directions import (
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.session.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
 from appmode.session.hold import HoldToDrive
+from appmode.session.status import GLYPHS, Row, Span, hold_mode, link_rows, telemetry
 
 COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("params", "", "read the nine parameters"),
@@ -189,6 +190,55 @@ class Session(BaseSession):
     @property
     def page_text(self) -> str:
         return f"{self.page.value} ({self.page_letter} {PAGE_NAMES[self.page_letter]})"
+
+    # ------------------------------------------------------------ what it shows
+
+    def status_rows(self) -> list[Row]:
+        host, state = self.host, self.host.state
+        now = host.now()
+        moving = self.in_force != STOP_LETTER
+        rows = link_rows(host.connected, state.stats, now)
+        rows += telemetry(state, now)
+        page: tuple[Span, ...] = (
+            ("", f" {self.page_text}   "),
+            ("label", "in force "),
+            ("on" if moving else "", f" {self.in_force_text} "),
+            ("", f"   {hold_mode(self.driving)}"),
+        )
+        rows.append(Row("page", page))
+        if state.letters_ignored:
+            ignored: tuple[Span, ...] = (
+                ("warn", " the car does not follow the letters "),
+                ("", "  UART2 may have taken over (§8.3)"),
+            )
+            rows.append(Row("control", ignored))
+        record = state.params
+        if record is None:
+            rows.append(Row("params", (("", " not read yet (p reads them)"),)))
+        else:
+            pairs = zip(params.PARAMS, record.values, strict=True)
+            rows.append(Row("params", pairs=tuple(f"{p.name} {value}" for p, value in pairs)))
+        return rows
+
+    def grid_cells(self) -> list[list[str]]:
+        letters = grid_for(self.page)
+        return [
+            [
+                f"{letter} {GLYPHS[r][c]} {letter_name(self.page, letter)}"
+                for c, letter in enumerate(row)
+            ]
+            for r, row in enumerate(letters)
+        ]
+
+    def lit_cell(self) -> tuple[int, int] | None:
+        if self.in_force == STOP_LETTER:
+            return None
+        letters = grid_for(self.page)
+        cells = [(r, c) for r in range(3) for c in range(3)]
+        return next(((r, c) for r, c in cells if letters[r][c] == self.in_force), None)
+
+    def telemetry_state(self) -> HostState:
+        return self.host.state
 
     # ------------------------------------------------------------ parameters
 

@@ -25,6 +25,8 @@ from appmode.text import wrapped
 if TYPE_CHECKING:
     from appmode.host.client import Host
     from appmode.host.control_client import ControlHost
+    from appmode.host.state import HostState
+    from appmode.session.status import Row
 
 SPEED_STEP = 100
 SPEED_KEYS = {"+": f"speed +{SPEED_STEP}", "=": f"speed +{SPEED_STEP}", "-": f"speed -{SPEED_STEP}"}
@@ -142,6 +144,25 @@ class BaseSession(ABC):
     @abstractmethod
     def stop(self) -> None:
         """Stop the car now."""
+
+    title: ClassVar[str] = "appmode drive"
+    """What a view calls the session."""
+
+    @abstractmethod
+    def status_rows(self) -> list[Row]:
+        """What the session shows now, row by row (the key grid apart)."""
+
+    @abstractmethod
+    def grid_cells(self) -> list[list[str]]:
+        """The 3×3 grid (row 0 is the front): what each key does, as shown."""
+
+    @abstractmethod
+    def lit_cell(self) -> tuple[int, int] | None:
+        """The cell of the grid in force (the car moves), if any."""
+
+    def telemetry_state(self) -> HostState | None:
+        """The APP port's state, whose A and B records a view may draw as waveforms."""
+        return None
 
     @abstractmethod
     def unsaved_warning(self) -> str | None:

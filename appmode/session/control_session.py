@@ -27,14 +27,15 @@ from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETT
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
 from appmode.session.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.session.control_status import STOP, control_grid, control_lit, control_rows
 from appmode.session.hold import HoldToDrive
+from appmode.session.status import Row
 
 DEFAULT_SPEED = 300
 """Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""
 DEFAULT_ANGLE = 90.0
 REPORT_BIT = params.MODE_BIT["encoder_report"]
 SETTING_NAMES = tuple(s.name for s in settings.SETTINGS)
-STOP = "stop"
 
 COMMANDS: tuple[CommandSpec, ...] = (
     CommandSpec("settings", "", "read the ten settings"),
@@ -227,6 +228,19 @@ class ControlSession(BaseSession):
         if done:
             self.rotation = None
             self.say(f"rotated {degrees:g}° in {self.now() - started:.2f} s")
+
+    # ------------------------------------------------------------ what it shows
+
+    title = "appmode drive --uart2"
+
+    def status_rows(self) -> list[Row]:
+        return control_rows(self)
+
+    def grid_cells(self) -> list[list[str]]:
+        return control_grid(self)
+
+    def lit_cell(self) -> tuple[int, int] | None:
+        return control_lit(self)
 
     # ------------------------------------------------------------ driving
 

@@ -10,12 +10,12 @@ from pathlib import Path
 from prompt_toolkit.utils import get_cwidth
 
 from appmode.console.panel import status_fragments
-from appmode.console.panel_parts import WIDTH
 from appmode.host.state import BoardWarning, HostState
 from appmode.protocol.directions import MOTIONS
 from appmode.protocol.params import DriveType
 from appmode.session.control_session import ControlSession, velocity_for
 from appmode.session.hold import HoldToDrive
+from appmode.session.status import WIDTH
 from tests.console.test_console_tmux import (
     SESSION,
     _alive,

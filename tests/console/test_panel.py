@@ -11,10 +11,10 @@ from prompt_toolkit.formatted_text import StyleAndTextTuples
 from prompt_toolkit.utils import get_cwidth
 
 from appmode.console.panel import status_fragments
-from appmode.console.panel_parts import BAR, WIDTH
 from appmode.console.waves import LEVELS
 from appmode.session.app_session import Session
 from appmode.session.hold import HoldToDrive
+from appmode.session.status import BAR, WIDTH
 
 
 def test_a_battery_out_of_range_fills_the_gauge_and_no_more() -> None:

@@ -1,0 +1,139 @@
+"""What a session shows, for any view: rows of a label and spans of text, each span with
+a tone (what it means: a value in force, a warning, a stale reading), never a style.
+
+The terminal panel renders the rows as styled text; another view maps the same tones to
+its own look. The session decides what to say and how fresh it is; a view decides how
+it looks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from appmode.host.state import HostState, LinkStats
+from appmode.protocol import app
+from appmode.session.hold import HoldToDrive
+from appmode.text import counted
+
+Tone = Literal["", "label", "on", "ok", "warn", "alert", "late", "low", "dim"]
+"""What a span means: plain, a label inside a row, in force (a car moving), fine, a
+warning, an alarm, a link that is late, a low battery, old or secondary."""
+Span = tuple[Tone, str]
+
+GLYPHS = (("↖", "↑", "↗"), ("←", "■", "→"), ("↙", "↓", "↘"))
+"""The 3×3 grid's arrows: row 0 is the front."""
+STALE = 0.5
+"""Seconds without a record after which a reading shows how long it has been."""
+SILENT = 2.0
+"""Seconds after opening with nothing received after which the link row says what to
+check."""
+SILENT_HINT = "is the car on (and paired)? appmode doctor finds its port and baud rate"
+BAR = 20
+WIDTH = 80
+"""Columns every row fits in."""
+
+
+@dataclass(frozen=True, slots=True)
+class Row:
+    """One line of status: a label (empty: none), then its spans; `pairs` are
+    `name value` texts a view lays out in columns after the spans."""
+
+    label: str
+    spans: tuple[Span, ...] = ()
+    pairs: tuple[str, ...] = ()
+
+    @property
+    def text(self) -> str:
+        return "".join(text for _, text in self.spans)
+
+
+def _size(count: int) -> str:
+    return f"{count} B" if count < 1000 else f"{count // 1000} kB"
+
+
+def bar(percent: int) -> str:
+    """A BAR-wide gauge; a reading outside 0–100 (a garbled or odd board) fills it to
+    its end, never beyond."""
+    filled = round(min(100, max(0, percent)) / 100 * BAR)
+    return "[" + "#" * filled + "." * (BAR - filled) + "]"
+
+
+def link_spans(
+    connected: bool,
+    stats: LinkStats,
+    now: float,
+    noun: str = "records",
+    brief: bool = False,
+) -> tuple[Span, ...] | None:
+    """Whether the link is up: counters (bytes unless `brief`), errors, how fresh what it
+    brings is; None while the port is open and nothing has come."""
+    age = stats.since_last(now)
+    if not connected:
+        return (("alert", " LINK LOST — retrying; keys do nothing "),)
+    if age is None:
+        return None
+    last = f"{noun} live" if age < STALE else f"last {noun[:-1]} {age:.1f} s ago"
+    recent = stats.recent_errors(now)
+    if recent:
+        first: Span = ("warn", f" link DEGRADED: {counted(recent, 'error')} in 5 s ")
+    else:
+        first = ("late" if age > 1.0 else "ok", " link up")
+    sizes = "" if brief else f"in {_size(stats.bytes_in)} · out {_size(stats.bytes_out)} · "
+    return first, ("", f"  {stats.rate(now):3.0f} {noun}/s · {sizes}errors {stats.errors} · {last}")
+
+
+def link_rows(
+    connected: bool,
+    stats: LinkStats,
+    now: float,
+    noun: str = "records",
+    hint: str = SILENT_HINT,
+    label: str = "",
+    brief: bool = False,
+) -> list[Row]:
+    """The link row (under `label`); a port open with nothing received says so, and
+    after SILENT what to check (it is not known to be up)."""
+    spans = link_spans(connected, stats, now, noun, brief)
+    if spans is not None:
+        return [Row(label, spans)]
+    if now <= SILENT:
+        return [Row(label, (("", " port open, nothing received "),))]
+    return [
+        Row(label, (("alert", " port open, nothing received "),)),
+        Row("", (("", f"  {hint}"),)),
+    ]
+
+
+def reading(label: str, text: str, age: float | None) -> Row:
+    """A row of values; dimmed, with their age, once they are not fresh (a silent or
+    lost link must not show a car that looks as if it were moving)."""
+    if age is None or age <= STALE:
+        return Row(label, (("", f" {text}"),))
+    return Row(label, (("dim", f" {text}   ({age:.1f} s ago)"),))
+
+
+def telemetry(state: HostState, now: float) -> list[Row]:
+    """The A and B records: velocity, attitude, battery."""
+    v, a = state.velocity, state.attitude
+    if v is None:
+        velocity = "  —"
+    else:
+        values, labels = app.record_fields(v)[1], state.layout.labels
+        velocity = "   ".join(f"{labels[i]} {values[i]:6d}" for i in state.layout.motion)
+    attitude = "  —" if a is None else f"pitch {a.pitch:4d}   roll {a.roll:4d}   yaw {a.yaw:4d}"
+    rows = [
+        reading("velocity", velocity, state.velocities.age(now)),
+        reading("attitude", attitude, state.attitudes.age(now)),
+    ]
+    if a is None:
+        return [*rows, Row("battery", (("", "  —"),))]
+    old = (state.attitudes.age(now) or 0.0) > STALE
+    tone: Tone = "dim" if old else "low" if a.battery < 20 else "ok"
+    return [*rows, Row("battery", ((tone, f" {a.battery:3d} % {bar(a.battery)}"),))]
+
+
+def hold_mode(driving: HoldToDrive) -> str:
+    if driving.latched:
+        return "latched"
+    return f"hold {driving.first_timeout:g}/{driving.repeat_timeout:g} s"
