@@ -254,7 +254,7 @@ def bench_key_latency(keys: int) -> list[Row]:
     from prompt_toolkit.input import create_pipe_input
     from prompt_toolkit.output import DummyOutput
 
-    from appmode.console.app import run_drive
+    from appmode.console.driving import run_drive
     from appmode.session.app_session import Session
     from appmode.session.hold import HoldToDrive
 

@@ -102,7 +102,7 @@ def test_the_command_line_loads_a_commands_machinery_only_to_run_it() -> None:
         "appmode.cli.control_port",
         "appmode.board.firmware",
         "appmode.ports.sim",
-        "appmode.console.app",
+        "appmode.console.driving",
     )
     loaded = subprocess.run(
         [

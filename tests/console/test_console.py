@@ -13,7 +13,7 @@ import pytest
 from prompt_toolkit.input import create_pipe_input
 from prompt_toolkit.output import DummyOutput
 
-from appmode.console import app
+from appmode.console.driving import run_drive
 from appmode.session.app_session import Session
 from appmode.session.hold import HoldToDrive
 
@@ -49,7 +49,7 @@ def run_console(
 
         thread = threading.Thread(target=typist, daemon=True)
         thread.start()
-        app.run_drive(session, True, [], io.StringIO(), pipe, DummyOutput())
+        run_drive(session, True, [], io.StringIO(), pipe, DummyOutput())
         thread.join(5)
     return session, record, typed_at
 

@@ -1,0 +1,52 @@
+"""`appmode drive` from start to stop: the session started, the console (or script mode)
+run, and the session always closed — its stop is the last thing sent."""
+
+from __future__ import annotations
+
+import asyncio
+import sys
+from collections.abc import Iterable
+from typing import TextIO
+
+from prompt_toolkit.input import Input
+from prompt_toolkit.output import Output
+
+from appmode.console.script import run_script
+from appmode.console.terminal import Console, command_history
+from appmode.session.base import BaseSession
+
+
+def run_drive(
+    session: BaseSession,
+    interactive: bool,
+    script: Iterable[str],
+    out: TextIO,
+    input: Input | None = None,
+    output: Output | None = None,
+    keep_going: bool = False,
+) -> int:
+    """Start the session, run the console (or script mode), and always close it: the
+    stop last. Values set and not saved are named at the end. Script mode ends at the
+    first error (every line with `keep_going`); its exit status is 1 if any line failed."""
+    try:
+        session.start()
+        if interactive:
+            console = Console(session, input, output, command_history())
+            asyncio.run(console.run())
+        else:
+            run_script(session, script, out, keep_going)
+    finally:
+        warning = session.unsaved_warning()
+        try:
+            session.close()
+        finally:
+            for note in session.closing_notes:
+                print(f"appmode: WARNING: {note}", file=sys.stderr)
+            if warning is not None:
+                lasts = (
+                    "the embedded board ends with this session"
+                    if session.simulated
+                    else "the board keeps it until it is switched off"
+                )
+                print(f"appmode: {warning}: {lasts}", file=sys.stderr)
+    return 1 if session.failures and not interactive else 0

@@ -1,0 +1,60 @@
+"""Script mode: `appmode drive` with stdin that is no TTY runs the console's commands
+line by line, and lets time pass with `wait`."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Iterable
+from typing import TextIO
+
+from appmode.console.panel import status_text
+from appmode.host.tokens import Wait
+from appmode.session.base import BaseSession, Quit, ShowHelp, ShowStatus, Step
+
+REFRESH = 0.02
+"""Seconds between reads of the link while time passes."""
+
+
+def run_script(
+    session: BaseSession, lines: Iterable[str], out: TextIO, keep_going: bool = False
+) -> None:
+    """Run commands line by line; `wait S` lets S seconds pass.
+
+    A parameter read or set finishes before the next line runs. The first error ends
+    the script, unless `keep_going`.
+    """
+    settle(session, 0.0)
+    for raw in lines:
+        if session.failures and not keep_going:
+            print(
+                "appmode: the script stopped at its first error (--keep-going runs on)",
+                file=sys.stderr,
+            )
+            break
+        try:
+            step = session.run(raw)
+        except Quit:
+            break  # run_drive names what was not saved
+        show(session, step)
+        settle(session, step.seconds if isinstance(step, Wait) else 0.0)
+    out.flush()
+
+
+def show(session: BaseSession, step: Step) -> None:
+    """What a command returned for the view: the panel for `status`, the help for
+    `help`, as messages."""
+    if isinstance(step, ShowStatus):
+        session.say(status_text(session))
+    elif isinstance(step, ShowHelp):
+        for text in session.help_lines():
+            session.say(text)
+
+
+def settle(session: BaseSession, seconds: float) -> None:
+    """Let `seconds` pass, and any parameter query end, reading the link meanwhile."""
+    end = time.monotonic() + seconds
+    session.tick()
+    while time.monotonic() < end or session.busy:
+        time.sleep(min(REFRESH, max(0.0, end - time.monotonic())) or REFRESH)
+        session.tick()
