@@ -36,7 +36,7 @@ if TYPE_CHECKING:
     from appmode.board.firmware import Board
     from appmode.host.client import Host
     from appmode.host.control_client import ControlHost
-    from appmode.ports.link import open_link
+    from appmode.ports.urls import open_link
     from appmode.protocol.app import BoardDecoder, HostDecoder, encode
     from appmode.protocol.transcript import (
         Recorder,
@@ -51,7 +51,7 @@ _WHERE = {
     "Board": "appmode.board.firmware",
     "Host": "appmode.host.client",
     "ControlHost": "appmode.host.control_client",
-    "open_link": "appmode.ports.link",
+    "open_link": "appmode.ports.urls",
     "BoardDecoder": "appmode.protocol.app",
     "HostDecoder": "appmode.protocol.app",
     "encode": "appmode.protocol.app",

@@ -16,7 +16,7 @@ import time
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-from appmode.protocol import app, control, settings
+from appmode.protocol import app, control, control_decoders, settings
 from appmode.protocol.app import RECORDS, Attitude, BoardDecoder, ParamsRecord, Velocity, encode
 
 
@@ -308,7 +308,7 @@ class ControlHostByteAtATime(_Gathering):
             if self.need:
                 buf.append(byte)
                 if len(buf) == self.need:
-                    self.events.append(control._parse(bytes(buf), 3))
+                    self.events.append(control_decoders._parse(bytes(buf), 3))
                     self.need = 0
                     buf.clear()
             elif len(buf) == 2:
@@ -363,8 +363,8 @@ def streams(size: int) -> dict[str, bytes]:
 DECODERS: dict[str, tuple[Callable[[], Any], Callable[[], Any]]] = {
     "APP board decoder": (BoardDecoder, SameEventsByteLoop),
     "APP host decoder": (app.HostDecoder, HostByteAtATime),
-    "UART2 board decoder": (control.BoardDecoder, ControlBoardByteAtATime),
-    "UART2 host decoder": (control.HostDecoder, ControlHostByteAtATime),
+    "UART2 board decoder": (control_decoders.ReplyDecoder, ControlBoardByteAtATime),
+    "UART2 host decoder": (control_decoders.FrameDecoder, ControlHostByteAtATime),
 }
 
 

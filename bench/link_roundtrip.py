@@ -16,7 +16,7 @@ import time
 from common import board, summary_ms
 
 import appmode  # noqa: F401 - registers sim://
-from appmode.ports.link import open_link
+from appmode.ports.urls import open_link
 from appmode.protocol.app import BoardDecoder, ParamsRecord
 
 SLOT = 0.05

@@ -15,7 +15,7 @@ import time
 from common import board, percentile
 
 from appmode.host.client import Host
-from appmode.ports.link import open_link
+from appmode.ports.urls import open_link
 from appmode.protocol.app import BoardDecoder, ParamsRecord
 
 

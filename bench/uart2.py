@@ -23,7 +23,7 @@ from contextlib import contextmanager
 import serial
 from common import percentile, share_and_floor
 
-from appmode.protocol import control
+from appmode.protocol import control, control_decoders
 from appmode.protocol.params import DriveType
 
 TICK = 0.010
@@ -62,8 +62,8 @@ def decoder_rows(size: int) -> list[tuple[str, str, str]]:
     board_stream = replies * (len(stream) // len(replies))
     rows = []
     for name, make, data in (
-        ("host→board", lambda: control.HostDecoder(DriveType.MECANUM), stream),
-        ("board→host", control.BoardDecoder, board_stream),
+        ("host→board", lambda: control_decoders.FrameDecoder(DriveType.MECANUM), stream),
+        ("board→host", control_decoders.ReplyDecoder, board_stream),
     ):
         start = time.perf_counter()
         decoder = make()

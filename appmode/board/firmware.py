@@ -24,7 +24,7 @@ from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
 from appmode.board.vehicle import YAW_GAIN, Vehicle, battery_percent, wrap_degrees
 from appmode.errors import AppmodeError
-from appmode.protocol import app, control, params, settings
+from appmode.protocol import app, control, control_decoders, params, settings
 from appmode.protocol.directions import PAGE_LETTERS, Page, motion_for, target_velocity
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
@@ -128,7 +128,7 @@ class Board:
         self._target_is: tuple[float, float, float] = (0.0, 0.0, 0.0)  # and what it was
         self._reads: list[settings.Read] = []
         self._out2 = bytearray()
-        self._frames = control.HostDecoder(self.drive_type)
+        self._frames = control_decoders.FrameDecoder(self.drive_type)
         self._app2 = app.HostDecoder()
         self._intake2 = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
         self._control_intake = ControlIntake()
@@ -339,7 +339,7 @@ class Board:
             name = control.MODES.get(mode, f"mode {mode:02X}")
             self._note(now, "rejected", f"{shown}: {name} frame: no effect (§13.1)", UART2)
             return
-        event = control.HostDecoder().feed(frame)[0]
+        event = control_decoders.FrameDecoder().feed(frame)[0]
         assert isinstance(event, control.VelocityFrame), "control_modes holds only 01 here"
         self._command = event
         self._note(now, "applied", f"{shown}: velocity {event.values}, as it is (§13.1)", UART2)

@@ -61,7 +61,7 @@ WARNING = (
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.ports.link import is_simulated
+    from appmode.ports.urls import is_simulated
     from appmode.transcript.runner import run_conform
 
     if args.board and not is_simulated(args.board) and not args.yes:

@@ -103,7 +103,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from appmode.console.driving import run_drive
-    from appmode.ports.link import is_simulated  # here: start-up stays short
+    from appmode.ports.urls import is_simulated  # here: start-up stays short
     from appmode.session.app_session import Session
     from appmode.session.control_session import ControlSession
     from appmode.session.hold import HoldToDrive

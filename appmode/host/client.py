@@ -18,8 +18,8 @@ from appmode.host.query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, Q
 from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.stop_check import SETTLE, StopCheck
 from appmode.line.wire import UART2, Tap
-from appmode.ports.link import is_simulated, open_link
 from appmode.ports.sim import sim_side
+from appmode.ports.urls import is_simulated, open_link
 from appmode.protocol import app, params
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, ALayout

@@ -31,8 +31,8 @@ from appmode.host.link import Link, LinkLost
 from appmode.host.query import TRIES, QueryFailed
 from appmode.host.state import LinkStatus
 from appmode.line.wire import UART2_BAUD, Tap
-from appmode.ports.link import is_simulated, open_link
 from appmode.ports.sim import sim_side
+from appmode.ports.urls import is_simulated, open_link
 from appmode.protocol import control, params, reader, settings
 from appmode.protocol.params import DriveType
 

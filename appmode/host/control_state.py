@@ -13,7 +13,7 @@ from __future__ import annotations
 from appmode.host.control_query import ControlOutcome, ReadDone, ReadQuery
 from appmode.host.query import QueryFailed
 from appmode.host.state import LinkStats
-from appmode.protocol import app, control, params
+from appmode.protocol import app, control, control_decoders, params
 from appmode.protocol.params import DriveType
 
 TAKEOVER_BYTE = 10
@@ -31,8 +31,8 @@ class ControlState:
         self.drive = drive
         """The board's drive type: told, or learnt from a system_mode read or sent."""
         self.takeover_byte = takeover_byte
-        self.decoder = control.BoardDecoder(None)
-        self.sent_decoder = control.HostDecoder(drive or DriveType.OMNI)
+        self.decoder = control_decoders.ReplyDecoder(None)
+        self.sent_decoder = control_decoders.FrameDecoder(drive or DriveType.OMNI)
         """What was sent, decoded as the board does: is a frame left open?"""
         self.stats = LinkStats()
         self.report: control.EncoderReport | None = None
@@ -99,7 +99,7 @@ class ControlState:
 
     def reset_decoder(self) -> None:
         """Forget a partial reply or report (after the link was lost)."""
-        self.decoder = control.BoardDecoder(None, self.decoder.app_mode)
+        self.decoder = control_decoders.ReplyDecoder(None, self.decoder.app_mode)
 
     def _apply(self, events: list[control.BoardEvent], now: float) -> list[Received]:
         out: list[Received] = []

@@ -20,7 +20,7 @@ from appmode.host import signals
 from appmode.host.state import LinkStatus
 from appmode.line.pacing import Ahead
 from appmode.line.wire import Tap
-from appmode.ports.link import is_network
+from appmode.ports.urls import is_network
 
 RETRY = 0.5
 CHUNK = 64

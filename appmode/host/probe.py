@@ -25,8 +25,8 @@ from appmode.board.profiles import PROFILES, Profile
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.line.wire import APP_BAUD, UART2_BAUD
-from appmode.ports.link import is_simulated, open_link, parse_device
-from appmode.protocol import app, control, params
+from appmode.ports.urls import is_simulated, open_link, parse_device
+from appmode.protocol import app, control, control_decoders, params
 from appmode.protocol.escaping import text_part
 
 RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
@@ -103,7 +103,7 @@ class Heard:
         data: bytes,
         at: float,
         app_decoder: app.BoardDecoder,
-        uart2_decoder: control.BoardDecoder,
+        uart2_decoder: control_decoders.ReplyDecoder,
     ) -> None:
         """Count what `data`, come at `at` s, holds."""
         self.size += len(data)
@@ -191,7 +191,7 @@ def listen(
     its start-up text); the port stays open for a read that follows."""
     port = open_link(url, timeout=0.02, baud=baud)
     heard = Heard(baud)
-    app_decoder, uart2_decoder = app.BoardDecoder(), control.BoardDecoder(wheels=None)
+    app_decoder, uart2_decoder = app.BoardDecoder(), control_decoders.ReplyDecoder(wheels=None)
     start = time.monotonic()
     try:
         while not stop.is_set():

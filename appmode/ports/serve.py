@@ -34,7 +34,7 @@ from appmode.files import temporary_beside
 from appmode.line.faults import Faults, FaultSpec
 from appmode.line.uart import misread
 from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
-from appmode.ports.link import BAUD, NO_PTY, explain_open_error, parse_device
+from appmode.ports.urls import BAUD, NO_PTY, explain_open_error, parse_device
 from appmode.protocol import app, params
 from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder

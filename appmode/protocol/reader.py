@@ -8,7 +8,7 @@ system_mode setting), from the moment it is sent, and decodes every direction.
 
 from __future__ import annotations
 
-from appmode.protocol import app, control, params
+from appmode.protocol import app, control, control_decoders, params
 from appmode.protocol.params import DriveType
 
 SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
@@ -21,8 +21,8 @@ class PortsReader:
     def __init__(self, system_mode: int = 0, drive: DriveType | None = None) -> None:
         self.host = app.HostDecoder()
         self.board = app.BoardDecoder()
-        self.host2 = control.HostDecoder()
-        self.board2 = control.BoardDecoder()
+        self.host2 = control_decoders.FrameDecoder()
+        self.board2 = control_decoders.ReplyDecoder()
         self.app_mode = False
         self.follow(system_mode if drive is None else system_mode & ~7 | int(drive))
 

@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, ClassVar
 
 from appmode.errors import AppmodeError
 from appmode.host.tokens import Wait, parse_token
-from appmode.ports.link import is_simulated
 from appmode.ports.sim import sim_directives
+from appmode.ports.urls import is_simulated
 from appmode.protocol.transcript import Recorder
 from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped

@@ -180,7 +180,7 @@ def appmode_sim_url(request: pytest.FixtureRequest) -> str:
     real = _real(request.config, options)
     if real is not None:
         return real.port
-    import appmode.ports.link  # noqa: F401 - registers sim:// with pyserial
+    import appmode.ports.urls  # noqa: F401 - registers sim:// with pyserial
 
     query = {k: v for k, v in options.items() if v not in (None, "")}
     if "pace" in query:

@@ -19,7 +19,7 @@ import serial
 
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
-from appmode.ports.link import new_pty, open_link
+from appmode.ports.urls import new_pty, open_link
 from appmode.ports.wakeups import exact_wakeups
 from appmode.protocol.app import BoardDecoder, HostDecoder
 from appmode.protocol.render import describe, line

@@ -24,7 +24,7 @@ from appmode.host.client import Host
 from appmode.host.link import LinkLost
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
-from appmode.ports.link import is_simulated, open_link
+from appmode.ports.urls import is_simulated, open_link
 from appmode.protocol import app, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript

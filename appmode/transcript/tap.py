@@ -16,7 +16,7 @@ from typing import Protocol
 import serial
 
 from appmode.line.pacing import Ahead
-from appmode.ports.link import new_pty, open_link
+from appmode.ports.urls import new_pty, open_link
 from appmode.protocol.app import SessionEnd
 from appmode.protocol.transcript import Recorder
 

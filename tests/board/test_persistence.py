@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 import serial
 
-import appmode.ports.link  # noqa: F401 - registers sim://
+import appmode.ports.urls  # noqa: F401 - registers sim://
 from appmode.board.store import JsonFileStore, open_store
 from appmode.errors import AppmodeError
 from appmode.protocol import params

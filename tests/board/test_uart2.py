@@ -5,14 +5,14 @@ from __future__ import annotations
 from appmode.board.firmware import Board
 from appmode.board.profiles import MINIBALANCE
 from appmode.board.store import MemoryStore
-from appmode.protocol import app, control, params, settings
+from appmode.protocol import app, control, control_decoders, params, settings
 from appmode.protocol.control import MotorFrame, PositionFrame, SetSetting, encode
 from appmode.protocol.params import DriveType
 
 
 def replies(board: Board, now: float) -> dict[str, int]:
     wheels = control.motor_count(board.drive_type)
-    events = control.BoardDecoder(wheels).feed(board.poll_uart2(now))
+    events = control_decoders.ReplyDecoder(wheels).feed(board.poll_uart2(now))
     return {e.name: e.value for e in events if isinstance(e, control.Reply)}
 
 
@@ -223,7 +223,7 @@ def test_s12_encoder_report_every_50_ms_while_bit_6_is_set() -> None:
     board = Board(drive=DriveType.MECANUM)
     board.receive_uart2(encode(control.velocity(DriveType.MECANUM, y=200)), 0.0)
     set_setting(board, "system_mode", 1 | params.MODE_BIT["encoder_report"], 0.0)
-    events = control.BoardDecoder(4).feed(board.poll_uart2(2.0))
+    events = control_decoders.ReplyDecoder(4).feed(board.poll_uart2(2.0))
     reports = [e for e in events if isinstance(e, control.EncoderReport)]
     assert len(reports) == 40
     assert reports[-1].targets == (200, 200, 200, 200) == reports[-1].actuals

@@ -8,7 +8,7 @@ from appmode.errors import AppmodeError
 from appmode.host.control_query import ReadDone, ReadQuery, rotation_done
 from appmode.host.control_state import ControlState
 from appmode.host.query import QueryFailed
-from appmode.protocol import control, settings
+from appmode.protocol import control, control_decoders, settings
 
 
 def reply(name: str, value: int) -> control.Reply:
@@ -16,7 +16,7 @@ def reply(name: str, value: int) -> control.Reply:
 
 
 def frames(data: bytes) -> list[object]:
-    return control.HostDecoder(control.DriveType.MECANUM).feed(data)
+    return control_decoders.FrameDecoder(control.DriveType.MECANUM).feed(data)
 
 
 def test_a_read_is_sent_twice_at_once_and_reported_when_the_replies_agree() -> None:

@@ -12,8 +12,8 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.state import HostState
 from appmode.line.faults import Faults, FaultSpec, FaultyPort
-from appmode.ports.link import open_link
 from appmode.ports.sim import SimSerial
+from appmode.ports.urls import open_link
 from appmode.protocol import params
 from tests.support.processes import board_process, run
 

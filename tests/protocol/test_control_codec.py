@@ -13,10 +13,8 @@ from hypothesis import strategies as st
 from appmode.protocol import control, settings
 from appmode.protocol.control import (
     BadFrame,
-    BoardDecoder,
     EncoderReport,
     Garbage,
-    HostDecoder,
     MotorFrame,
     PositionFrame,
     Reply,
@@ -26,6 +24,7 @@ from appmode.protocol.control import (
     VelocityFrame,
     encode,
 )
+from appmode.protocol.control_decoders import FrameDecoder, ReplyDecoder
 from appmode.protocol.params import DriveType
 from tests.support.decoders import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
@@ -52,25 +51,25 @@ def test_s8_2_a_value_holding_ff_fe_does_not_split_the_frame() -> None:
     frame = VelocityFrame(0xFFFE, 0xFFFE, 0xFFFE)
     raw = encode(frame)
     assert raw.count(control.HEADER) == 4
-    assert assert_split_invariant(HostDecoder, raw) == [frame]
+    assert assert_split_invariant(FrameDecoder, raw) == [frame]
 
 
 def test_s8_2_unknown_mode_is_three_bytes_of_garbage_then_resync() -> None:
     velocity = encode(control.velocity(DriveType.OMNI, y=5))
-    events = assert_split_invariant(HostDecoder, hexes("FF FE 07") + velocity)
+    events = assert_split_invariant(FrameDecoder, hexes("FF FE 07") + velocity)
     assert events == [Garbage(hexes("FF FE 07"), "unknown mode 07"), VelocityFrame(0, 5, 0)]
 
 
 def test_s8_2_bytes_outside_frames_are_reported_not_dropped() -> None:
     velocity = encode(control.velocity(DriveType.OMNI, y=5))
-    events = assert_split_invariant(HostDecoder, b"noise\xff" + velocity + b"\xfe")
+    events = assert_split_invariant(FrameDecoder, b"noise\xff" + velocity + b"\xfe")
     assert [type(e) for e in events] == [Garbage, VelocityFrame, Garbage]
     assert events[0].raw == b"noise\xff"
 
 
 def test_s8_2_a_truncated_frame_at_the_end_is_reported() -> None:
     velocity = encode(control.velocity(DriveType.OMNI, y=5))
-    assert decode_whole(HostDecoder, velocity[:7]) == [
+    assert decode_whole(FrameDecoder, velocity[:7]) == [
         Garbage(velocity[:7], "truncated frame at end of stream")
     ]
 
@@ -79,9 +78,9 @@ def test_s8_2_the_motor_frame_length_follows_the_drive_type() -> None:
     three = encode(MotorFrame((100, -200, 300)))
     four = encode(MotorFrame((100, -200, 300, -400)))
     assert len(three) == 10 and len(four) == 12
-    assert decode_whole(HostDecoder, three) == [MotorFrame((100, -200, 300))]
+    assert decode_whole(FrameDecoder, three) == [MotorFrame((100, -200, 300))]
     for drive in (DriveType.MECANUM, DriveType.DIFF, DriveType.DIFF_GYRO):
-        make = partial(HostDecoder, drive)
+        make = partial(FrameDecoder, drive)
         assert assert_split_invariant(make, four) == [MotorFrame((100, -200, 300, -400))]
 
 
@@ -94,7 +93,7 @@ def test_s9_1_velocity_direction_bits_x2_y1_z0() -> None:
     assert encode(control.velocity(DriveType.MECANUM, -1, 2, -3)) == hexes(
         "FF FE 01 00 01 00 02 00 03 05"
     )
-    assert decode_whole(HostDecoder, hexes("FF FE 01 01 F4 00 C8 00 64 07")) == [
+    assert decode_whole(FrameDecoder, hexes("FF FE 01 01 F4 00 C8 00 64 07")) == [
         VelocityFrame(-500, -200, -100)
     ]
 
@@ -102,7 +101,7 @@ def test_s9_1_velocity_direction_bits_x2_y1_z0() -> None:
 def test_s9_1_angle_mode_sets_bit_4_and_carries_the_angle_in_tenths() -> None:
     frame = control.velocity(DriveType.OMNI, angle=-900)
     assert encode(frame) == hexes("FF FE 01 00 00 00 00 03 84 11")
-    assert decode_whole(HostDecoder, encode(frame)) == [VelocityFrame(0, 0, -900, angle=True)]
+    assert decode_whole(FrameDecoder, encode(frame)) == [VelocityFrame(0, 0, -900, angle=True)]
 
 
 def test_s9_1_diff_takes_duties_and_diff_gyro_left_and_right() -> None:
@@ -127,7 +126,7 @@ def test_s9_2_motor_bits_four_motors_bit_3_is_motor_4() -> None:
 def test_s9_3_position_frame() -> None:
     raw = encode(PositionFrame(100, -200, 0))
     assert raw == hexes("FF FE 03 00 64 00 C8 00 00 02")
-    assert decode_whole(HostDecoder, raw) == [PositionFrame(100, -200, 0)]
+    assert decode_whole(FrameDecoder, raw) == [PositionFrame(100, -200, 0)]
 
 
 @pytest.mark.parametrize("setting", settings.SETTINGS, ids=lambda s: s.name)
@@ -135,7 +134,7 @@ def test_s10_every_setting_encodes_and_decodes(setting: settings.Setting) -> Non
     value = min(setting.maximum, 1234)
     raw = encode(SetSetting(setting, value))
     assert raw == hexes(f"FF FE 80 80 {setting.id:02X}") + value.to_bytes(4, "big") + b"\0"
-    assert decode_whole(HostDecoder, raw) == [SetSetting(setting, value)]
+    assert decode_whole(FrameDecoder, raw) == [SetSetting(setting, value)]
 
 
 def test_s10_out_of_range_values_raise_and_decode_as_bad_frames() -> None:
@@ -144,7 +143,7 @@ def test_s10_out_of_range_values_raise_and_decode_as_bad_frames() -> None:
     with pytest.raises(ValueError, match="drive type 5"):
         encode(SetSetting(settings.BY_NAME["system_mode"], 5))
     raw = hexes("FF FE 80 80 01 00 01 00 00 00")
-    [event] = decode_whole(HostDecoder, raw)
+    [event] = decode_whole(FrameDecoder, raw)
     assert isinstance(event, BadFrame) and "must be in 0–65535, not 65536" in event.reason
 
 
@@ -152,8 +151,8 @@ def test_s10_load_defaults_save() -> None:
     for name, code in (("load", 1), ("defaults", 2), ("save", 3)):
         raw = encode(control.store(name))
         assert raw == hexes(f"FF FE 80 80 00 80 00 00 {code:02X} 00")
-        assert decode_whole(HostDecoder, raw) == [StoreFrame(settings.STORE_BY_NAME[name])]
-    [bad] = decode_whole(HostDecoder, hexes("FF FE 80 80 00 80 00 00 04 00"))
+        assert decode_whole(FrameDecoder, raw) == [StoreFrame(settings.STORE_BY_NAME[name])]
+    [bad] = decode_whole(FrameDecoder, hexes("FF FE 80 80 00 80 00 00 04 00"))
     assert isinstance(bad, BadFrame)
 
 
@@ -164,13 +163,13 @@ def test_s11_reads_and_their_reply_ids() -> None:
     assert settings.read_named("pending_angle").reply_id == 0x20
     assert [settings.read_named(f"speed_{w}").ss for w in "abcd"] == [0x21, 0x22, 0x23, 0x24]
     assert [settings.read_named(f"position_{w}").ss for w in "abcd"] == [0x25, 0x26, 0x27, 0x28]
-    [unknown] = decode_whole(HostDecoder, hexes("FF FE 80 80 30 00 00 00 00 00"))
+    [unknown] = decode_whole(FrameDecoder, hexes("FF FE 80 80 30 00 00 00 00 00"))
     assert isinstance(unknown, BadFrame) and "SS 30" in unknown.reason
 
 
 def test_s11_replies_unsigned_for_settings_signed_for_encoders() -> None:
     data = hexes("23 01 00 00 01 F4 23 21 FF FF FF 9C 23 20 FF FF FC 7C")
-    events = assert_split_invariant(BoardDecoder, data)
+    events = assert_split_invariant(ReplyDecoder, data)
     assert [(e.name, e.value) for e in events] == [
         ("max_speed", 500),
         ("speed_a", -100),
@@ -184,20 +183,20 @@ def test_s12_encoder_report_34_bytes_or_26_on_an_omni() -> None:
     three = EncoderReport((1, 2, 3), (-1, -2, -3))
     assert len(encode(four)) == 34 and len(encode(three)) == 26
     assert encode(four)[0] == 0x24 and encode(four)[-1] == 0x19
-    assert assert_split_invariant(BoardDecoder, encode(four)) == [four]
-    assert assert_split_invariant(partial(BoardDecoder, 3), encode(three)) == [three]
+    assert assert_split_invariant(ReplyDecoder, encode(four)) == [four]
+    assert assert_split_invariant(partial(ReplyDecoder, 3), encode(three)) == [three]
 
 
 def test_s12_a_report_without_its_end_byte_is_garbage() -> None:
     bad = encode(EncoderReport((1, 2, 3, 4), (5, 6, 7, 8)))[:-1] + b"\x00"
-    events = decode_whole(BoardDecoder, bad + encode(Reply(1, 500)))
+    events = decode_whole(ReplyDecoder, bad + encode(Reply(1, 500)))
     assert events[-1] == Reply(1, 500)
     assert all(isinstance(e, Garbage) for e in events[:-1])
     assert b"".join(e.raw for e in events) == bad + encode(Reply(1, 500))
 
 
 def test_s12_app_mode_decodes_app_records() -> None:
-    decoder = BoardDecoder(app_mode=True)
+    decoder = ReplyDecoder(app_mode=True)
     [record] = decoder.feed(b"{A0:200:0:100}$")
     assert (record.x, record.y) == (0, 200)
     assert decoder.set_app_mode(False) == []
@@ -209,14 +208,14 @@ def test_host_decoder_never_raises_bounded_and_every_byte_in_one_event(
     data: bytes, cuts: list[int]
 ) -> None:
     data = data + encode(control.velocity(DriveType.OMNI, 1, 2, 3)) + data
-    assert_any_bytes_ok(partial(HostDecoder, DriveType.MECANUM), data, cuts)
+    assert_any_bytes_ok(partial(FrameDecoder, DriveType.MECANUM), data, cuts)
 
 
 @given(st.binary(max_size=200), st.lists(st.integers(1, 40), max_size=10))
 def test_board_decoder_never_raises_bounded_and_every_byte_in_one_event(
     data: bytes, cuts: list[int]
 ) -> None:
-    assert_any_bytes_ok(BoardDecoder, data, cuts, BoardDecoder().limit)
+    assert_any_bytes_ok(ReplyDecoder, data, cuts, ReplyDecoder().limit)
 
 
 @pytest.mark.parametrize(
@@ -231,7 +230,7 @@ def test_board_decoder_never_raises_bounded_and_every_byte_in_one_event(
     ids=["random", "ff", "headers", "hashes", "dollars"],
 )
 def test_a_megabyte_of_garbage_decodes_in_linear_time(data: bytes) -> None:
-    for make in (HostDecoder, BoardDecoder):
+    for make in (FrameDecoder, ReplyDecoder):
         start = time.perf_counter()
         decoder = make()
         events = [*decoder.feed(data), *decoder.flush()]
@@ -241,15 +240,15 @@ def test_a_megabyte_of_garbage_decodes_in_linear_time(data: bytes) -> None:
 
 def test_a_run_of_ff_is_garbage_in_bounded_runs_and_its_last_ff_may_start_a_burst() -> None:
     tail = b"\xff\x00\x00" + encode(Reply(1, 5))
-    events = assert_split_invariant(BoardDecoder, b"\xff" * 69 + tail)
+    events = assert_split_invariant(ReplyDecoder, b"\xff" * 69 + tail)
     assert [len(e.raw) for e in events] == [64, 5, 3, 6]
     assert [type(e) for e in events] == [Garbage, Garbage, Status, Reply]
-    assert decode_whole(BoardDecoder, b"\xff" * 3)[-1] == Status(b"\xff")
+    assert decode_whole(ReplyDecoder, b"\xff" * 3)[-1] == Status(b"\xff")
 
 
 def test_a_flood_of_24_is_garbage_in_bounded_runs_and_a_report_after_it_decodes() -> None:
     report = EncoderReport((1, 2, 3, 4), (5, 6, 7, 8))
-    events = assert_split_invariant(BoardDecoder, b"$" * 100 + encode(report))
+    events = assert_split_invariant(ReplyDecoder, b"$" * 100 + encode(report))
     assert events[-1] == report
     assert all(isinstance(e, Garbage) and len(e.raw) <= 64 for e in events[:-1])
 
@@ -262,15 +261,15 @@ def test_runs_of_the_protocols_own_bytes_keep_every_byte_in_one_event(
     data: bytes, cuts: list[int]
 ) -> None:
     for wheels in (4, 3, None):
-        make = partial(BoardDecoder, wheels)
-        assert_any_bytes_ok(make, data, cuts, limit=BoardDecoder(wheels).limit)
+        make = partial(ReplyDecoder, wheels)
+        assert_any_bytes_ok(make, data, cuts, limit=ReplyDecoder(wheels).limit)
 
 
 @pytest.mark.parametrize("wheels", [3, 4])
 def test_s12_a_report_of_either_length_decodes_without_its_wheel_count(wheels: int) -> None:
     report = EncoderReport(tuple(range(-wheels, 0)), tuple(range(100, 100 + wheels)))
     data = encode(report) + encode(Reply(1, 500)) + encode(report)
-    events = assert_split_invariant(partial(BoardDecoder, None), data)
+    events = assert_split_invariant(partial(ReplyDecoder, None), data)
     assert [type(e) for e in events] == [EncoderReport, Reply, EncoderReport]
     assert events[0].targets == report.targets and events[2].actuals == report.actuals
 
@@ -279,7 +278,7 @@ def test_s12_a_report_of_either_length_decodes_without_its_wheel_count(wheels: i
 def test_the_report_length_finder_keeps_every_byte_in_one_event(
     data: bytes, cuts: list[int]
 ) -> None:
-    assert_any_bytes_ok(partial(BoardDecoder, None), data, cuts, limit=BoardDecoder(None).limit)
+    assert_any_bytes_ok(partial(ReplyDecoder, None), data, cuts, limit=ReplyDecoder(None).limit)
 
 
 @pytest.mark.parametrize(
@@ -293,7 +292,7 @@ def test_the_report_length_finder_keeps_every_byte_in_one_event(
     ],
 )
 def test_rest_completes_an_open_frame_so_the_next_is_read_whole(sent: str, rest: str) -> None:
-    decoder = HostDecoder(DriveType.MECANUM)
+    decoder = FrameDecoder(DriveType.MECANUM)
     decoder.feed(bytes.fromhex(sent))
     assert decoder.rest() == bytes.fromhex(rest)
     after = decoder.feed(decoder.rest() + control.STOP)
