@@ -37,7 +37,8 @@ if TYPE_CHECKING:
     from appmode.host.client import Host
     from appmode.host.control_client import ControlHost
     from appmode.ports.urls import open_link
-    from appmode.protocol.app import BoardDecoder, HostDecoder, encode
+    from appmode.protocol.app import encode
+    from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
     from appmode.protocol.transcript import (
         Recorder,
         TranscriptError,
@@ -52,8 +53,8 @@ _WHERE = {
     "Host": "appmode.host.client",
     "ControlHost": "appmode.host.control_client",
     "open_link": "appmode.ports.urls",
-    "BoardDecoder": "appmode.protocol.app",
-    "HostDecoder": "appmode.protocol.app",
+    "BoardDecoder": "appmode.protocol.app_decoders",
+    "HostDecoder": "appmode.protocol.app_decoders",
     "encode": "appmode.protocol.app",
     "Recorder": "appmode.protocol.transcript",
     "TranscriptError": "appmode.protocol.transcript",

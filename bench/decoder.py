@@ -16,8 +16,9 @@ import time
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-from appmode.protocol import app, control, control_decoders, settings
-from appmode.protocol.app import RECORDS, Attitude, BoardDecoder, ParamsRecord, Velocity, encode
+from appmode.protocol import app, app_decoders, control, control_decoders, settings
+from appmode.protocol.app import RECORDS, Attitude, ParamsRecord, Velocity, encode
+from appmode.protocol.app_decoders import BoardDecoder
 
 
 def make_stream(size: int, noise: float, seed: int = 1) -> tuple[bytes, int]:
@@ -134,7 +135,7 @@ class SameEventsByteLoop:
                 if len(record) == 1:
                     self.braces += 1
                 else:
-                    reason = app._interrupted("record", 1)
+                    reason = app_decoders._interrupted("record", 1)
                     self.events.append(app.Malformed(bytes(record), reason))
                     self.record = bytearray(b"{")
                 continue
@@ -159,7 +160,9 @@ class SameEventsByteLoop:
     def _brace_run(self) -> None:
         while self.braces:
             count = min(self.braces, app.MAX_RUN)
-            self.events.append(app.Malformed(b"{" * count, app._interrupted("record", count)))
+            self.events.append(
+                app.Malformed(b"{" * count, app_decoders._interrupted("record", count))
+            )
             self.braces -= count
 
     def _garbage(self) -> None:
@@ -168,7 +171,7 @@ class SameEventsByteLoop:
             self.garbage.clear()
 
     def _record(self, raw: bytes, terminated: bool) -> None:
-        self.events.append(app._parse_record(raw, raw[1 : raw.index(b"}")], terminated))
+        self.events.append(app_decoders._parse_record(raw, raw[1 : raw.index(b"}")], terminated))
 
 
 def timed(run: object) -> tuple[float, int]:
@@ -220,7 +223,7 @@ def garbage_inputs(megabytes: float = GARBAGE_MB) -> dict[str, bytes]:
 def garbage(megabytes: float = GARBAGE_MB, chunk: int = 4096) -> dict[str, float]:
     """MB/s of BoardDecoder and HostDecoder on each garbage input, fed in chunks: linear
     decoding keeps these near the clean stream's figure."""
-    from appmode.protocol.app import HostDecoder
+    from appmode.protocol.app_decoders import HostDecoder
 
     rates = {}
     for name, data in garbage_inputs(megabytes).items():
@@ -253,12 +256,12 @@ class HostByteAtATime:
             elif frame is not None:
                 frame.append(byte)
                 if byte == 0x7D:
-                    self.events.append(app._parse_frame(bytes(frame)))
+                    self.events.append(app_decoders._parse_frame(bytes(frame)))
                     self.frame = None
                 elif len(frame) > app.MAX_FRAME:
                     self.frame = None
             else:
-                self.events.append(app.SINGLE_BYTE[byte])
+                self.events.append(app_decoders.SINGLE_BYTE[byte])
 
 
 class _Gathering:
@@ -362,7 +365,7 @@ def streams(size: int) -> dict[str, bytes]:
 
 DECODERS: dict[str, tuple[Callable[[], Any], Callable[[], Any]]] = {
     "APP board decoder": (BoardDecoder, SameEventsByteLoop),
-    "APP host decoder": (app.HostDecoder, HostByteAtATime),
+    "APP host decoder": (app_decoders.HostDecoder, HostByteAtATime),
     "UART2 board decoder": (control_decoders.ReplyDecoder, ControlBoardByteAtATime),
     "UART2 host decoder": (control_decoders.FrameDecoder, ControlHostByteAtATime),
 }

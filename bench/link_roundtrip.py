@@ -17,7 +17,8 @@ from common import board, summary_ms
 
 import appmode  # noqa: F401 - registers sim://
 from appmode.ports.urls import open_link
-from appmode.protocol.app import BoardDecoder, ParamsRecord
+from appmode.protocol.app import ParamsRecord
+from appmode.protocol.app_decoders import BoardDecoder
 
 SLOT = 0.05
 

@@ -25,7 +25,8 @@ from common import percentile
 from appmode.board.firmware import Board
 from appmode.board.profiles import SHEET
 from appmode.ports.serve import BoardServer, _pty, switched_on
-from appmode.protocol.app import RECORDS, BoardDecoder
+from appmode.protocol.app import RECORDS
+from appmode.protocol.app_decoders import BoardDecoder
 
 
 def serve(count: int) -> None:

@@ -16,7 +16,8 @@ from common import board, percentile
 
 from appmode.host.client import Host
 from appmode.ports.urls import open_link
-from appmode.protocol.app import BoardDecoder, ParamsRecord
+from appmode.protocol.app import ParamsRecord
+from appmode.protocol.app_decoders import BoardDecoder
 
 
 def round_trips(url: str, trials: int) -> list[float]:

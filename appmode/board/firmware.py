@@ -24,7 +24,7 @@ from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
 from appmode.board.vehicle import YAW_GAIN, Vehicle, battery_percent, wrap_degrees
 from appmode.errors import AppmodeError
-from appmode.protocol import app, control, control_decoders, params, settings
+from appmode.protocol import app, app_decoders, control, control_decoders, params, settings
 from appmode.protocol.directions import PAGE_LETTERS, Page, motion_for, target_velocity
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
@@ -114,7 +114,7 @@ class Board:
         self._c_pending = False
         self._c_on_wire_until = -math.inf
         self._outbox = bytearray()
-        self._decoder = app.HostDecoder()
+        self._decoder = app_decoders.HostDecoder()
         self._intake = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
         # the control port (§8–§12)
         self.uart2_control = False
@@ -129,7 +129,7 @@ class Board:
         self._reads: list[settings.Read] = []
         self._out2 = bytearray()
         self._frames = control_decoders.FrameDecoder(self.drive_type)
-        self._app2 = app.HostDecoder()
+        self._app2 = app_decoders.HostDecoder()
         self._intake2 = FirmwareIntake(profile.steer_in_frames, profile.frame_restarts)
         self._control_intake = ControlIntake()
         self._last_frame: bytes | None = None  # UART2's last frame, not yet taken

@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 
 from appmode.board.chip import float32
-from appmode.protocol import app, control
+from appmode.protocol import app, app_decoders, control
 
 INT_PARAMS = (0, 1)
 """max_speed and max_position, which the firmware keeps as `int` (the others as floats)."""
@@ -41,7 +41,9 @@ class Steer:
     framed: bool
 
 
-_STEER = tuple(tuple(Steer(event, framed) for event in app.SINGLE_BYTE) for framed in (False, True))
+_STEER = tuple(
+    tuple(Steer(event, framed) for event in app_decoders.SINGLE_BYTE) for framed in (False, True)
+)
 
 
 def frame_value(digits: bytes) -> float:

@@ -20,9 +20,9 @@ CHUNK = 65536
 
 def decode_chunks(chunks: Iterable[bytes], source: str) -> Iterator[app.Event]:
     """Events of a stream from the host (`host`) or the board (`board`)."""
-    from appmode.protocol import app
+    from appmode.protocol import app_decoders
 
-    decoder = app.HostDecoder() if source == "host" else app.BoardDecoder()
+    decoder = app_decoders.HostDecoder() if source == "host" else app_decoders.BoardDecoder()
     for chunk in chunks:
         yield from decoder.feed(chunk)
     yield from decoder.flush()

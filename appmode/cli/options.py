@@ -94,7 +94,7 @@ def profile_for(url: str | None, name: str | None) -> Profile:
 
 def stop_again_for(url: str | None, name: str | None) -> bytes:
     """What a host sends when its stop did not take, on `profile_for(url, name)`."""
-    from appmode.protocol.app import stop_again
+    from appmode.protocol.session_end import stop_again
 
     return stop_again(frames_take_letters=not profile_for(url, name).steer_in_frames)
 

@@ -104,7 +104,7 @@ def run_send(
     stops this board's car (§13)."""
     from appmode.cli.hostio import open_host, show
     from appmode.host.tokens import Wait, parse_token
-    from appmode.protocol.app import HostDecoder
+    from appmode.protocol.app_decoders import HostDecoder
 
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:

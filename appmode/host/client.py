@@ -20,7 +20,7 @@ from appmode.host.stop_check import SETTLE, StopCheck
 from appmode.line.wire import UART2, Tap
 from appmode.ports.sim import sim_side
 from appmode.ports.urls import is_simulated, open_link
-from appmode.protocol import app, params
+from appmode.protocol import app, params, session_end
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import motion_text
@@ -46,7 +46,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         stop_on_close: bool = True,
         layout: ALayout = VELOCITY,
         confirm_stop: bool = False,
-        stop_again: bytes = app.stop_again(frames_take_letters=True),
+        stop_again: bytes = session_end.stop_again(frames_take_letters=True),
         frames_stop: bool = False,
     ) -> None:
         if is_simulated(url) and sim_side(url) == UART2:
@@ -60,7 +60,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         self.confirm_stop = confirm_stop
         """Check on the board's A records that the final stop took (`_confirm`)."""
         self.stop_again = stop_again
-        """What to send when it did not (`app.stop_again` for the board's profile)."""
+        """What to send when it did not (`session_end.stop_again` for the board's profile)."""
         self.notes: list[str] = []
         """What closing had to do beyond its stop, for people."""
 

@@ -26,7 +26,7 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.line.wire import APP_BAUD, UART2_BAUD
 from appmode.ports.urls import is_simulated, open_link, parse_device
-from appmode.protocol import app, control, control_decoders, params
+from appmode.protocol import app, app_decoders, control, control_decoders, params
 from appmode.protocol.escaping import text_part
 
 RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
@@ -102,7 +102,7 @@ class Heard:
         self,
         data: bytes,
         at: float,
-        app_decoder: app.BoardDecoder,
+        app_decoder: app_decoders.BoardDecoder,
         uart2_decoder: control_decoders.ReplyDecoder,
     ) -> None:
         """Count what `data`, come at `at` s, holds."""
@@ -191,7 +191,10 @@ def listen(
     its start-up text); the port stays open for a read that follows."""
     port = open_link(url, timeout=0.02, baud=baud)
     heard = Heard(baud)
-    app_decoder, uart2_decoder = app.BoardDecoder(), control_decoders.ReplyDecoder(wheels=None)
+    app_decoder, uart2_decoder = (
+        app_decoders.BoardDecoder(),
+        control_decoders.ReplyDecoder(wheels=None),
+    )
     start = time.monotonic()
     try:
         while not stop.is_set():

@@ -11,7 +11,7 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from appmode.host.query import Outcome, ParamQuery, QueryFailed
-from appmode.protocol import app, params
+from appmode.protocol import app, app_decoders, params, session_end
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.render import motion_text
 from appmode.text import counted
@@ -116,7 +116,7 @@ class HostState:
         """How the board's A records are laid out (§3.1, §13)."""
         self.frames_stop = frames_stop
         """Every frame sent stops the car (a minibalance board: its `{` steers, §13)."""
-        self.decoder = app.BoardDecoder()
+        self.decoder = app_decoders.BoardDecoder()
         self.in_step = False
         """A record has come since the link opened: undecodable bytes are errors now."""
         self.stats = LinkStats()
@@ -128,7 +128,7 @@ class HostState:
         self.query: ParamQuery | None = None
         self._errors_at_start = 0
         self._outbox = bytearray()
-        self.end = app.SessionEnd()
+        self.end = session_end.SessionEnd()
         self.stopped_at: float | None = None
         """When the host last told the car to stop (Z or a page letter), while it has not
         told it to move since."""
@@ -242,7 +242,7 @@ class HostState:
 
     def reset_decoder(self) -> None:
         """Forget a partial record (after the link was lost: the board may restart)."""
-        self.decoder = app.BoardDecoder()
+        self.decoder = app_decoders.BoardDecoder()
         self.in_step = False
         self.letters_ignored = False
 

@@ -4,7 +4,7 @@ After the session's stop, an A record must show the car at rest (every motion fi
 most STILL) within SETTLE seconds. If none does, something kept the stop from taking: a
 frame left open by another program, or a `}` lost on a noisy link, swallowed the `Z`
 (on the sheet board a frame takes letters); a button-page rotation left by `I`/`J` goes
-on after `Z` (§13). Then the check asks for `again` (`app.stop_again`) and waits once
+on after `Z` (§13). Then the check asks for `again` (`session_end.stop_again`) and waits once
 more; after TRIES stops in all it gives up, and the host says the car may still move.
 """
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from appmode.errors import AppmodeError
-from appmode.protocol import app
+from appmode.protocol import app, app_decoders
 from appmode.protocol.directions import LETTERS, PAGE_LETTERS, STOP_LETTER
 from appmode.protocol.escaping import unescape
 
@@ -46,7 +46,7 @@ def parse_token(token: str, raw: bool = False) -> bytes | Wait:
     if raw:
         return data
     if token.startswith("{"):
-        events = app.HostDecoder().feed(data)
+        events = app_decoders.HostDecoder().feed(data)
         if len(events) != 1 or len(events[0].raw) != len(data):
             raise AppmodeError(f"token {token!r} is not one frame; {HELP}")
         event = events[0]

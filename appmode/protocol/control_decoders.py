@@ -12,7 +12,7 @@ from __future__ import annotations
 import functools
 import re
 
-from appmode.protocol import app, settings
+from appmode.protocol import app, app_decoders, settings
 from appmode.protocol.bulk import linear
 from appmode.protocol.control import (
     ANGLE_BIT,
@@ -97,7 +97,9 @@ class FrameDecoder:
     def __init__(self, drive: DriveType = DriveType.OMNI, app_mode: bool = False) -> None:
         self._buf = b""
         self.drive = drive
-        self._app: app.HostDecoder | None = app.HostDecoder() if app_mode else None
+        self._app: app_decoders.HostDecoder | None = (
+            app_decoders.HostDecoder() if app_mode else None
+        )
 
     @property
     def app_mode(self) -> bool:
@@ -108,7 +110,7 @@ class FrameDecoder:
         if on == self.app_mode:
             return []
         out = self.flush()
-        self._app = app.HostDecoder() if on else None
+        self._app = app_decoders.HostDecoder() if on else None
         return out
 
     @property
@@ -223,9 +225,11 @@ class ReplyDecoder:
     def __init__(self, wheels: int | None = 4, app_mode: bool = False) -> None:
         self._buf = b""
         self.wheels = wheels
-        self.limit = max(2 + 8 * (wheels or 4), MAX_RUN, app.BoardDecoder.LIMIT)
+        self.limit = max(2 + 8 * (wheels or 4), MAX_RUN, app_decoders.BoardDecoder.LIMIT)
         """Most bytes ever held between calls."""
-        self._app: app.BoardDecoder | None = app.BoardDecoder() if app_mode else None
+        self._app: app_decoders.BoardDecoder | None = (
+            app_decoders.BoardDecoder() if app_mode else None
+        )
 
     @property
     def app_mode(self) -> bool:
@@ -249,7 +253,7 @@ class ReplyDecoder:
         if on == self.app_mode:
             return []
         out = self.flush()
-        self._app = app.BoardDecoder() if on else None
+        self._app = app_decoders.BoardDecoder() if on else None
         return out
 
     @linear

@@ -17,7 +17,8 @@ from appmode.host.query import ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.tokens import Wait, parse_token
 from appmode.protocol import params
-from appmode.protocol.app import HostDecoder, Move, Noise, Stop, SwitchPage
+from appmode.protocol.app import Move, Noise, Stop, SwitchPage
+from appmode.protocol.app_decoders import HostDecoder
 from appmode.protocol.directions import (
     PAGE_LETTERS,
     PAGE_NAMES,

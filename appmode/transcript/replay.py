@@ -21,7 +21,7 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.ports.urls import new_pty, open_link
 from appmode.ports.wakeups import exact_wakeups
-from appmode.protocol.app import BoardDecoder, HostDecoder
+from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
 from appmode.protocol.render import describe, line
 from appmode.protocol.transcript import read_transcript
 

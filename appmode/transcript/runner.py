@@ -25,7 +25,7 @@ from appmode.host.link import LinkLost
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.urls import is_simulated, open_link
-from appmode.protocol import app, params
+from appmode.protocol import app, app_decoders, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
 from appmode.text import wrapped
@@ -53,7 +53,7 @@ def run_virtual(transcript: Transcript) -> Result:
     check = Check(transcript)
     needs = check.needs
     wire = Wire(Board(MemoryStore(), drive=needs.drive, profile=needs.profile), 9600)
-    decoder = app.BoardDecoder()
+    decoder = app_decoders.BoardDecoder()
     reader = PortsReader(drive=needs.drive)
     now = 0.0
     while not check.done and now <= check.end:
@@ -80,7 +80,9 @@ def _feed2(check: Check, reader: PortsReader, direction: str, data: bytes, now: 
             check.on_record(event, now, UART2_PORT)
 
 
-def _feed(check: Check, decoder: app.BoardDecoder, timed: list[tuple[float, bytes]]) -> None:
+def _feed(
+    check: Check, decoder: app_decoders.BoardDecoder, timed: list[tuple[float, bytes]]
+) -> None:
     """Decode delivered bytes; each record counts at the time its last byte arrived."""
     if not timed:
         return

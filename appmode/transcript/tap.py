@@ -17,7 +17,7 @@ import serial
 
 from appmode.line.pacing import Ahead
 from appmode.ports.urls import new_pty, open_link
-from appmode.protocol.app import SessionEnd
+from appmode.protocol.session_end import SessionEnd
 from appmode.protocol.transcript import Recorder
 
 READ_TIMEOUT = 0.05

@@ -14,7 +14,8 @@ from appmode.board.profiles import MINIBALANCE, SHEET, Profile
 from appmode.board.store import JsonFileStore, MemoryStore
 from appmode.board.vehicle import battery_percent, wrap_degrees
 from appmode.protocol import params
-from appmode.protocol.app import Attitude, BoardDecoder, ParamsRecord, Velocity
+from appmode.protocol.app import Attitude, ParamsRecord, Velocity
+from appmode.protocol.app_decoders import BoardDecoder
 from appmode.protocol.params import DriveType
 
 S = 500

@@ -12,7 +12,7 @@ from appmode.board.profiles import MINIBALANCE, PROFILES, SHEET
 from appmode.board.store import MemoryStore
 from appmode.board.vehicle import battery_percent
 from appmode.errors import AppmodeError
-from appmode.protocol import app
+from appmode.protocol import app, app_decoders
 from appmode.protocol.params import DriveType
 
 ON = 2.0
@@ -29,7 +29,7 @@ def records(
 ) -> list[tuple[float, app.Record]]:
     """Each record with the time the board sent it (to the ms)."""
     out = []
-    decoder = app.BoardDecoder()
+    decoder = app_decoders.BoardDecoder()
     t = start
     while t <= end + 1e-9:
         for event in decoder.feed(b.poll(t)):

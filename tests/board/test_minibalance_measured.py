@@ -6,7 +6,7 @@ from __future__ import annotations
 from appmode.board.firmware import Board
 from appmode.board.profiles import MINIBALANCE
 from appmode.line.wire import APP, UART2, Wire
-from appmode.protocol import app
+from appmode.protocol import app, app_decoders
 
 ON = 2.0
 """After the dead time (the battery reads 1.9 s after power-up)."""
@@ -19,7 +19,7 @@ def play(script: Script, until: float) -> tuple[Board, list[tuple[float, app.Rec
     """Send each (time, port, bytes) on a fresh board's paced wires; the APP port's records
     with the time each came, and all UART2 carried."""
     wire = Wire(Board(profile=MINIBALANCE))
-    decoder = app.BoardDecoder()
+    decoder = app_decoders.BoardDecoder()
     out: list[tuple[float, app.Record]] = []
     uart2 = b""
     pending = sorted(script, key=lambda item: item[0])

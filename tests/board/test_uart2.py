@@ -5,7 +5,7 @@ from __future__ import annotations
 from appmode.board.firmware import Board
 from appmode.board.profiles import MINIBALANCE
 from appmode.board.store import MemoryStore
-from appmode.protocol import app, control, control_decoders, params, settings
+from appmode.protocol import app, app_decoders, control, control_decoders, params, settings
 from appmode.protocol.control import MotorFrame, PositionFrame, SetSetting, encode
 from appmode.protocol.params import DriveType
 
@@ -22,7 +22,9 @@ def read(board: Board, name: str, now: float) -> int:
 
 
 def a_records(board: Board, now: float) -> list[app.Velocity]:
-    return [e for e in app.BoardDecoder().feed(board.poll(now)) if isinstance(e, app.Velocity)]
+    return [
+        e for e in app_decoders.BoardDecoder().feed(board.poll(now)) if isinstance(e, app.Velocity)
+    ]
 
 
 def set_setting(board: Board, name: str, value: int, now: float) -> None:

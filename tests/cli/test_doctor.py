@@ -21,7 +21,7 @@ import serial
 from appmode.board.profiles import MINIBALANCE, SHEET
 from appmode.cli import main as cli_main
 from appmode.host import probe
-from appmode.protocol import app, params
+from appmode.protocol import app, app_decoders, params
 from tests.support.processes import ROOT, appmode_cmd, board_process, run
 
 
@@ -205,7 +205,7 @@ def test_no_ports_at_all_says_how_to_connect_one(
 
 def timed_records(period_ms: float, records: list[bytes]) -> probe.Heard:
     heard = probe.Heard(9600)
-    decoders = app.BoardDecoder(), probe.control_decoders.ReplyDecoder(wheels=None)
+    decoders = app_decoders.BoardDecoder(), probe.control_decoders.ReplyDecoder(wheels=None)
     for i, record in enumerate(records):
         heard.feed(record, i * period_ms / 1000, *decoders)
     return heard

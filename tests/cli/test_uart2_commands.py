@@ -9,7 +9,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from appmode.protocol import app, control
+from appmode.protocol import app, app_decoders, control
 from appmode.protocol.transcript import read_transcript
 from tests.support.processes import appmode_cmd, board_process, run
 
@@ -57,7 +57,7 @@ def test_send_velocity_shows_reports_the_app_port_follows_and_the_stop_is_last(
         e.y
         for entry in transcript.entries
         if entry.direction == "<"
-        for e in app.BoardDecoder().feed(entry.data)
+        for e in app_decoders.BoardDecoder().feed(entry.data)
         if isinstance(e, app.Velocity)
     ]
     assert max(ys) >= 290, "the APP port's A record follows the velocity frame"

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from appmode.host.stop_check import SETTLE, TRIES, StopCheck
-from appmode.protocol import app
+from appmode.protocol import app, session_end
 from appmode.protocol.layouts import SCALED, VELOCITY
 
 
@@ -34,5 +34,5 @@ def test_the_minibalance_layout_reads_its_scaled_fields() -> None:
 
 
 def test_what_is_sent_again_never_closes_a_frame_where_that_applies_it() -> None:
-    assert app.stop_again(frames_take_letters=True) == b"{}KJZ"
-    assert app.stop_again(frames_take_letters=False) == b"KJZ"  # minibalance: } applies
+    assert session_end.stop_again(frames_take_letters=True) == b"{}KJZ"
+    assert session_end.stop_again(frames_take_letters=False) == b"KJZ"  # minibalance: } applies

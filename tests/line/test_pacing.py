@@ -7,7 +7,8 @@ import pytest
 from appmode.board.firmware import Board
 from appmode.line.pacing import Line, byte_time
 from appmode.line.wire import Wire
-from appmode.protocol.app import BoardDecoder, Velocity
+from appmode.protocol.app import Velocity
+from appmode.protocol.app_decoders import BoardDecoder
 
 BYTE = 10 / 9600
 

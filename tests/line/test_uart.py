@@ -6,14 +6,14 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from appmode.line.uart import BITS, misread
-from appmode.protocol import app
+from appmode.protocol import app, app_decoders
 
 RECORDS = b"{A12:-5:0:33}${B1:2:90:100}$" * 8
 RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200)
 
 
 def records_in(data: bytes) -> int:
-    return sum(isinstance(e, app.RECORDS) for e in app.BoardDecoder().feed(data))
+    return sum(isinstance(e, app.RECORDS) for e in app_decoders.BoardDecoder().feed(data))
 
 
 def test_rates_a_uart_tolerates_read_every_byte() -> None:

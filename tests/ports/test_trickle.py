@@ -10,7 +10,8 @@ import time
 import tty
 
 from appmode.line.pacing import byte_time
-from appmode.protocol.app import BoardDecoder, ParamsRecord
+from appmode.protocol.app import ParamsRecord
+from appmode.protocol.app_decoders import BoardDecoder
 from tests.support.processes import board_process
 
 BYTE = byte_time(9600)

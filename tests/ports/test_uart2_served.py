@@ -8,7 +8,7 @@ from pathlib import Path
 
 import serial
 
-from appmode.protocol import app, control
+from appmode.protocol import app, app_decoders, control
 from appmode.protocol.params import DriveType
 from tests.support.processes import board_process, run
 
@@ -18,7 +18,7 @@ READ_MAX_SPEED = bytes.fromhex("FF FE 80 80 11 00 00 00 00 00")
 def a_records(port: serial.Serial, seconds: float) -> list[app.Velocity]:
     port.reset_input_buffer()
     time.sleep(seconds)
-    events = app.BoardDecoder().feed(port.read(port.in_waiting))
+    events = app_decoders.BoardDecoder().feed(port.read(port.in_waiting))
     return [e for e in events if isinstance(e, app.Velocity)]
 
 

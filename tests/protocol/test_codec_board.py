@@ -9,7 +9,6 @@ from hypothesis import strategies as st
 from appmode.protocol import params
 from appmode.protocol.app import (
     Attitude,
-    BoardDecoder,
     Garbage,
     Malformed,
     OtherRecord,
@@ -17,6 +16,7 @@ from appmode.protocol.app import (
     Velocity,
     encode,
 )
+from appmode.protocol.app_decoders import BoardDecoder
 from tests.support.decoders import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
 C_DEFAULT = b"{C500:10000:20:0:10:10:10:0:0}$"

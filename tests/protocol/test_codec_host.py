@@ -10,7 +10,6 @@ from appmode.protocol import params
 from appmode.protocol.app import (
     MAX_FRAME,
     BadFrame,
-    HostDecoder,
     Move,
     Noise,
     ReadParams,
@@ -20,6 +19,7 @@ from appmode.protocol.app import (
     SwitchPage,
     encode,
 )
+from appmode.protocol.app_decoders import HostDecoder
 from tests.support.decoders import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
 

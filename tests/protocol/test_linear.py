@@ -9,7 +9,8 @@ import time
 
 import pytest
 
-from appmode.protocol.app import BoardDecoder, Garbage, HostDecoder, Noise
+from appmode.protocol.app import Garbage, Noise
+from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
 from appmode.protocol.render import coalesce
 
 SIZE = 1_000_000

@@ -8,7 +8,7 @@ import json
 from hypothesis import given
 from hypothesis import strategies as st
 
-from appmode.protocol.app import BoardDecoder, HostDecoder
+from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
 from appmode.protocol.escaping import _TABLE, escape, unescape
 from appmode.protocol.render import json_line, to_json
 
@@ -32,14 +32,16 @@ def test_escape_is_the_table_byte_by_byte(data: bytes) -> None:
 
 
 def test_json_keys_name_every_key_to_json_writes() -> None:
-    from appmode.protocol import app
+    from appmode.protocol import app_decoders
     from appmode.protocol.render import JSON_KEYS, to_json
 
     events = [
-        *app.BoardDecoder().feed(b"{A1:2:3:4}${B1:2:3:4}${C1:2:3:4:5:6:7:8:9}${D1:2}$x{A1"),
-        *app.BoardDecoder().flush(),
-        *app.HostDecoder().feed(b"AZJ{Q:P}{Q;W}{0:800}{0:x}\x01{" + b"9" * 60 + b"}"),
-        *app.HostDecoder().flush(),
+        *app_decoders.BoardDecoder().feed(
+            b"{A1:2:3:4}${B1:2:3:4}${C1:2:3:4:5:6:7:8:9}${D1:2}$x{A1"
+        ),
+        *app_decoders.BoardDecoder().flush(),
+        *app_decoders.HostDecoder().feed(b"AZJ{Q:P}{Q;W}{0:800}{0:x}\x01{" + b"9" * 60 + b"}"),
+        *app_decoders.HostDecoder().flush(),
     ]
     kinds = {to_json(e)["kind"] for e in events}
     assert len(kinds) >= 12, kinds

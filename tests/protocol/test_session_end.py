@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from appmode.protocol.app import SessionEnd
+from appmode.protocol.session_end import SessionEnd
 
 
 @pytest.mark.parametrize(

@@ -5,9 +5,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from appmode.protocol import app
+from appmode.protocol import app_decoders
 
-Decoder = app.HostDecoder | app.BoardDecoder
+Decoder = app_decoders.HostDecoder | app_decoders.BoardDecoder
 
 
 def decode_whole(make: Callable[[], Decoder], data: bytes) -> list[Any]:

@@ -115,7 +115,8 @@ def board_state(url: str, seconds: float = 1.5) -> tuple[tuple[int, int, int], t
     to decay to 0) and its parameters (`{Q:P}`, which changes no motion)."""
     import serial
 
-    from appmode.protocol.app import BoardDecoder, ParamsRecord, Velocity
+    from appmode.protocol.app import ParamsRecord, Velocity
+    from appmode.protocol.app_decoders import BoardDecoder
 
     decoder = BoardDecoder()
     velocity: tuple[int, int, int] | None = None
