@@ -24,7 +24,8 @@ from common import percentile
 
 from appmode.board.firmware import Board
 from appmode.board.profiles import SHEET
-from appmode.ports.serve import BoardServer, _pty, switched_on
+from appmode.ports.endpoints import PtyEndpoint
+from appmode.ports.serve import BoardServer, switched_on
 from appmode.protocol.app import RECORDS
 from appmode.protocol.app_decoders import BoardDecoder
 
@@ -32,7 +33,7 @@ from appmode.protocol.app_decoders import BoardDecoder
 def serve(count: int) -> None:
     """Serve `count` boards (both ports on ptys, as `appmode board --count`) until
     SIGTERM; then print CPU seconds, wall seconds and the grid's lateness as JSON."""
-    make = partial(_pty, link=None, baud=None)
+    make = partial(PtyEndpoint, link=None, baud=None)
     server = BoardServer(
         [make] * count,
         [Board(now=on) for on in switched_on(count, SHEET)],

@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import argparse
+from functools import partial
+from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile, add_record, file_name, number_type
+from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES
+
+if TYPE_CHECKING:
+    from appmode.ports.endpoints import MakeEndpoint
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -19,40 +25,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "port, UART2 at 115200 bps, docs/protocol.md §8) for clients to open, then logs "
         "what it receives, port by port, until Ctrl-C.",
     )
-    where = board.add_mutually_exclusive_group()
-    where.add_argument(
-        "--pty", action="store_true", help="serve on a new pseudo-terminal (the default)"
-    )
-    where.add_argument(
-        "--listen",
-        metavar="HOST:PORT",
-        help="serve on TCP, one client at a time (host 127.0.0.1 by default; "
-        "port 0 picks a free one)",
-    )
-    where.add_argument(
-        "--port",
-        metavar="DEV",
-        help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
-    )
-    where2 = board.add_mutually_exclusive_group()
-    where2.add_argument(
-        "--listen2",
-        metavar="HOST:PORT",
-        help="serve UART2, the control port, on TCP (default: a second pseudo-terminal)",
-    )
-    where2.add_argument(
-        "--port2",
-        metavar="DEV",
-        help="serve UART2 on a real serial port (?baud=N to change 115200)",
-    )
-    board.add_argument(
-        "--baud",
-        type=number_type(300, 4_000_000, whole=True),
-        metavar="N",
-        help="the APP port's bit rate (default 9600): a car whose Bluetooth module is set "
-        "to another rate. It paces the port; on a pty, a client that opens it at another "
-        "rate reads garbled bytes, as from a real UART (the UART2 pty likewise at 115200)",
-    )
+    _add_where(board)
     board.add_argument(
         "--count",
         type=number_type(1, 1000, whole=True),
@@ -94,22 +67,89 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     return board
 
 
-def run(args: argparse.Namespace) -> int:
-    from appmode.ports.serve import run_board
+def _add_where(board: argparse.ArgumentParser) -> None:
+    """Where each port is served, and the APP port's rate."""
+    where = board.add_mutually_exclusive_group()
+    where.add_argument(
+        "--pty", action="store_true", help="serve on a new pseudo-terminal (the default)"
+    )
+    where.add_argument(
+        "--listen",
+        metavar="HOST:PORT",
+        help="serve on TCP, one client at a time (host 127.0.0.1 by default; "
+        "port 0 picks a free one)",
+    )
+    where.add_argument(
+        "--port",
+        metavar="DEV",
+        help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
+    )
+    where2 = board.add_mutually_exclusive_group()
+    where2.add_argument(
+        "--listen2",
+        metavar="HOST:PORT",
+        help="serve UART2, the control port, on TCP (default: a second pseudo-terminal)",
+    )
+    where2.add_argument(
+        "--port2",
+        metavar="DEV",
+        help="serve UART2 on a real serial port (?baud=N to change 115200)",
+    )
+    board.add_argument(
+        "--baud",
+        type=number_type(300, 4_000_000, whole=True),
+        metavar="N",
+        help="the APP port's bit rate (default 9600): a car whose Bluetooth module is set "
+        "to another rate. It paces the port; on a pty, a client that opens it at another "
+        "rate reads garbled bytes, as from a real UART (the UART2 pty likewise at 115200)",
+    )
 
-    return run_board(
-        use_pty=args.pty,
-        link=args.link,
-        listen=args.listen,
-        device=args.port,
-        drive=args.drive,
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.board.profiles import profile_named
+    from appmode.ports.serve import ServeOptions, run_board
+    from appmode.protocol.params import DriveType
+
+    alone = (args.listen, args.port, args.link, args.flash, args.record, args.listen2, args.port2)
+    if args.count > 1 and any(option is not None for option in alone):
+        raise AppmodeError(
+            "--count serves several boards on ptys: it cannot be combined "
+            "with --listen, --port, --listen2, --port2, --link, --flash or --record"
+        )
+    options = ServeOptions(
+        app=_app_endpoint(args),
+        uart2=_uart2_endpoint(args),
+        count=args.count,
+        profile=profile_named(args.profile),
+        drive=DriveType.from_cli_name(args.drive) if args.drive else None,
         flash=args.flash,
         pace=not args.no_pace,
         record=args.record,
         quiet=args.quiet,
-        count=args.count,
-        profile=args.profile,
-        listen2=args.listen2,
-        device2=args.port2,
         baud=args.baud,
     )
+    return run_board(options)
+
+
+def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
+    from appmode.ports import endpoints
+    from appmode.ports.urls import BAUD
+
+    if args.listen is not None:
+        host, port = endpoints.parse_listen(args.listen)
+        return partial(endpoints.TcpEndpoint, host=host, port=port, baud=args.baud)
+    if args.port is not None:
+        return partial(endpoints.SerialEndpoint, device=args.port, baud=args.baud or BAUD)
+    return partial(endpoints.PtyEndpoint, link=args.link, baud=args.baud)
+
+
+def _uart2_endpoint(args: argparse.Namespace) -> MakeEndpoint:
+    from appmode.line.wire import UART2_BAUD
+    from appmode.ports import endpoints
+
+    if args.listen2 is not None:
+        host, port = endpoints.parse_listen(args.listen2, "--listen2")
+        return partial(endpoints.TcpEndpoint, host=host, port=port, baud=None)
+    if args.port2 is not None:
+        return partial(endpoints.SerialEndpoint, device=args.port2, baud=UART2_BAUD)
+    return partial(endpoints.PtyEndpoint, link=None, baud=UART2_BAUD if args.baud else None)

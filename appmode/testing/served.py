@@ -25,7 +25,8 @@ from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec
 from appmode.line.wire import APP, UART2
-from appmode.ports.serve import BoardServer, MakeEndpoint, PtyEndpoint, TcpEndpoint
+from appmode.ports.endpoints import MakeEndpoint, PtyEndpoint, TcpEndpoint
+from appmode.ports.serve import BoardServer
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
 from appmode.protocol.transcript import Transcript, read_transcript

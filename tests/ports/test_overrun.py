@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 import selectors
 
-from appmode.ports.serve import Overrun, PtyEndpoint
+from appmode.ports.endpoints import Overrun, PtyEndpoint
 
 
 def test_a_pty_nobody_reads_drops_and_says_so_then_resumes() -> None:
