@@ -6,6 +6,7 @@ import argparse
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import DAY, Subparsers, file_name, number_type
+from appmode.errors import AppmodeError
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -66,6 +67,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from appmode.transcript.replay import run_replay
 
+    if not (0.001 <= args.speed <= 1000 and args.loop >= 1):
+        raise AppmodeError("--speed must be > 0, in 0.001–1000, and --loop at least 1")
+    if args.side == "host" and args.to == "pty":
+        raise AppmodeError(
+            "replay --to pty plays the board's side to an app: add --side board (to drive "
+            "a board on a pty, serve it with appmode board and replay to its port)"
+        )
     return run_replay(
         args.file,
         args.to,

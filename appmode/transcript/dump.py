@@ -22,6 +22,7 @@ from appmode.protocol.transcript import (
     DIRECTIONS,
     Directive,
     Entry,
+    Transcript,
     iter_transcript,
     read_transcript,
 )
@@ -169,23 +170,8 @@ def run_plot(path: str, output: str) -> int:
     transcript = read_transcript(path)
     for warning in transcript.warnings:
         print(f"appmode: WARNING: {warning}", file=sys.stderr)
-    needs = Check(transcript).needs
-    layout = needs.profile.a_layout
-    motion: dict[int, list[int]] = {i: [] for i in layout.motion}
-    series: dict[str, list[Any]] = {k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")}
-    commands: list[tuple[float, str]] = []
-    for t, direction, event in decoded(transcript.items, needs.drive, path):
-        if isinstance(event, app.Velocity):
-            series["tA"].append(t)
-            values = app.record_fields(event)[1]
-            for i, column in motion.items():
-                column.append(values[i])
-        elif isinstance(event, app.Attitude):
-            series["tB"].append(t)
-            for k in ("pitch", "roll", "yaw", "battery"):
-                series[k].append(getattr(event, k))
-        elif direction == ">" and isinstance(event, app.Command):
-            commands.append((t, event.raw.decode("latin-1")))
+    layout = Check(transcript).needs.profile.a_layout
+    motion, series, commands = _series(transcript, path)
     if not series["tA"] and not series["tB"]:
         raise AppmodeError(f"{path} has no A or B records to plot")
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(11, 8), constrained_layout=True)
@@ -233,3 +219,27 @@ def run_plot(path: str, output: str) -> int:
         plt.close(fig)
     write_whole(output, image.getvalue(), "plot")
     return 0
+
+
+def _series(
+    transcript: Transcript, path: str
+) -> tuple[dict[int, list[int]], dict[str, list[Any]], list[tuple[float, str]]]:
+    """What a plot draws: the A record's motion fields by index, the times of A and B
+    records with B's fields, and the commands sent (time, text)."""
+    needs = Check(transcript).needs
+    motion: dict[int, list[int]] = {i: [] for i in needs.profile.a_layout.motion}
+    series: dict[str, list[Any]] = {k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")}
+    commands: list[tuple[float, str]] = []
+    for t, direction, event in decoded(transcript.items, needs.drive, path):
+        if isinstance(event, app.Velocity):
+            series["tA"].append(t)
+            values = app.record_fields(event)[1]
+            for i, column in motion.items():
+                column.append(values[i])
+        elif isinstance(event, app.Attitude):
+            series["tB"].append(t)
+            for k in ("pitch", "roll", "yaw", "battery"):
+                series[k].append(getattr(event, k))
+        elif direction == ">" and isinstance(event, app.Command):
+            commands.append((t, event.raw.decode("latin-1")))
+    return motion, series, commands

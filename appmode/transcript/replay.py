@@ -95,14 +95,8 @@ def run_replay(
     skip: float | None = None,
     verbose: bool = False,
 ) -> int:
-    """The `appmode replay` command."""
-    if not (0.001 <= speed <= 1000 and loops >= 1):
-        raise AppmodeError("--speed must be > 0, in 0.001–1000, and --loop at least 1")
-    if side == "host" and url == "pty":
-        raise AppmodeError(
-            "replay --to pty plays the board's side to an app: add --side board (to drive "
-            "a board on a pty, serve it with appmode board and replay to its port)"
-        )
+    """Play one side (`host` or `board`) of the transcript at `path` to `url` (`pty`: a new
+    pseudo-terminal, for an app to open), `loops` times at `speed`× its pace."""
     transcript = read_transcript(path)
     for warning in transcript.warnings:
         print(f"appmode: WARNING: {warning}", file=sys.stderr)

@@ -56,18 +56,82 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
     except BaseException:
         app.close()
         raise
-    recorder = Recorder.create(record)
-    lock = threading.Lock()
-    stop = threading.Event()
-    origin = time.monotonic()
-    counts = {">": 0, "<": 0}
-    end = SessionEnd()  # what the app sent: its frame may be open when it leaves
-    errors: list[str] = []
+    tap = Tap(app, board, Recorder.create(record))
+    if not quiet:
+        print(
+            f"tap: {app_url} <-> {board_url}, recording to {record} (Ctrl-C to stop)",
+            file=sys.stderr,
+            flush=True,
+        )
+    tap.run()
+    if not quiet:
+        counts = tap.counts
+        print(
+            f"tap: {counts['>']} bytes app->board, {counts['<']} bytes board->app", file=sys.stderr
+        )
+    for error in tap.errors:
+        print(f"tap: stopped: {error}", file=sys.stderr)
+    return 1 if tap.errors else 0
 
-    def forward(src: Port, dst: Port, direction: str, name: str) -> None:
+
+class Tap:
+    """Two ports forwarded to each other, each way in its own thread, both recorded; at
+    the end the board gets the stop the app can no longer send."""
+
+    def __init__(self, app: Port, board: Port, recorder: Recorder) -> None:
+        self.app, self.board, self.recorder = app, board, recorder
+        self.counts = {">": 0, "<": 0}
+        self.errors: list[str] = []
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._origin = time.monotonic()
+        self._end = SessionEnd()  # what the app sent: its frame may be open when it leaves
+
+    def run(self) -> None:
+        """Forward until interrupted (Ctrl-C) or a side fails; then stop the car and close."""
+        threads = [
+            threading.Thread(
+                target=self._forward,
+                args=(self.app, self.board, ">"),
+                name="app side",
+                daemon=True,
+            ),
+            threading.Thread(
+                target=self._forward,
+                args=(self.board, self.app, "<"),
+                name="board side",
+                daemon=True,
+            ),
+        ]
+        for thread in threads:
+            thread.start()
+        try:
+            while not self._stop.is_set():
+                self._stop.wait(0.2)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            self._stop.set()
+            for thread in threads:  # forwarding ends first: the stop is the last on the wire
+                thread.join(JOIN)
+            stuck = [t.name for t in threads if t.is_alive()]
+            with contextlib.suppress(serial.SerialException, OSError):
+                self.board.write(self._end.stop)  # the app can no longer stop the car
+                self.recorder(">", time.monotonic() - self._origin, self._end.stop)
+            if stuck:
+                stuck_text = ", ".join(stuck)
+                self.errors.append(
+                    f"{stuck_text} still writing after {JOIN:g} s: its port is stuck"
+                )
+            self.board.close()
+            self.app.close()
+            self.recorder.close()
+
+    def _forward(self, src: Port, dst: Port, direction: str) -> None:
         """Copy src to dst, a chunk at a time and no faster than dst's line carries
         it, until stopped: at the end nothing is still on its way to the board."""
         ahead = Ahead(getattr(dst, "baudrate", None), CHUNK)
+        stop = self._stop
         try:
             while not stop.is_set():
                 data = _read(src)
@@ -78,53 +142,12 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
                     chunk = data[start : start + CHUNK]
                     dst.write(chunk)
                     ahead.wrote(len(chunk), time.monotonic())
-                    with lock:
-                        counts[direction] += len(chunk)
+                    with self._lock:
+                        self.counts[direction] += len(chunk)
                         if direction == ">":
-                            end.sent(chunk)
-                        recorder(direction, time.monotonic() - origin, chunk)
+                            self._end.sent(chunk)
+                        self.recorder(direction, time.monotonic() - self._origin, chunk)
         except Exception as exc:  # a lost port, a failed recording: end the tap, say why
-            errors.append(f"{name}: {exc}")
+            name = "app side" if direction == ">" else "board side"
+            self.errors.append(f"{name}: {exc}")
             stop.set()
-
-    threads = [
-        threading.Thread(
-            target=forward, args=(app, board, ">", "app side"), name="app side", daemon=True
-        ),
-        threading.Thread(
-            target=forward, args=(board, app, "<", "board side"), name="board side", daemon=True
-        ),
-    ]
-    if not quiet:
-        print(
-            f"tap: {app_url} <-> {board_url}, recording to {record} (Ctrl-C to stop)",
-            file=sys.stderr,
-            flush=True,
-        )
-    for thread in threads:
-        thread.start()
-    try:
-        while not stop.is_set():
-            stop.wait(0.2)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        stop.set()
-        for thread in threads:  # forwarding ends first: the stop is the last on the wire
-            thread.join(JOIN)
-        stuck = [t.name for t in threads if t.is_alive()]
-        with contextlib.suppress(serial.SerialException, OSError):
-            board.write(end.stop)  # the app can no longer stop the car
-            recorder(">", time.monotonic() - origin, end.stop)
-        if stuck:
-            errors.append(f"{', '.join(stuck)} still writing after {JOIN:g} s: its port is stuck")
-        board.close()
-        app.close()
-        recorder.close()
-    if not quiet:
-        print(
-            f"tap: {counts['>']} bytes app->board, {counts['<']} bytes board->app", file=sys.stderr
-        )
-    for error in errors:
-        print(f"tap: stopped: {error}", file=sys.stderr)
-    return 1 if errors else 0
