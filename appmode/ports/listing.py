@@ -23,7 +23,9 @@ BLUETOOTH_HINTS = ("rfcomm", "bluetooth", "-serialport", "hc-05", "hc-06")
 
 
 @dataclass(frozen=True, slots=True)
-class Port:
+class Device:
+    """A serial device the system lists, and what it looks like."""
+
     device: str
     description: str
     hwid: str
@@ -40,10 +42,10 @@ def kind_of(device: str, description: str, vid: int | None, pid: int | None) -> 
     return ""
 
 
-def serial_ports() -> list[Port]:
+def serial_ports() -> list[Device]:
     """Every serial port pyserial finds, likely links first, then by device name."""
     found = [
-        Port(
+        Device(
             info.device,
             info.description if info.description != "n/a" else "",
             info.hwid if info.hwid != "n/a" else "",

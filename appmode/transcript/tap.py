@@ -27,7 +27,9 @@ JOIN = 5.0
 """Seconds a forwarding thread has to finish its chunk once the tap stops."""
 
 
-class Port(Protocol):
+class Stream(Protocol):
+    """What tap forwards between: a pyserial port or a new pty."""
+
     @property
     def in_waiting(self) -> int: ...
 
@@ -38,13 +40,13 @@ class Port(Protocol):
     def close(self) -> None: ...
 
 
-def _read(port: Port) -> bytes:
+def _read(port: Stream) -> bytes:
     return port.read(max(1, port.in_waiting))
 
 
 def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
     """Forward until interrupted, recording both directions."""
-    app: Port
+    app: Stream
     if app_url == "pty":
         pty_port = new_pty()
         app = pty_port
@@ -78,7 +80,7 @@ class Tap:
     """Two ports forwarded to each other, each way in its own thread, both recorded; at
     the end the board gets the stop the app can no longer send."""
 
-    def __init__(self, app: Port, board: Port, recorder: Recorder) -> None:
+    def __init__(self, app: Stream, board: Stream, recorder: Recorder) -> None:
         self.app, self.board, self.recorder = app, board, recorder
         self.counts = {">": 0, "<": 0}
         self.errors: list[str] = []
@@ -127,7 +129,7 @@ class Tap:
             self.app.close()
             self.recorder.close()
 
-    def _forward(self, src: Port, dst: Port, direction: str) -> None:
+    def _forward(self, src: Stream, dst: Stream, direction: str) -> None:
         """Copy src to dst, a chunk at a time and no faster than dst's line carries
         it, until stopped: at the end nothing is still on its way to the board."""
         ahead = Ahead(getattr(dst, "baudrate", None), CHUNK)
