@@ -1,0 +1,92 @@
+"""The architecture as the code has it (issue 25): layers whose imports point only down,
+small modules and functions, and no two modules of one name."""
+
+from __future__ import annotations
+
+import ast
+from collections import Counter
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent.parent / "appmode"
+LAYERS = (
+    "protocol",
+    "board",
+    "line",
+    "ports",
+    "host",
+    "transcript",
+    "session",
+    "console",
+    "testing",
+    "cli",
+)
+"""Bottom up: a subpackage imports only from its own layer or those below it."""
+LEAVES = ("errors", "text", "files")
+"""Modules of no layer, which any layer may use (they import only each other)."""
+MAX_MODULE = 450
+MAX_FUNCTION = 80
+
+
+def modules() -> list[Path]:
+    return sorted(PACKAGE.rglob("*.py"))
+
+
+def layer_of(name: str) -> int | None:
+    """The layer of `appmode.x.y` (None for a leaf or the package itself)."""
+    parts = name.split(".")
+    if len(parts) < 2 or parts[1] in LEAVES or parts[1] in ("__init__", "__main__"):
+        return None
+    return LAYERS.index(parts[1])
+
+
+def imported(path: Path) -> list[tuple[int, str]]:
+    """(line, module) for every appmode module `path` imports, at run time or for types."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("appmode"):
+            found.append((node.lineno, node.module))
+        elif isinstance(node, ast.Import):
+            found += [(node.lineno, a.name) for a in node.names if a.name.startswith("appmode")]
+    return found
+
+
+def name_of(path: Path) -> str:
+    return ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+
+
+def test_every_subpackage_is_a_layer() -> None:
+    packages = {p.parent.name for p in modules() if p.parent != PACKAGE}
+    assert packages == set(LAYERS)
+
+
+def test_imports_point_down_the_layers() -> None:
+    upward = []
+    for path in modules():
+        here = layer_of(name_of(path))
+        leaf = path.parent == PACKAGE and path.stem in LEAVES
+        for line, module in imported(path):
+            there = layer_of(module)
+            if leaf and there is not None:
+                upward.append(f"{name_of(path)}:{line} imports {module}: a leaf uses no layer")
+            elif here is not None and there is not None and there > here:
+                upward.append(f"{name_of(path)}:{line} imports {module}")
+    assert not upward, "\n".join(upward)
+
+
+def test_modules_and_functions_are_small() -> None:
+    long = []
+    for path in modules():
+        text = path.read_text(encoding="utf-8")
+        if len(text.splitlines()) > MAX_MODULE:
+            long.append(f"{name_of(path)}: {len(text.splitlines())} lines")
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                size = (node.end_lineno or node.lineno) - node.lineno + 1
+                if size > MAX_FUNCTION:
+                    long.append(f"{name_of(path)}.{node.name}: {size} lines")
+    assert not long, "\n".join(long)
+
+
+def test_outside_cli_no_two_modules_share_a_name() -> None:
+    names = Counter(p.stem for p in modules() if p.parent.name != "cli" and p.stem != "__init__")
+    assert [name for name, count in names.items() if count > 1] == []
