@@ -296,9 +296,7 @@ class Console:
 
 
 def _completer(session: BaseSession) -> NestedCompleter:
-    table: dict[str, object] = dict.fromkeys(session.command_names)
-    table.update(latch={"on": None, "off": None}, record={"stop": None}, **session.completions)
-    return NestedCompleter.from_nested_dict(table)
+    return NestedCompleter.from_nested_dict(session.completions)
 
 
 def is_quit(text: str) -> bool:

@@ -28,21 +28,13 @@ from appmode.protocol.directions import (
     letter_name,
 )
 from appmode.protocol.layouts import VELOCITY, ALayout
-from appmode.session.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.session.app_commands import COMMANDS
+from appmode.session.base import (
+    SPEED_KEYS,
+    BaseSession,
+)
 from appmode.session.hold import HoldToDrive
 from appmode.session.status import GLYPHS, Row, Span, hold_mode, link_rows, telemetry
-
-COMMANDS: tuple[CommandSpec, ...] = (
-    CommandSpec("params", "", "read the nine parameters"),
-    CommandSpec("set", "NAME VALUE", "set a parameter, verified by reading back"),
-    CommandSpec("save", "", "save the parameters to the board's flash ({Q:W})"),
-    CommandSpec("speed", "+N|-N|N", f"change max_speed (keys + and - step {SPEED_STEP})"),
-    CommandSpec("drive", "A-H", "drive in a direction (latched: until stop)"),
-    CommandSpec("stop", "", "stop the car (Z)"),
-    CommandSpec("page", "NAME", "switch page: direction (J), button (K), gravity (I)"),
-    CommandSpec("send", "TOKEN...", "send raw tokens: letters, {frames}, \\xNN"),
-)
-PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}
 
 KEYS_HELP = (
     "arrows, q w e / a s d / z x c drive · space stop · i j k page · l latch\n"
@@ -92,10 +84,6 @@ class Session(BaseSession):
         self._sent = HostDecoder()
         self.baseline: tuple[int, ...] | None = None
         """The parameters as first read, or as last sent to flash: what a quit would keep."""
-        self.completions |= {
-            "set": {p.name: None for p in params.PARAMS},
-            "page": dict.fromkeys(PAGE_WORDS),
-        }
         self._open_recording(record)
 
     # ------------------------------------------------------------ life cycle
@@ -296,33 +284,8 @@ class Session(BaseSession):
         changed = params.changes(self.baseline, current.values)
         return f"not saved: {', '.join(changed)}" if changed else None
 
-    def _dispatch(self, name: str, args: list[str]) -> Step:
-        if name == "params":
-            self.read_params()
-        elif name == "set":
-            value = params.whole(args[1]) if len(args) == 2 else None
-            if value is None:
-                raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
-            self.set_param(params.lookup(args[0]).index, value)
-        elif name == "save":
-            self.save()
-        elif name == "speed":
-            self._speed(args)
-        elif name == "drive":
-            if len(args) != 1 or args[0].upper() not in "ABCDEFGH" or len(args[0]) != 1:
-                raise AppmodeError("usage: drive LETTER, one of A-H")
-            self.press(args[0].upper())
-        elif name == "stop":
-            self.stop()
-        elif name == "page":
-            if len(args) != 1 or args[0].lower() not in PAGE_WORDS:
-                raise AppmodeError("usage: page direction|button|gravity|joystick")
-            self.switch_page(PAGE_WORDS[args[0].lower()])
-        elif name == "send":
-            self._send_tokens(args)
-        return None
-
-    def _speed(self, args: list[str]) -> None:
+    def speed_command(self, args: list[str]) -> None:
+        """`speed +N`, `speed -N` or `speed N`: max_speed."""
         number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
         if number is None:
             raise AppmodeError("usage: speed +N, speed -N or speed N")
@@ -331,7 +294,8 @@ class Session(BaseSession):
         else:
             self.set_param(params.MAX_SPEED, number)
 
-    def _send_tokens(self, tokens: list[str]) -> None:
+    def send_tokens(self, tokens: list[str]) -> None:
+        """`send`: letters, frames and escaped bytes, as they are."""
         if not tokens:
             raise AppmodeError("usage: send TOKEN..., e.g. send J A or send {Q:P}")
         steps = [parse_token(token) for token in tokens]

@@ -10,9 +10,9 @@ import contextlib
 import shlex
 from abc import ABC, abstractmethod
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 from appmode.errors import AppmodeError
 from appmode.host.tokens import Wait, parse_token
@@ -31,27 +31,11 @@ if TYPE_CHECKING:
 SPEED_STEP = 100
 SPEED_KEYS = {"+": f"speed +{SPEED_STEP}", "=": f"speed +{SPEED_STEP}", "-": f"speed -{SPEED_STEP}"}
 """The keys that change the speed, as command lines."""
+SPEED_COMPLETES = {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None}
 LOG = 500
 """Messages kept for scrolling back."""
 QUIT_WORDS = ("quit", "exit", "q")
-
-
-@dataclass(frozen=True, slots=True)
-class CommandSpec:
-    name: str
-    args: str
-    help: str
-
-
-COMMON: tuple[CommandSpec, ...] = (
-    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop"),
-    CommandSpec("record", "FILE|stop", "start or stop recording a transcript"),
-    CommandSpec("wait", "SECONDS", "script mode: let time pass"),
-    CommandSpec("status", "", "print the status panel (script mode)"),
-    CommandSpec("help", "", "list the commands and keys"),
-    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)"),
-)
-"""The commands every session takes, listed after its own."""
+ON_OFF = {"on": None, "off": None}
 
 
 class Quit(Exception):
@@ -72,13 +56,66 @@ class ShowHelp:
 SHOW_HELP = ShowHelp()
 
 Step = Wait | ShowStatus | ShowHelp | None
+S = TypeVar("S", bound="BaseSession")
+
+
+@dataclass(frozen=True, slots=True)
+class CommandSpec(Generic[S]):
+    """A command of the command line: its name, its arguments and help as `help` lists
+    them, what runs it, and what completes after its name."""
+
+    name: str
+    args: str
+    help: str
+    run: Callable[[S, list[str]], Step]
+    """Runs it on a session with its arguments; AppmodeError or ValueError for a mistake."""
+    completes: Mapping[str, object] | None = None
+
+
+def _latch(session: BaseSession, args: list[str]) -> None:
+    if args not in (["on"], ["off"]):
+        raise AppmodeError("usage: latch on|off")
+    session.driving.latched = args[0] == "on"
+    session.say(f"latched driving {args[0]}")
+
+
+def _record(session: BaseSession, args: list[str]) -> None:
+    if len(args) != 1:
+        raise AppmodeError("usage: record FILE, or record stop")
+    session.stop_recording() if args[0] == "stop" else session.start_recording(args[0])
+
+
+def _wait(session: BaseSession, args: list[str]) -> Wait:
+    step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
+    assert isinstance(step, Wait)
+    return step
+
+
+def _quit(session: BaseSession, args: list[str]) -> None:
+    raise Quit
+
+
+COMMON: tuple[CommandSpec[BaseSession], ...] = (
+    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop", _latch, ON_OFF),
+    CommandSpec(
+        "record", "FILE|stop", "start or stop recording a transcript", _record, {"stop": None}
+    ),
+    CommandSpec("wait", "SECONDS", "script mode: let time pass", _wait),
+    CommandSpec("status", "", "print the status panel (script mode)", lambda s, a: SHOW_STATUS),
+    CommandSpec("help", "", "list the commands and keys", lambda s, a: SHOW_HELP),
+    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)", _quit),
+)
+"""The commands every session takes, listed after its own."""
+COMMON_ALIASES = {"?": "help", **{word: "quit" for word in QUIT_WORDS}}
 
 
 class BaseSession(ABC):
     """A console session: what it shows (messages), what it records, how it drives."""
 
-    commands: tuple[CommandSpec, ...] = ()
+    commands: tuple[CommandSpec[Any], ...] = ()
     """The session's own commands (COMMON follows them)."""
+    aliases: ClassVar[dict[str, str]] = {}
+    """Other names for its commands."""
     keys_help = ""
     """Its keys, as the panel and help show them."""
     keys: ClassVar[dict[str, str]] = {}
@@ -100,10 +137,10 @@ class BaseSession(ABC):
         """Commands and queries that failed (`fail`)."""
         self.on_message = on_message
         self.recorder: Recorder | None = None
-        self.completions: dict[str, object] = {
-            "speed": {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None}
-        }
-        """What the command line completes after a command's name."""
+        specs: tuple[CommandSpec[Any], ...] = (*self.commands, *COMMON)
+        self._specs = {spec.name: spec for spec in specs}
+        self.completions: dict[str, object] = {spec.name: spec.completes for spec in specs}
+        """Every command's name, and what the command line completes after it."""
         self.closing_notes: list[str] = []
         """What closing had to do beyond its stop, for people (shown after the console)."""
 
@@ -168,11 +205,6 @@ class BaseSession(ABC):
     def unsaved_warning(self) -> str | None:
         """What was set in this session and not saved since, in a line; None if nothing."""
 
-    @abstractmethod
-    def _dispatch(self, name: str, args: list[str]) -> Step:
-        """Run one of the session's own commands; AppmodeError or ValueError for a
-        mistake."""
-
     # ------------------------------------------------------------ messages
 
     def link_down(self) -> bool:
@@ -211,10 +243,6 @@ class BaseSession(ABC):
             *self.keys_help.splitlines(),
             "PgUp/PgDn scroll the messages · End: the newest",
         ]
-
-    @property
-    def command_names(self) -> tuple[str, ...]:
-        return tuple(spec.name for spec in (*self.commands, *COMMON))
 
     # ------------------------------------------------------------ recording
 
@@ -280,36 +308,14 @@ class BaseSession(ABC):
         if not words:
             return None
         try:
-            return self._common(words[0].lower(), words[1:])
+            return self._command(words[0].lower(), words[1:])
         except (AppmodeError, ValueError) as exc:
             self.fail(str(exc))
             return None
 
-    def _common(self, name: str, args: list[str]) -> Step:
-        if name in QUIT_WORDS:
-            raise Quit
-        if name in ("help", "?"):
-            return SHOW_HELP
-        if name == "status":
-            return SHOW_STATUS
-        if name == "wait":
-            step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
-            assert isinstance(step, Wait)
-            return step
-        if name == "latch":
-            if args not in (["on"], ["off"]):
-                raise AppmodeError("usage: latch on|off")
-            self.driving.latched = args[0] == "on"
-            self.say(f"latched driving {args[0]}")
-        elif name == "record":
-            if len(args) != 1:
-                raise AppmodeError("usage: record FILE, or record stop")
-            self.stop_recording() if args[0] == "stop" else self.start_recording(args[0])
-        elif name in self.command_names or name in self.aliases:
-            return self._dispatch(self.aliases.get(name, name), args)
-        else:
+    def _command(self, name: str, args: list[str]) -> Step:
+        name = COMMON_ALIASES.get(name, self.aliases.get(name, name))
+        spec = self._specs.get(name)
+        if spec is None:
             raise AppmodeError(f"unknown command {name!r}: type help for the list")
-        return None
-
-    aliases: ClassVar[dict[str, str]] = {}
-    """Other names for commands."""
+        return spec.run(self, args)

@@ -26,7 +26,8 @@ from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
-from appmode.session.base import SPEED_KEYS, SPEED_STEP, BaseSession, CommandSpec, Step
+from appmode.session.base import SPEED_KEYS, BaseSession
+from appmode.session.control_commands import COMMANDS, SETTING_NAMES
 from appmode.session.control_status import STOP, control_grid, control_lit, control_rows
 from appmode.session.hold import HoldToDrive
 from appmode.session.status import Row
@@ -35,23 +36,7 @@ DEFAULT_SPEED = 300
 """Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""
 DEFAULT_ANGLE = 90.0
 REPORT_BIT = params.MODE_BIT["encoder_report"]
-SETTING_NAMES = tuple(s.name for s in settings.SETTINGS)
 
-COMMANDS: tuple[CommandSpec, ...] = (
-    CommandSpec("settings", "", "read the ten settings"),
-    CommandSpec("read", "NAME...", "read values: settings, pending_angle, speed_a, position_a…"),
-    CommandSpec("set", "NAME VALUE", "set a setting, verified by reading back"),
-    CommandSpec("save", "", "save the settings to the board's flash"),
-    CommandSpec("load", "", "load the saved settings into the running copy"),
-    CommandSpec("defaults", "", "load the factory defaults into the running copy"),
-    CommandSpec("speed", "+N|-N|N", f"the speed keys drive at (keys + and - step {SPEED_STEP})"),
-    CommandSpec("angle", "DEGREES", "the turn r and R make"),
-    CommandSpec("rotate", "[DEGREES]", "turn in angle mode (default: the set angle)"),
-    CommandSpec("drive", "MOTION", "drive: forward, right, rotate-cw… (latched: until stop)"),
-    CommandSpec("velocity", "X Y Z|L R", "send a velocity frame (stays until stop)"),
-    CommandSpec("stop", "", "stop the car (the zero velocity frame)"),
-    CommandSpec("send", "TOKEN...", "send frames as `send --uart2` takes them, or raw hex"),
-)
 
 KEYS_HELP = (
     "arrows, q w e / a s d / z x c drive · , . turn · space stop · l latch\n"
@@ -130,11 +115,6 @@ class ControlSession(BaseSession):
         self._next_angle_read = 0.0
         self.baseline: dict[str, int] | None = None
         """The settings as first read, or as last saved: what a quit would keep."""
-        self.completions |= {
-            "set": dict.fromkeys(SETTING_NAMES),
-            "read": dict.fromkeys(settings.READ_BY_NAME),
-            "drive": dict.fromkeys(MOTIONS),
-        }
         self._open_recording(record)
 
     @property
@@ -148,7 +128,7 @@ class ControlSession(BaseSession):
         (the encoder report is turned on for the session once system_mode is known)."""
         self._send(lambda: self.host.stop())
         if self.reads:
-            self._query(SETTING_NAMES)
+            self.query(SETTING_NAMES)
         else:
             self.say(NO_READS)
 
@@ -208,13 +188,13 @@ class ControlSession(BaseSession):
             return
         self.host.put_back_on_close("system_mode", mode)
         self.say("turning the encoder report on for this session (system_mode bit 6)")
-        self._query(change=("system_mode", mode | REPORT_BIT), quiet=True)
+        self.query(change=("system_mode", mode | REPORT_BIT), quiet=True)
 
     def _follow_rotation(self) -> None:
         if self.rotation is None or self.busy or self.now() < self._next_angle_read:
             return
         self._next_angle_read = self.now() + ROTATE_POLL
-        self._query(["pending_angle"], quiet=True)
+        self.query(["pending_angle"], quiet=True)
 
     def _rotation_read(self, left: int) -> None:
         assert self.rotation is not None
@@ -264,7 +244,7 @@ class ControlSession(BaseSession):
             self.driving.stop()
             self.say("the drive type is not known yet: reading system_mode (or use --drive-type)")
             if not self.busy:
-                self._query(["system_mode"])
+                self.query(["system_mode"])
             return
         fields = velocity_for(MOTIONS[name], self.speed, drive)
         if self._send(lambda: self.host.velocity(**fields)):
@@ -306,7 +286,7 @@ class ControlSession(BaseSession):
 
     # ------------------------------------------------------------ settings
 
-    def _query(
+    def query(
         self,
         names: Iterable[str] = (),
         change: tuple[str, int] | None = None,
@@ -320,7 +300,7 @@ class ControlSession(BaseSession):
         self.host.start_query(self.host.new_query(names, change))
 
     def set_setting(self, name: str, value: int) -> None:
-        self._query(change=(name, value))
+        self.query(change=(name, value))
 
     def store(self, op: str) -> None:
         if not self._send(lambda: self.host.store(op)):
@@ -333,7 +313,7 @@ class ControlSession(BaseSession):
             self.say(f"sent save: {meaning} (the board sends no reply)")
         else:
             self.say(f"sent {op}: {meaning}; reading the settings")
-            self._query(SETTING_NAMES, quiet=True)
+            self.query(SETTING_NAMES, quiet=True)
 
     def unsaved_warning(self) -> str | None:
         if self.baseline is None:
@@ -356,43 +336,8 @@ class ControlSession(BaseSession):
 
     # ------------------------------------------------------------ commands
 
-    def _dispatch(self, name: str, args: list[str]) -> Step:
-        if name == "settings":
-            self._query(SETTING_NAMES)
-        elif name == "read":
-            if not args:
-                raise AppmodeError("usage: read NAME..., e.g. read max_speed pending_angle")
-            self._query(args)
-        elif name == "set":
-            value = params.whole(args[1]) if len(args) == 2 else None
-            if value is None:
-                raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
-            self.set_setting(args[0], value)
-        elif name in settings.STORE_BY_NAME:
-            self.store(name)
-        elif name == "speed":
-            self._speed(args)
-        elif name == "angle":
-            self.angle = _degrees(args, "usage: angle DEGREES, e.g. angle 45")
-            self.say(f"r and R turn {self.angle:g}°")
-        elif name == "rotate":
-            if args == ["-"]:
-                self.rotate(-self.angle)
-            else:
-                self.rotate(_degrees(args, "usage: rotate [DEGREES]") if args else self.angle)
-        elif name == "drive":
-            if len(args) != 1 or args[0] not in MOTIONS:
-                raise AppmodeError(f"usage: drive MOTION, one of {', '.join(MOTIONS)}")
-            self.press(args[0])
-        elif name == "velocity":
-            self._velocity(args)
-        elif name == "stop":
-            self.stop()
-        elif name == "send":
-            self._send_tokens(args)
-        return None
-
-    def _speed(self, args: list[str]) -> None:
+    def speed_command(self, args: list[str]) -> None:
+        """`speed +N`, `speed -N` or `speed N`: the speed the keys drive at."""
         number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
         if number is None:
             raise AppmodeError("usage: speed +N, speed -N or speed N")
@@ -412,12 +357,8 @@ class ControlSession(BaseSession):
         )
         self.say(f"speed {self.speed}{unit}")
 
-    def _velocity(self, args: list[str]) -> None:
-        if not args:
-            raise AppmodeError("usage: velocity X Y Z (diff-gyro: velocity LEFT RIGHT)")
-        self._send_tokens(["velocity:" + ",".join(args)])
-
-    def _send_tokens(self, tokens: list[str]) -> None:
+    def send_tokens(self, tokens: list[str]) -> None:
+        """`send`: frames as `send --uart2` takes them, or raw hex."""
         if not tokens:
             raise AppmodeError("usage: send TOKEN..., e.g. send velocity:0,200,0 or send FFFE01…")
         steps = [parse_token(token) for token in tokens]
@@ -429,13 +370,3 @@ class ControlSession(BaseSession):
             if not self._send(partial(perform, self.host, step)):
                 return
         self.say(f"sent {' '.join(tokens)}")
-
-
-def _degrees(args: list[str], usage: str) -> float:
-    try:
-        degrees = float(args[0]) if len(args) == 1 else float("nan")
-    except ValueError:
-        degrees = float("nan")
-    if not abs(degrees) <= control.U16 / 10:
-        raise AppmodeError(usage)
-    return degrees

@@ -1,0 +1,71 @@
+"""The APP port's session commands: each one's name, arguments, help, what runs it and
+what completes after it."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from appmode.errors import AppmodeError
+from appmode.protocol import params
+from appmode.session.base import SPEED_COMPLETES, SPEED_STEP, CommandSpec
+
+if TYPE_CHECKING:
+    from appmode.session.app_session import Session
+
+PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}
+
+
+def _set(session: Session, args: list[str]) -> None:
+    value = params.whole(args[1]) if len(args) == 2 else None
+    if value is None:
+        raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
+    session.set_param(params.lookup(args[0]).index, value)
+
+
+def _drive(session: Session, args: list[str]) -> None:
+    if len(args) != 1 or args[0].upper() not in "ABCDEFGH" or len(args[0]) != 1:
+        raise AppmodeError("usage: drive LETTER, one of A-H")
+    session.press(args[0].upper())
+
+
+def _page(session: Session, args: list[str]) -> None:
+    if len(args) != 1 or args[0].lower() not in PAGE_WORDS:
+        raise AppmodeError("usage: page direction|button|gravity|joystick")
+    session.switch_page(PAGE_WORDS[args[0].lower()])
+
+
+COMMANDS: tuple[CommandSpec[Session], ...] = (
+    CommandSpec("params", "", "read the nine parameters", lambda s, a: s.read_params()),
+    CommandSpec(
+        "set",
+        "NAME VALUE",
+        "set a parameter, verified by reading back",
+        _set,
+        {p.name: None for p in params.PARAMS},
+    ),
+    CommandSpec(
+        "save", "", "save the parameters to the board's flash ({Q:W})", lambda s, a: s.save()
+    ),
+    CommandSpec(
+        "speed",
+        "+N|-N|N",
+        f"change max_speed (keys + and - step {SPEED_STEP})",
+        lambda s, a: s.speed_command(a),
+        SPEED_COMPLETES,
+    ),
+    CommandSpec("drive", "A-H", "drive in a direction (latched: until stop)", _drive),
+    CommandSpec("stop", "", "stop the car (Z)", lambda s, a: s.stop()),
+    CommandSpec(
+        "page",
+        "NAME",
+        "switch page: direction (J), button (K), gravity (I)",
+        _page,
+        dict.fromkeys(PAGE_WORDS),
+    ),
+    CommandSpec(
+        "send",
+        "TOKEN...",
+        "send raw tokens: letters, {frames}, \\xNN",
+        lambda s, a: s.send_tokens(a),
+    ),
+)
