@@ -10,7 +10,7 @@ from contextlib import ExitStack
 from typing import TextIO
 
 from appmode.board.profiles import SHEET, Profile
-from appmode.cli.hostio import with_recording
+from appmode.cli.hostio import until_count, with_recording
 from appmode.host.control_client import ControlHost, Event
 from appmode.host.control_tokens import Step, parse_setting, parse_token, perform
 from appmode.host.state import LinkStatus
@@ -182,12 +182,10 @@ def run_monitor(
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         try:
-            for event in host.events(duration):
+            for event in until_count(host.events(duration), _is_answer, count):
                 errors += isinstance(event, control.Garbage)
                 bursts += isinstance(event, control.Status)
-                seen += isinstance(event, (control.Reply, control.EncoderReport))
-                if count is not None and seen >= count:
-                    break
+                seen += _is_answer(event)
         finally:
             also = f", {counted(bursts, 'status burst')} (a minibalance board's)" if bursts else ""
             print(
@@ -198,3 +196,8 @@ def run_monitor(
             if not seen:
                 print(wrapped(f"monitor: {QUIET_UART2}"), file=sys.stderr)
     return 0
+
+
+def _is_answer(event: Event) -> bool:
+    """A reply or an encoder report: what a UART2 monitor counts."""
+    return isinstance(event, (control.Reply, control.EncoderReport))

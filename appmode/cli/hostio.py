@@ -1,10 +1,11 @@
-"""What `send`, `params` and `monitor` share: a host opened with its recording, and its
-events printed as text or JSON Lines."""
+"""What `send`, `params` and `monitor` share, on either port: a host opened with its
+recording, its events printed as text or JSON Lines, and read until a count."""
 
 from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import ExitStack, closing
 from typing import TextIO, TypeVar
 
@@ -18,6 +19,7 @@ from appmode.protocol.render import describe, line, to_json
 from appmode.protocol.transcript import Recorder
 
 H = TypeVar("H", Host, ControlHost)
+E = TypeVar("E")
 
 
 def open_host(
@@ -71,3 +73,14 @@ def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:
     else:
         out.write(line(host.now(), "<", event.raw, describe(event, host.state.layout)) + "\n")
     out.flush()
+
+
+def until_count(events: Iterable[E], counts: Callable[[E], bool], count: int | None) -> Iterator[E]:
+    """`events` until `count` of them are ones that `counts` (all of them when None): a
+    monitor on either port stops after its --count."""
+    seen = 0
+    for event in events:
+        yield event
+        seen += counts(event)
+        if count is not None and seen >= count:
+            return

@@ -117,22 +117,17 @@ def run_monitor(
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none
     (`appmode record`)."""
-    from appmode.cli.hostio import open_host, show
+    from appmode.cli.hostio import open_host, show, until_count
 
-    seen = 0
     with ExitStack() as stack:
         host = open_host(stack, url, record, stop_on_close=stop_on_exit, layout=layout)
         doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"
         print(f"{doing} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+        wanted = (e for e in host.events(duration) if kinds is None or _kind(e) in kinds)
         try:
-            for event in host.events(duration):
-                if kinds is not None and _kind(event) not in kinds:
-                    continue
+            for event in until_count(wanted, _is_record, count):
                 if out is not None:
                     show(host, event, out, as_json)
-                seen += isinstance(event, app.RECORDS)
-                if count is not None and seen >= count:
-                    break
         finally:
             stats = host.state.stats
             skipped = f" ({stats.skipped} before the first record)" if stats.skipped else ""
@@ -153,6 +148,10 @@ def parse_kinds(text: str) -> frozenset[str]:
             f"{text!r}: expected record letters and 'errors', e.g. A,B or C,errors"
         )
     return kinds
+
+
+def _is_record(event: Event) -> bool:
+    return isinstance(event, app.RECORDS)
 
 
 def _kind(event: Event) -> str:
