@@ -1,4 +1,4 @@
-"""Board profiles (design.md "Board profiles"): every point where the simulated board can
+"""Board profiles (docs/design.md, "The board in parts"): every point where the simulated board can
 behave differently, as one named switch, and one row of values per profile.
 
 `sheet` is the vendor's sheet as docs/protocol.md §1–§12 reads it; `minibalance` is the

@@ -74,11 +74,11 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.uart2:
-        from appmode.cli import control_port  # here: start-up stays short
+        from appmode.cli import uart2  # here: start-up stays short
 
         if args.filter is not None:
             raise AppmodeError("--filter picks APP records: not with --uart2")
-        return control_port.run_monitor(
+        return uart2.run_monitor(
             args.url,
             profile=profile_for(args.url, args.profile),
             as_json=args.json,

@@ -87,10 +87,10 @@ def run(args: argparse.Namespace) -> int:
                 "--verify-saved is for the APP port: over --uart2, restart the board and "
                 "read the settings again"
             )
-        from appmode.cli import control_port  # here: start-up stays short
+        from appmode.cli import uart2  # here: start-up stays short
 
         store = next((op for op in ("load", "defaults", "save") if getattr(args, op)), None)
-        return control_port.run_params(
+        return uart2.run_params(
             args.url, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
         )
     if args.load or args.defaults:

@@ -60,9 +60,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     if args.uart2:
-        from appmode.cli import control_port  # here: start-up stays short
+        from appmode.cli import uart2  # here: start-up stays short
 
-        return control_port.run_send(
+        return uart2.run_send(
             args.url,
             args.tokens,
             profile=profile_for(args.url, args.profile),

@@ -4,7 +4,7 @@
 default, or minibalance: docs/protocol.md §13), `drive` (omni, mecanum, diff, diff-gyro;
 default: what the flash holds, else omni), `flash` (a JSON parameter file; default: in
 memory), `pace` (1: bytes move at the real 9600-bps rate, the default; 0: instantly),
-`baud`, `faults` (a faulty link both ways, see appmode.faults), `port` (app, the
+`baud`, `faults` (a faulty link both ways, see line/faults.py), `port` (app, the
 default: the APP port, UART3 at 9600 bps; uart2: the control port at 115200 bps,
 docs/protocol.md §8) and `share` (a name: every port opened with the same name in one
 process is a port of one board, so `sim://?share=car` and `sim://?share=car&port=uart2`

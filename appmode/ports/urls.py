@@ -1,4 +1,4 @@
-"""Open any board by URL (design.md): a device path, pyserial's URLs, or `sim://`.
+"""Open any board by URL (docs/design.md, "Contracts"): a device path, pyserial's URLs, or `sim://`.
 
 | URL | what |
 |---|---|

@@ -1,4 +1,4 @@
-"""Bytes as printable text, losslessly (transcript format v1, design.md).
+"""Bytes as printable text, losslessly (transcript format v1, docs/design.md).
 
 Bytes 0x21–0x7E stand for themselves, except the backslash, written `\\\\`; every
 other byte is written `\\xNN`.

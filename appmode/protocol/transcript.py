@@ -1,4 +1,4 @@
-"""Transcripts, format v1 (design.md): one protocol unit a line, `TIME DIR PAYLOAD`."""
+"""Transcripts, format v1 (docs/design.md): one protocol unit a line, `TIME DIR PAYLOAD`."""
 
 from __future__ import annotations
 

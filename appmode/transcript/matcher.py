@@ -1,4 +1,4 @@
-"""Transcripts as conformance tests (design.md): the matcher, with no I/O.
+"""Transcripts as conformance tests (docs/design.md, "Contracts"): the matcher, with no I/O.
 
 `>` lines are sent at their times (`2>` lines on UART2). Each `<` line that is a record
 is an expectation, to be matched in file order by a record the board sends (each `2<`

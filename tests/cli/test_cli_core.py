@@ -1,4 +1,4 @@
-"""The command line: `appmode decode` (design.md contract) and `appmode demo`."""
+"""The command line: `appmode decode` (docs/design.md, "Contracts") and `appmode demo`."""
 
 from __future__ import annotations
 
@@ -99,7 +99,7 @@ def test_the_command_line_loads_a_commands_machinery_only_to_run_it() -> None:
         "appmode.host.client",
         "appmode.host.probe",
         "appmode.cli.hostio",
-        "appmode.cli.control_port",
+        "appmode.cli.uart2",
         "appmode.board.firmware",
         "appmode.ports.sim",
         "appmode.console.driving",

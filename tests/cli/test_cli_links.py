@@ -1,4 +1,4 @@
-"""`appmode board`, `params`, `send`, `monitor` as a user runs them (design.md contract)."""
+"""`appmode board`, `params`, `send`, `monitor` as a user runs them (docs/design.md)."""
 
 from __future__ import annotations
 

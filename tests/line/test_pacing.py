@@ -1,4 +1,4 @@
-"""Pacing (design.md): 10 bits a byte at the baud rate, deadline-based, no drift."""
+"""Pacing (docs/design.md): 10 bits a byte at the baud rate, deadline-based, no drift."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Links by URL (design.md): every URL kind, sim:// for pyserial, and clear open errors."""
+"""Links by URL (docs/design.md): every URL kind, sim:// for pyserial, and clear open errors."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Transcript format v1 (design.md): writer and reader, and bad input with file:line."""
+"""Transcript format v1 (docs/design.md): writer and reader, and bad input with file:line."""
 
 from __future__ import annotations
 

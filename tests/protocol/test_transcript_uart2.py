@@ -1,4 +1,4 @@
-"""Transcripts with two ports (design.md): `2>` / `2<` lines of hex pairs, `??` in
+"""Transcripts with two ports (docs/design.md, "Contracts"): `2>` / `2<` lines of hex pairs, `??` in
 expectations, APP text on UART2 in APP mode, and a recorder that follows the board."""
 
 from __future__ import annotations

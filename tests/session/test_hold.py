@@ -1,4 +1,4 @@
-"""Hold-to-drive release emulation (design.md, "The console")."""
+"""Hold-to-drive release emulation (docs/design.md, the session layer)."""
 
 from __future__ import annotations
 
