@@ -17,6 +17,7 @@ LAYERS = (
     "transcript",
     "session",
     "console",
+    "web",
     "testing",
     "cli",
 )

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 COMMANDS: dict[str, str] = {
     "drive": "drive and tune a car from the keyboard (the main job)",
+    "web": "drive and tune a car from a browser: the page appmode serves",
     "demo": "drive the embedded simulated board through a short route, printing every record",
     "decode": "decode a raw byte stream to JSON Lines",
     "board": "serve the simulated board on a pseudo-terminal, TCP or a serial port",

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from serial import SerialException
 
@@ -23,6 +25,10 @@ from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 from appmode.session.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
+if TYPE_CHECKING:
+    from appmode.session.base import BaseSession
+    from appmode.session.hold import HoldToDrive
+
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     drive = sub.add_parser(
@@ -37,36 +43,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "velocity frame); with --uart2-url (or a second URL) it holds both ports of one "
         "board: it drives over UART2 and shows the APP port's records.",
     )
-    drive.add_argument(
-        "url",
-        nargs="?",
-        default="sim://",
-        metavar="URL",
-        help="the board (default: sim://, the simulated board); see "
-        "'appmode params -h' for URL forms",
-    )
-    drive.add_argument(
-        "url2",
-        nargs="?",
-        metavar="URL2",
-        help="the same board's control port: as --uart2-url",
-    )
-    add_uart2(drive, "drive over the board's control port (UART2, velocity frames)")
-    drive.add_argument(
-        "--uart2-url",
-        metavar="URL",
-        help="open the board's control port there too: drive over it and show the APP "
-        "port's records (two sim:// URLs are one simulated board)",
-    )
-    drive.add_argument(
-        "--drive",
-        "--drive-type",
-        dest="drive_type",
-        choices=DRIVE_NAMES,
-        help="the car's drive type: the embedded board's (sim://?drive=; default: omni), "
-        "or with UART2 a board's that does not answer reads (default: read from "
-        "system_mode)",
-    )
+    add_board(drive)
     drive.add_argument(
         "--hold-first",
         type=number_type(0, 60, low_open=True),
@@ -91,27 +68,71 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="script mode (commands on stdin): run every line after an error (by default "
         "the first error ends the script); the exit status is 1 if any line failed",
     )
+    return drive
+
+
+def add_board(parser: argparse.ArgumentParser) -> None:
+    """Which board, and which of its ports, a driving session opens (drive and web)."""
+    parser.add_argument(
+        "url",
+        nargs="?",
+        default="sim://",
+        metavar="URL",
+        help="the board (default: sim://, the simulated board); see "
+        "'appmode params -h' for URL forms",
+    )
+    parser.add_argument(
+        "url2",
+        nargs="?",
+        metavar="URL2",
+        help="the same board's control port: as --uart2-url",
+    )
+    add_uart2(parser, "drive over the board's control port (UART2, velocity frames)")
+    parser.add_argument(
+        "--uart2-url",
+        metavar="URL",
+        help="open the board's control port there too: drive over it and show the APP "
+        "port's records (two sim:// URLs are one simulated board)",
+    )
+    parser.add_argument(
+        "--drive",
+        "--drive-type",
+        dest="drive_type",
+        choices=DRIVE_NAMES,
+        help="the car's drive type: the embedded board's (sim://?drive=; default: omni), "
+        "or with UART2 a board's that does not answer reads (default: read from "
+        "system_mode)",
+    )
     add_profile(
-        drive,
+        parser,
         "the board's profile: with no URL, the simulated board's (sheet or minibalance: the "
         "reference firmware, docs/protocol.md §13); with a URL, what its A record holds",
         default=None,
     )
-    add_record(drive)
-    return drive
+    add_record(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.console.driving import run_drive
-    from appmode.ports.urls import is_simulated  # here: start-up stays short
-    from appmode.session.app_session import Session
-    from appmode.session.control_session import ControlSession
+    from appmode.console.driving import run_drive  # here: start-up stays short
     from appmode.session.hold import HoldToDrive
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
-    url = _with_options(args.url, profile=args.profile, drive=args.drive_type)
     on_message = None if interactive else _print_message
+    session = make_session(args, driving, on_message)
+    return run_drive(session, interactive, sys.stdin, sys.stdout, keep_going=args.keep_going)
+
+
+def make_session(
+    args: argparse.Namespace, driving: HoldToDrive, on_message: Callable[[str], None] | None
+) -> BaseSession:
+    """The session `add_board`'s arguments ask for: the APP port's, or the control port's
+    (with the APP port of the same board if given)."""
+    from appmode.ports.urls import is_simulated
+    from appmode.session.app_session import Session
+    from appmode.session.control_session import ControlSession
+
+    url = _with_options(args.url, profile=args.profile, drive=args.drive_type)
     layout = layout_for(url, args.profile)
     uart2_url = args.uart2_url or args.url2
     if args.url2 and args.uart2_url:
@@ -122,20 +143,14 @@ def run(args: argparse.Namespace) -> int:
                 "--drive on a real board's APP port: its drive type is part of "
                 "system_mode (appmode params URL --set system_mode=N), or add --uart2"
             )
-        return run_drive(
-            Session(
-                url,
-                driving,
-                args.record,
-                on_message,
-                layout,
-                stop_again_for(url, args.profile),
-                profile_for(url, args.profile).steer_in_frames,
-            ),
-            interactive,
-            sys.stdin,
-            sys.stdout,
-            keep_going=args.keep_going,
+        return Session(
+            url,
+            driving,
+            args.record,
+            on_message,
+            layout,
+            stop_again_for(url, args.profile),
+            profile_for(url, args.profile).steer_in_frames,
         )
     app_url = None
     if uart2_url is not None:
@@ -143,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         if is_simulated(app_url) and is_simulated(url):
             app_url, url = _one_board(app_url, url)
     profile = profile_for(url, args.profile)
-    session = ControlSession(
+    return ControlSession(
         url,
         driving,
         args.record,
@@ -154,7 +169,6 @@ def run(args: argparse.Namespace) -> int:
         takeover_byte=profile.takeover_byte,
         reads=profile.answers_reads,
     )
-    return run_drive(session, interactive, sys.stdin, sys.stdout, keep_going=args.keep_going)
 
 
 def _with_options(url: str, **options: str | None) -> str:

@@ -1,0 +1,224 @@
+"""`appmode web`: the page a phone's (or any) browser opens to drive the car, served
+with aiohttp on this machine.
+
+Every request carries the owner's token (in the address printed once, then a cookie) and
+a Host header naming this server; the websocket's Origin must be the page itself. The
+session is ticked every REFRESH seconds; each page gets its status when it changes.
+Whatever ends the server — Ctrl-C, SIGTERM, SIGHUP — the session closes, and its stop is
+the last thing sent to the car.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import sys
+from collections.abc import Awaitable, Callable
+from contextlib import suppress
+from importlib import resources
+
+from aiohttp import WSMsgType, web
+
+from appmode.errors import AppmodeError
+from appmode.host import signals
+from appmode.session.base import BaseSession
+from appmode.web.access import (
+    COOKIE,
+    allowed_hosts,
+    new_token,
+    origin_matches,
+    token_matches,
+)
+from appmode.web.bridge import MAX_MESSAGE, Bridge
+
+REFRESH = 0.02
+"""Seconds between reads of the link (and checks of the heartbeat)."""
+SEND = 0.1
+"""How often each page's status is checked, and sent if it changed."""
+ASSETS = ("index.html", "app.js", "app.css")
+TYPES = {".html": "text/html", ".js": "text/javascript", ".css": "text/css"}
+HEADERS = {
+    "Cache-Control": "no-store",
+    "X-Content-Type-Options": "nosniff",
+    "Referrer-Policy": "no-referrer",
+    "Content-Security-Policy": "default-src 'self'; connect-src 'self'; frame-ancestors 'none'",
+}
+
+
+def _asset(name: str) -> bytes:
+    return (resources.files("appmode.web") / "static" / name).read_bytes()
+
+
+class WebServer:
+    """The page and its websocket over one session."""
+
+    def __init__(self, session: BaseSession, host: str, port: int, token: str | None = None):
+        self.bridge = Bridge(session)
+        self.session = session
+        self.host = host
+        self.port = port
+        self.token = token or new_token()
+        self._hosts: frozenset[str] = frozenset()
+        self._sockets: set[web.WebSocketResponse] = set()
+        self._runner: web.AppRunner | None = None
+        self.app = web.Application(middlewares=[self._guard], client_max_size=MAX_MESSAGE)
+        self.app.router.add_get("/", self._index)
+        self.app.router.add_get("/static/{name}", self._static)
+        self.app.router.add_get("/ws", self._websocket)
+
+    @property
+    def address(self) -> str:
+        """What the owner opens: the page, with the token."""
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"http://{host}:{self.port}/?token={self.token}"
+
+    async def start(self) -> None:
+        """Listen (port 0 picks a free one: `port` then says which)."""
+        self._runner = web.AppRunner(self.app, access_log=None, handle_signals=False)
+        await self._runner.setup()
+        site = web.TCPSite(self._runner, self.host, self.port, shutdown_timeout=0.5)
+        try:
+            await site.start()
+        except OSError as exc:
+            await self._runner.cleanup()
+            where = f"{self.host}:{self.port}"
+            raise AppmodeError(
+                f"cannot serve the page on {where}: {exc.strerror or exc}; pick another "
+                "address with --listen HOST:PORT (port 0 picks a free one)"
+            ) from None
+        self.port = self._runner.addresses[0][1]
+        self._hosts = allowed_hosts(self.host, self.port)
+
+    async def stop(self) -> None:
+        for socket in list(self._sockets):
+            await socket.close()
+        if self._runner is not None:
+            await self._runner.cleanup()
+
+    # ------------------------------------------------------------ who may come in
+
+    @web.middleware
+    async def _guard(
+        self, request: web.Request, handler: Callable[[web.Request], Awaitable[web.StreamResponse]]
+    ) -> web.StreamResponse:
+        if request.headers.get("Host") not in self._hosts:
+            return _refused("this server answers only to its own address")
+        if request.path == "/" and "token" in request.query:
+            if not token_matches(self.token, request.query.get("token")):
+                return _refused("wrong token: open the address appmode web printed")
+            found = web.HTTPSeeOther("/")  # the token leaves the address bar
+            found.set_cookie(
+                COOKIE, self.token, httponly=True, samesite="Strict", path="/", max_age=None
+            )
+            return found
+        if not token_matches(self.token, request.cookies.get(COOKIE)):
+            return _refused("no token: open the address appmode web printed, with its token")
+        response = await handler(request)
+        response.headers.update(HEADERS)
+        return response
+
+    # ------------------------------------------------------------ routes
+
+    async def _index(self, request: web.Request) -> web.StreamResponse:
+        return web.Response(body=_asset("index.html"), content_type="text/html")
+
+    async def _static(self, request: web.Request) -> web.StreamResponse:
+        name = request.match_info["name"]
+        if name not in ASSETS:
+            raise web.HTTPNotFound()
+        kind = TYPES[name[name.rindex(".") :]]
+        return web.Response(body=_asset(name), content_type=kind)
+
+    async def _websocket(self, request: web.Request) -> web.StreamResponse:
+        if not origin_matches(request.headers.get("Origin"), request.host, request.scheme):
+            return _refused("the websocket takes this page only (Origin)")
+        socket = web.WebSocketResponse(max_msg_size=MAX_MESSAGE, heartbeat=5.0)
+        await socket.prepare(request)
+        self._sockets.add(socket)
+        self.bridge.join(socket)
+        sender = asyncio.ensure_future(self._send_status(socket))
+        try:
+            async for message in socket:
+                if message.type in (WSMsgType.TEXT, WSMsgType.BINARY):
+                    reply = self.bridge.handle(socket, message.data)
+                    if reply is not None:
+                        await socket.send_str(json.dumps(reply))
+        finally:
+            sender.cancel()
+            self._sockets.discard(socket)
+            self.bridge.leave(socket)
+        return socket
+
+    async def _send_status(self, socket: web.WebSocketResponse) -> None:
+        shown = ""
+        while not socket.closed:
+            text = json.dumps(self.bridge.status(socket))
+            if text != shown:
+                shown = text
+                await socket.send_str(text)
+            await asyncio.sleep(SEND)
+
+    # ------------------------------------------------------------ running
+
+    async def run(self, announce: Callable[[str], None]) -> None:
+        """Serve until an ending signal (or Ctrl-C); the session ticks meanwhile."""
+        loop = asyncio.get_running_loop()
+        ended = asyncio.Event()
+
+        def on_signal() -> None:
+            loop.call_soon_threadsafe(ended.set)
+
+        with signals.diverted(on_signal):
+            await self.start()
+            announce(self.address)
+            try:
+                while not ended.is_set():
+                    self.session.tick()
+                    with suppress(asyncio.TimeoutError):
+                        await asyncio.wait_for(ended.wait(), REFRESH)
+            finally:
+                await self.stop()
+
+
+def _refused(text: str) -> web.Response:
+    return web.Response(status=403, text=f"403: {text}\n", headers=HEADERS)
+
+
+class _OneLine(logging.Formatter):
+    """The server's own complaints (a handler that failed), one line each."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        text = record.getMessage()
+        if record.exc_info and record.exc_info[1] is not None:
+            text += f": {record.exc_info[1]!r}"
+        return f"appmode web: {text}"
+
+
+def serve_web(session: BaseSession, host: str, port: int) -> int:
+    """Start the session, serve the page until ended, and always close the session: its
+    stop is the last thing sent."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(_OneLine())
+    server_log = logging.getLogger("aiohttp")
+    server_log.addHandler(handler)
+    server_log.propagate = False
+    try:
+        session.start()
+        server = WebServer(session, host, port)
+
+        def announce(address: str) -> None:
+            print(f"web: {address}", flush=True)
+            print(
+                "appmode: open that address in a browser on this machine; Ctrl-C stops "
+                "the car and the server",
+                file=sys.stderr,
+                flush=True,
+            )
+
+        asyncio.run(server.run(announce))
+    finally:
+        session.close()
+        for note in session.closing_notes:
+            print(f"appmode: WARNING: {note}", file=sys.stderr)
+    return 0

@@ -1,0 +1,82 @@
+"""`appmode web` as a process, beside a board process whose host bytes are recorded."""
+
+from __future__ import annotations
+
+import re
+import selectors
+import signal
+import subprocess
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from tests.support.processes import ROOT, BoardProcess, appmode_cmd, board_process, sent_lines
+
+
+@dataclass
+class WebProcess:
+    proc: subprocess.Popen[str]
+    address: str
+    """The page's address, with its token."""
+    board: BoardProcess
+    record: Path
+
+    @property
+    def origin(self) -> str:
+        return self.address.split("/?", 1)[0]
+
+    @property
+    def token(self) -> str:
+        return self.address.rsplit("=", 1)[1]
+
+    def sent(self) -> list[str]:
+        """What the board received, one unit a line."""
+        return sent_lines(self.record) if self.record.exists() else []
+
+    def stop(self, sig: int = signal.SIGTERM) -> tuple[int, str]:
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            _, err = self.proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            _, err = self.proc.communicate()
+        return self.proc.returncode, err
+
+
+@contextmanager
+def web_process(tmp_path: Path, *args: str) -> Iterator[WebProcess]:
+    """A board on a pty recording what it receives, and `appmode web` driving it."""
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--record", str(record), "--quiet") as board:
+        proc = subprocess.Popen(
+            appmode_cmd("web", board.url, "--listen", "127.0.0.1:0", *args),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+        assert proc.stdout is not None
+        sel = selectors.DefaultSelector()
+        sel.register(proc.stdout, selectors.EVENT_READ)
+        line = proc.stdout.readline() if sel.select(20) else ""
+        found = re.match(r"web: (http://\S+)", line)
+        web = WebProcess(proc, found.group(1) if found else "", board, record)
+        try:
+            assert found, f"appmode web printed {line!r}: {web.stop()[1]}"
+            yield web
+        finally:
+            web.stop()
+
+
+def wait_sent(web: WebProcess, wanted: str, timeout: float = 5.0) -> list[str]:
+    """Wait until the board has received `wanted` last; what it received."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        sent = web.sent()
+        if sent and sent[-1] == wanted:
+            return sent
+        time.sleep(0.02)
+    raise AssertionError(f"the board's last unit is not {wanted!r}: {web.sent()[-8:]}")
