@@ -219,6 +219,9 @@ class Session(BaseSession):
             for r, row in enumerate(letters)
         ]
 
+    def cell_names(self) -> list[list[str]]:
+        return [[letter_name(self.page, x) for x in row] for row in grid_for(self.page)]
+
     def lit_cell(self) -> tuple[int, int] | None:
         if self.in_force == STOP_LETTER:
             return None

@@ -194,6 +194,10 @@ class BaseSession(ABC):
         """The 3×3 grid (row 0 is the front): what each key does, as shown."""
 
     @abstractmethod
+    def cell_names(self) -> list[list[str]]:
+        """What each key of the grid does, by name (`forward`, `rotate-cw`, `stop`)."""
+
+    @abstractmethod
     def lit_cell(self) -> tuple[int, int] | None:
         """The cell of the grid in force (the car moves), if any."""
 

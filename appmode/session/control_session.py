@@ -219,6 +219,10 @@ class ControlSession(BaseSession):
     def grid_cells(self) -> list[list[str]]:
         return control_grid(self)
 
+    def cell_names(self) -> list[list[str]]:
+        keys = [[self.grid_key(r, c) for c in range(3)] for r in range(3)]
+        return [["stop" if key == STOP_LETTER else key for key in row] for row in keys]
+
     def lit_cell(self) -> tuple[int, int] | None:
         return control_lit(self)
 

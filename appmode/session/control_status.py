@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING
 
 from appmode.protocol import settings
 from appmode.protocol.control_view import describe
-from appmode.protocol.directions import STOP_LETTER
 from appmode.session.status import (
     GLYPHS,
     WIDTH,
@@ -92,11 +91,8 @@ def _in_force(session: ControlSession) -> list[Row]:
 
 
 def control_grid(session: ControlSession) -> list[list[str]]:
-    def cell(r: int, c: int) -> str:
-        name = session.grid_key(r, c)
-        return f"{GLYPHS[r][c]} {'stop' if name == STOP_LETTER else name}"
-
-    return [[cell(r, c) for c in range(3)] for r in range(3)]
+    names = session.cell_names()
+    return [[f"{GLYPHS[r][c]} {names[r][c]}" for c in range(3)] for r in range(3)]
 
 
 def control_lit(session: ControlSession) -> tuple[int, int] | None:

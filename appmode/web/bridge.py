@@ -13,23 +13,13 @@ import json
 import time
 from typing import Any
 
+from appmode.host.state import TRACE_SECONDS, HostState
+from appmode.protocol import app
 from appmode.session.base import BaseSession, Quit, ShowHelp, ShowStatus
 from appmode.session.hold import HoldToDrive
 
 HEARTBEAT = 0.25
 """Seconds a held direction lasts without a heartbeat from its page."""
-CELLS = {
-    "front-left": (0, 0),
-    "forward": (0, 1),
-    "front-right": (0, 2),
-    "left": (1, 0),
-    "stop": (1, 1),
-    "right": (1, 2),
-    "rear-left": (2, 0),
-    "backward": (2, 1),
-    "rear-right": (2, 2),
-}
-"""The pad's cells by their accessible names: row 0 is the front."""
 MAX_MESSAGE = 1024
 """Longest message a page may send, in bytes."""
 RATE = 60.0
@@ -70,6 +60,8 @@ class Bridge:
         self.session = session
         self.driver: object | None = None
         self.pages: dict[object, Bucket] = {}
+        self.waves: set[object] = set()
+        """Pages that draw waveforms: their status carries the traces."""
 
     def join(self, page: object) -> None:
         """A page opened: it drives if none does, else it watches."""
@@ -80,6 +72,7 @@ class Bridge:
     def leave(self, page: object) -> None:
         """A page closed (or lost its connection): if it drove, the car stops."""
         self.pages.pop(page, None)
+        self.waves.discard(page)
         if page is self.driver:
             self.driver = None
             self.session.stop()
@@ -103,20 +96,34 @@ class Bridge:
         kind = message.get("t") if isinstance(message, dict) else None
         if kind == "take":
             return self._take(page)
+        if kind == "waves":
+            (self.waves.add if message.get("on") is True else self.waves.discard)(page)
+            return None
         if kind not in ("press", "hold", "release", "stop", "command"):
             return {"t": "error", "text": f"unknown message {kind!r}: ignored"}
         if page is not self.driver:
             return {"t": "error", "text": "this page watches: take over to drive"}
         if kind in ("press", "hold"):
-            cell = CELLS.get(message.get("key")) if isinstance(message.get("key"), str) else None
-            if cell is None:
-                return {"t": "error", "text": f"no pad cell {message.get('key')!r}"}
-            self.session.press(self.session.grid_key(*cell))
+            key = self._key(message.get("key"))
+            if key is None:
+                return {"t": "error", "text": f"no key {message.get('key')!r} here"}
+            self.session.press(key)
         elif kind in ("release", "stop"):
             self.session.stop()
         else:
             return self._command(message.get("line"))
         return None
+
+    def _key(self, name: object) -> str | None:
+        """What the session's `press` takes for a key the page names: a cell of the grid
+        by what it does (`forward`, `rotate-cw` on the button page), or a driving key
+        besides the grid."""
+        session = self.session
+        for r, row in enumerate(session.cell_names()):
+            for c, cell in enumerate(row):
+                if cell == name:
+                    return session.grid_key(r, c)
+        return name if isinstance(name, str) and name in session.hold_keys.values() else None
 
     def _take(self, page: object) -> dict[str, Any] | None:
         """A watcher takes over: the car stops first, and the page that drove sees it
@@ -156,7 +163,31 @@ class Bridge:
             "role": self.role(page),
             "pages": len(self.pages),
             "rows": rows,
-            "grid": session.grid_cells(),
+            "cells": session.cell_names(),
+            "extra": list(session.hold_keys.values()),
             "lit": session.lit_cell(),
+            "commands": [spec.name for spec in session.commands],
+            "traces": _traces(session.telemetry_state(), session.now())
+            if page in self.waves
+            else None,
             "messages": list(session.messages)[-MESSAGES:],
         }
+
+
+def _traces(state: HostState | None, now: float) -> dict[str, Any] | None:
+    """The last TRACE_SECONDS of A and B records, for waveforms: each series's label and
+    its points (seconds before now, value)."""
+    if state is None:
+        return None
+    velocity = [(now - t, app.record_fields(v)[1]) for t, v in state.velocities.points]
+    attitude = [(now - t, app.record_fields(a)[1]) for t, a in state.attitudes.points]
+    labels = state.layout.labels
+    series = [
+        {"label": labels[i], "points": [[round(ago, 3), values[i]] for ago, values in velocity]}
+        for i in state.layout.motion
+    ]
+    series += [
+        {"label": name, "points": [[round(ago, 3), values[i]] for ago, values in attitude]}
+        for i, name in enumerate(("pitch", "roll", "yaw", "battery"))
+    ]
+    return {"seconds": TRACE_SECONDS, "series": series}

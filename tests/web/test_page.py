@@ -121,3 +121,120 @@ def test_closing_or_hiding_the_page_stops_the_car(browser: Browser, tmp_path: Pa
         wait_sent(web, "C")
         page.context.close()  # the tab goes away with the finger still down
         wait_sent(web, "Z")
+
+
+def test_tilting_drives_past_the_dead_zone_and_level_stops(
+    browser: Browser, tmp_path: Path
+) -> None:
+    with web_process(tmp_path) as web:
+        page = phone(browser, web)
+        page.get_by_role("button", name="Tilt").click()
+
+        def tilt(beta: float, gamma: float) -> None:
+            page.evaluate(
+                "([beta, gamma]) => window.dispatchEvent("
+                "new DeviceOrientationEvent('deviceorientation', {beta, gamma, alpha: 0}))",
+                [beta, gamma],
+            )
+
+        tilt(40, 0)  # held at 40°: then calibrated as level
+        page.get_by_role("button", name="Calibrate level").click()
+        page.get_by_role("button", name="Drive by tilting").click()
+        tilt(45, 3)  # inside the dead zone: nothing
+        page.wait_for_timeout(300)
+        assert "A" not in web.sent()
+        for _ in range(5):  # the top edge down: forward, as the sensor repeats
+            tilt(15, 0)
+            page.wait_for_timeout(100)
+        wait_sent(web, "A")
+        tilt(40, 25)  # to the right
+        wait_sent(web, "C")
+        tilt(40, 0)  # level again: stop
+        wait_sent(web, "Z")
+        page.screenshot(path=str(tmp_path / "tilt.png"))
+
+
+def test_the_button_page_rotates_and_the_pad_says_so(browser: Browser, tmp_path: Path) -> None:
+    with web_process(tmp_path) as web:
+        page = phone(browser, web)
+        page.get_by_role("button", name="Button page").click()
+        rotate = page.get_by_role("button", name="rotate-cw", exact=True)
+        rotate.wait_for(timeout=5000)
+        x, y = centre(page, "rotate-cw")
+        page.mouse.move(x, y)
+        page.mouse.down()
+        wait_sent(web, "C")
+        page.mouse.up()
+        wait_sent(web, "Z")
+        assert "K" in web.sent()
+        x, y = centre(page, "front-left")  # B: mirrored on the button page (§4)
+        page.mouse.move(x, y)
+        page.mouse.down()
+        wait_sent(web, "B")
+        page.mouse.up()
+        wait_sent(web, "Z")
+
+
+def test_the_params_page_sets_verified_and_save_is_only_requested(
+    browser: Browser, tmp_path: Path
+) -> None:
+    with web_process(tmp_path) as web:
+        page = phone(browser, web)
+        page.get_by_role("button", name="Params").click()
+        page.get_by_label("new max_speed").fill("650")
+        page.get_by_role("button", name="set max_speed").click()
+        page.get_by_text("max_speed = 650 (verified)").wait_for(timeout=10_000)
+        page.get_by_role("button", name="Save to flash").click()
+        page.get_by_text("the board saves its parameters to flash (it sends no reply)").wait_for()
+        assert "{0:650}" in web.sent() and "{Q:W}" in web.sent()
+        page.screenshot(path=str(tmp_path / "params.png"))
+
+
+def test_the_waves_page_draws_the_telemetry(browser: Browser, tmp_path: Path) -> None:
+    with web_process(tmp_path) as web:
+        page = phone(browser, web)
+        page.get_by_role("button", name="Waves").click()
+        page.wait_for_timeout(1500)
+        drawn = page.evaluate(
+            "() => { const c = document.getElementById('chart');"
+            " const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;"
+            " let n = 0; for (let i = 3; i < d.length; i += 4) if (d[i]) n++; return n; }"
+        )
+        assert drawn > 1000, drawn
+        page.screenshot(path=str(tmp_path / "waves.png"))
+
+
+def test_a_gamepad_stick_drives_and_its_first_button_stops(
+    browser: Browser, tmp_path: Path
+) -> None:
+    with web_process(tmp_path) as web:
+        page = browser.new_page()
+        page.add_init_script(
+            "window.stick = [0, 0]; window.stopButton = false;"
+            "navigator.getGamepads = () => [{axes: window.stick,"
+            " buttons: [{pressed: window.stopButton}]}];"
+        )
+        page.goto(web.address)
+        page.get_by_text("parameters read").wait_for(timeout=10_000)
+        page.evaluate("window.stick = [0, -0.9]")  # pushed forward
+        wait_sent(web, "A")
+        page.evaluate("window.stick = [-0.8, -0.8]")
+        wait_sent(web, "H")
+        page.evaluate("window.stick = [0, 0]")
+        wait_sent(web, "Z")
+        page.close()
+
+
+def test_a_second_page_watches_and_takes_over_only_when_asked(
+    browser: Browser, tmp_path: Path
+) -> None:
+    with web_process(tmp_path) as web:
+        first = phone(browser, web)
+        second = phone(browser, web)
+        second.get_by_text("another page drives").wait_for()
+        first.keyboard.down("w")
+        wait_sent(web, "A")
+        second.get_by_role("button", name="Take over driving").click()
+        wait_sent(web, "Z")
+        first.get_by_text("another page drives").wait_for()
+        second.get_by_text("This page drives the car.").wait_for()
