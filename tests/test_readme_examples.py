@@ -36,6 +36,7 @@ NOT_RUN = {
     "whole suite in real time (40 s) against a served board, whose ±0.3 s a machine loaded "
     "by two test runs overruns; tests/cli/test_minibalance_wire.py runs three of its "
     "transcripts so, and the example before this one runs all on virtual time",
+    "appmode web": "a server until Ctrl-C: tests/web drives it, and its page in Chromium",
     "appmode drive /dev/pts/1 --uart2": "a full-screen console: tests/console drives it in tmux",
     "appmode drive /dev/pts/0 /dev/pts/1": "a full-screen console: tests/console drives it in tmux",
 }
