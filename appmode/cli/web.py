@@ -29,31 +29,42 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         metavar="HOST:PORT",
         default=DEFAULT_LISTEN,
         help=f"where to serve the page (default {DEFAULT_LISTEN}; port 0 picks a free one). "
-        "Only this machine's loopback addresses for now: a phone on the network needs "
-        "HTTPS for its sensors, which appmode web does not serve yet",
+        "On any address but loopback (0.0.0.0: every network of this machine, for a "
+        "phone on the same Wi-Fi) the page is served over HTTPS, which a phone's tilt "
+        "sensor needs: with appmode's own certificate, made on first use, unless --cert "
+        "and --key give yours",
     )
+    web.add_argument("--cert", metavar="FILE", help="serve HTTPS with this PEM certificate")
+    web.add_argument("--key", metavar="FILE", help="the private key of --cert (PEM)")
     return web
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from appmode.cli.drive import make_session
     from appmode.ports.endpoints import parse_listen
     from appmode.web.access import is_loopback
     from appmode.web.bridge import driving
 
     try:
+        from appmode.web import certificate
         from appmode.web.server import serve_web
     except ImportError:
         raise AppmodeError(
-            "appmode web needs aiohttp: pip install aiohttp (or, in a checkout of appmode, "
-            "pip install '.[web]')"
+            "appmode web needs aiohttp (and cryptography for HTTPS): pip install aiohttp "
+            "cryptography (or, in a checkout of appmode, pip install '.[web]')"
         ) from None
-
+    if (args.cert is None) != (args.key is None):
+        raise AppmodeError("--cert and --key go together: the certificate and its key")
     host, port = parse_listen(args.listen)
-    if not is_loopback(host):
-        raise AppmodeError(
-            f"--listen {args.listen}: appmode web serves this machine only (127.0.0.1, "
-            "localhost or ::1) until it serves HTTPS; from a phone, forward the port "
-            "(ssh -L 8080:127.0.0.1:8080 THIS_MACHINE) or drive with appmode drive"
-        )
-    return serve_web(make_session(args, driving(), None), host, port)
+    names = [n for n in certificate.machine_names(host) if not is_loopback(n)]
+    addresses = sorted(names, key=lambda name: (":" in name, not name[0].isdigit(), name))
+    tls = fingerprint = None
+    if args.cert is not None:
+        tls = certificate.server_context(Path(args.cert), Path(args.key))
+    elif not is_loopback(host):
+        cert, key = certificate.own_certificate(certificate.machine_names(host))
+        tls, fingerprint = certificate.server_context(cert, key), certificate.fingerprint(cert)
+    session = make_session(args, driving(), None)
+    return serve_web(session, host, port, tls, tuple(addresses), fingerprint)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import ipaddress
 import secrets
+import socket
 from urllib.parse import urlsplit
 
 COOKIE = "appmode_token"
@@ -31,16 +32,37 @@ def is_loopback(host: str) -> bool:
         return False
 
 
-def allowed_hosts(host: str, port: int) -> frozenset[str]:
-    """The Host headers a request to this server may carry: the address it listens on,
-    and the loopback names when that is loopback — never a name some DNS could point at
-    it (a rebinding page would carry its own)."""
-    names = {host}
-    if is_loopback(host):
-        names |= {"127.0.0.1", "localhost", "[::1]"}
-    if ":" in host and not host.startswith("["):
-        names.add(f"[{host}]")
-    return frozenset(f"{name}:{port}" for name in names)
+WILDCARDS = ("0.0.0.0", "::", "")
+LOOPBACK_NAMES = ("127.0.0.1", "localhost", "::1")
+
+
+def _is_address(name: str) -> bool:
+    try:
+        ipaddress.ip_address(name)
+    except ValueError:
+        return False
+    return True
+
+
+def host_allowed(header: str | None, listen: str, port: int) -> bool:
+    """Whether a request's Host header names this server (so a page on another name
+    that DNS points here — a rebinding attack — is refused): the address it listens on
+    with its port; on loopback the loopback names; on a wildcard address any address
+    literal, or this machine's own name."""
+    if header is None:
+        return False
+    host, colon, given = header.rpartition(":")
+    if not colon or given != str(port):
+        return False
+    name, listen = host.strip("[]").lower(), listen.strip("[]").lower()
+    if name == listen:
+        return True
+    if is_loopback(listen):
+        return name in LOOPBACK_NAMES
+    if listen in WILDCARDS:
+        own = socket.gethostname().lower()
+        return _is_address(name) or name in ("localhost", own, f"{own}.local")
+    return False
 
 
 def origin_matches(origin: str | None, host: str, scheme: str) -> bool:

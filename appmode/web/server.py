@@ -13,6 +13,7 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import ssl
 import sys
 from collections.abc import Awaitable, Callable
 from contextlib import suppress
@@ -25,7 +26,8 @@ from appmode.host import signals
 from appmode.session.base import BaseSession
 from appmode.web.access import (
     COOKIE,
-    allowed_hosts,
+    host_allowed,
+    is_loopback,
     new_token,
     origin_matches,
     token_matches,
@@ -53,13 +55,20 @@ def _asset(name: str) -> bytes:
 class WebServer:
     """The page and its websocket over one session."""
 
-    def __init__(self, session: BaseSession, host: str, port: int, token: str | None = None):
+    def __init__(
+        self,
+        session: BaseSession,
+        host: str,
+        port: int,
+        tls: ssl.SSLContext | None = None,
+        token: str | None = None,
+    ):
         self.bridge = Bridge(session)
+        self.tls = tls
         self.session = session
         self.host = host
         self.port = port
         self.token = token or new_token()
-        self._hosts: frozenset[str] = frozenset()
         self._sockets: set[web.WebSocketResponse] = set()
         self._runner: web.AppRunner | None = None
         self.app = web.Application(middlewares=[self._guard], client_max_size=MAX_MESSAGE)
@@ -67,17 +76,21 @@ class WebServer:
         self.app.router.add_get("/static/{name}", self._static)
         self.app.router.add_get("/ws", self._websocket)
 
-    @property
-    def address(self) -> str:
-        """What the owner opens: the page, with the token."""
-        host = f"[{self.host}]" if ":" in self.host else self.host
-        return f"http://{host}:{self.port}/?token={self.token}"
+    def address(self, host: str | None = None) -> str:
+        """What the owner opens: the page (at `host`, by default where it listens), with
+        the token."""
+        host = host or self.host
+        shown = f"[{host}]" if ":" in host else host
+        scheme = "https" if self.tls else "http"
+        return f"{scheme}://{shown}:{self.port}/?token={self.token}"
 
     async def start(self) -> None:
         """Listen (port 0 picks a free one: `port` then says which)."""
         self._runner = web.AppRunner(self.app, access_log=None, handle_signals=False)
         await self._runner.setup()
-        site = web.TCPSite(self._runner, self.host, self.port, shutdown_timeout=0.5)
+        site = web.TCPSite(
+            self._runner, self.host, self.port, shutdown_timeout=0.5, ssl_context=self.tls
+        )
         try:
             await site.start()
         except OSError as exc:
@@ -88,7 +101,6 @@ class WebServer:
                 "address with --listen HOST:PORT (port 0 picks a free one)"
             ) from None
         self.port = self._runner.addresses[0][1]
-        self._hosts = allowed_hosts(self.host, self.port)
 
     async def stop(self) -> None:
         for socket in list(self._sockets):
@@ -102,7 +114,7 @@ class WebServer:
     async def _guard(
         self, request: web.Request, handler: Callable[[web.Request], Awaitable[web.StreamResponse]]
     ) -> web.StreamResponse:
-        if request.headers.get("Host") not in self._hosts:
+        if not host_allowed(request.headers.get("Host"), self.host, self.port):
             return _refused("this server answers only to its own address")
         if request.path == "/" and "token" in request.query:
             if not token_matches(self.token, request.query.get("token")):
@@ -161,7 +173,7 @@ class WebServer:
 
     # ------------------------------------------------------------ running
 
-    async def run(self, announce: Callable[[str], None]) -> None:
+    async def run(self, announce: Callable[[WebServer], None]) -> None:
         """Serve until an ending signal (or Ctrl-C); the session ticks meanwhile."""
         loop = asyncio.get_running_loop()
         ended = asyncio.Event()
@@ -171,7 +183,7 @@ class WebServer:
 
         with signals.diverted(on_signal):
             await self.start()
-            announce(self.address)
+            announce(self)
             try:
                 while not ended.is_set():
                     self.session.tick()
@@ -195,28 +207,50 @@ class _OneLine(logging.Formatter):
         return f"appmode web: {text}"
 
 
-def serve_web(session: BaseSession, host: str, port: int) -> int:
+def serve_web(
+    session: BaseSession,
+    host: str,
+    port: int,
+    tls: ssl.SSLContext | None = None,
+    names: tuple[str, ...] = (),
+    fingerprint: str | None = None,
+) -> int:
     """Start the session, serve the page until ended, and always close the session: its
-    stop is the last thing sent."""
+    stop is the last thing sent. `names` are other addresses the page is reached at; a
+    self-signed certificate's `fingerprint` is printed for the owner to check."""
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(_OneLine())
     server_log = logging.getLogger("aiohttp")
     server_log.addHandler(handler)
     server_log.propagate = False
+
+    def announce(server: WebServer) -> None:
+        first = names[0] if names else None
+        print(f"web: {server.address(first)}", flush=True)
+        for other in names[1:]:
+            print(f"appmode: also at {server.address(other)}", file=sys.stderr)
+        if fingerprint is not None:
+            print(
+                f"appmode: the page's certificate is appmode's own (self-signed); the "
+                f"browser asks once: accept it if its SHA-256 fingerprint is {fingerprint}",
+                file=sys.stderr,
+            )
+        if not is_loopback(host):
+            print(
+                f"appmode: WARNING: the page is served on {host}:{server.port}: every device "
+                "that reaches this machine there can open it; only the token keeps it from "
+                "driving the car",
+                file=sys.stderr,
+            )
+        print(
+            "appmode: open that address in a browser; Ctrl-C stops the car and the server",
+            file=sys.stderr,
+            flush=True,
+        )
+
     try:
         session.start()
-        server = WebServer(session, host, port)
-
-        def announce(address: str) -> None:
-            print(f"web: {address}", flush=True)
-            print(
-                "appmode: open that address in a browser on this machine; Ctrl-C stops "
-                "the car and the server",
-                file=sys.stderr,
-                flush=True,
-            )
-
-        asyncio.run(server.run(announce))
+        asyncio.run(WebServer(session, host, port, tls).run(announce))
     finally:
         session.close()
         for note in session.closing_notes:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 import selectors
 import signal
@@ -48,7 +49,8 @@ class WebProcess:
 
 @contextmanager
 def web_process(tmp_path: Path, *args: str) -> Iterator[WebProcess]:
-    """A board on a pty recording what it receives, and `appmode web` driving it."""
+    """A board on a pty recording what it receives, and `appmode web` driving it (its
+    data folder, where a certificate is kept, in `tmp_path`)."""
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet") as board:
         proc = subprocess.Popen(
@@ -57,12 +59,13 @@ def web_process(tmp_path: Path, *args: str) -> Iterator[WebProcess]:
             stderr=subprocess.PIPE,
             text=True,
             cwd=ROOT,
+            env={**os.environ, "XDG_DATA_HOME": str(tmp_path / "data")},
         )
         assert proc.stdout is not None
         sel = selectors.DefaultSelector()
         sel.register(proc.stdout, selectors.EVENT_READ)
         line = proc.stdout.readline() if sel.select(20) else ""
-        found = re.match(r"web: (http://\S+)", line)
+        found = re.match(r"web: (https?://\S+)", line)
         web = WebProcess(proc, found.group(1) if found else "", board, record)
         try:
             assert found, f"appmode web printed {line!r}: {web.stop()[1]}"

@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import json
 import signal
+import ssl
 import time
 import urllib.error
 import urllib.request
@@ -17,14 +18,16 @@ import aiohttp
 from tests.support.web import WebProcess, wait_sent, web_process
 
 
-def get(url: str, headers: dict[str, str] | None = None) -> tuple[int, dict[str, str], str]:
-    """GET without following redirects: status, headers, body."""
+def get(
+    url: str, headers: dict[str, str] | None = None, tls: ssl.SSLContext | None = None
+) -> tuple[int, dict[str, str], str]:
+    """GET without following redirects (over `tls` for https): status, headers, body."""
 
     class NoRedirect(urllib.request.HTTPRedirectHandler):
         def redirect_request(self, *args: Any) -> None:
             return None
 
-    opener = urllib.request.build_opener(NoRedirect)
+    opener = urllib.request.build_opener(NoRedirect, urllib.request.HTTPSHandler(context=tls))
     request = urllib.request.Request(url, headers=headers or {})
     try:
         with opener.open(request, timeout=5) as response:

@@ -1,0 +1,143 @@
+"""HTTPS for a page served beyond this machine: browsers give the tilt sensor and the
+Gamepad API only to secure pages, and `http://192.168.1.20:8080` is not one.
+
+A self-signed certificate for this machine's names and addresses is made on first use
+(with `cryptography`) and kept in appmode's data folder; its fingerprint is printed with
+the address, so the owner can check what the phone's browser shows before accepting it.
+"""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import ipaddress
+import os
+import socket
+import ssl
+from pathlib import Path
+
+from appmode.errors import AppmodeError
+from appmode.files import data_folder, temporary_beside
+
+CERT, KEY = "web-cert.pem", "web-key.pem"
+DAYS = 825
+"""How long a made certificate is valid (the longest some browsers accept)."""
+
+
+def machine_names(listen: str) -> list[str]:
+    """The names and addresses a browser may reach this server by: the address it
+    listens on, or for a wildcard (`0.0.0.0`, `::`) this machine's name and addresses."""
+    names = {"localhost", "127.0.0.1"}
+    if listen not in ("0.0.0.0", "::", ""):
+        names.add(listen)
+        return sorted(names)
+    hostname = socket.gethostname()
+    names |= {hostname, f"{hostname}.local"}
+    try:
+        for *_, address in socket.getaddrinfo(hostname, None):
+            names.add(str(address[0]).split("%")[0])
+    except OSError:
+        pass
+    return sorted(names)
+
+
+def _san(names: list[str]) -> list[object]:
+    from cryptography import x509
+
+    entries: list[object] = []
+    for name in names:
+        try:
+            entries.append(x509.IPAddress(ipaddress.ip_address(name)))
+        except ValueError:
+            entries.append(x509.DNSName(name))
+    return entries
+
+
+def _covers(cert_path: Path, names: list[str]) -> bool:
+    """Whether the certificate there is valid now and names every one of `names`."""
+    from cryptography import x509
+
+    try:
+        cert = x509.load_pem_x509_certificate(cert_path.read_bytes())
+        held = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
+    except (OSError, ValueError, x509.ExtensionNotFound):
+        return False
+    now = datetime.datetime.now(datetime.timezone.utc)
+    fresh = cert.not_valid_before_utc <= now < cert.not_valid_after_utc
+    return fresh and all(entry in held for entry in _san(names))
+
+
+def own_certificate(names: list[str], folder: Path | None = None) -> tuple[Path, Path]:
+    """appmode's certificate for `names` (made, or made anew, when the one kept does not
+    cover them): the certificate's path and its key's."""
+    from cryptography import x509
+    from cryptography.hazmat.primitives import hashes, serialization
+    from cryptography.hazmat.primitives.asymmetric import ec
+    from cryptography.x509.oid import NameOID
+
+    folder = folder or data_folder()
+    cert_path, key_path = folder / CERT, folder / KEY
+    if key_path.exists() and _covers(cert_path, names):
+        return cert_path, key_path
+    key = ec.generate_private_key(ec.SECP256R1())
+    subject = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "appmode web")])
+    now = datetime.datetime.now(datetime.timezone.utc)
+    cert = (
+        x509.CertificateBuilder()
+        .subject_name(subject)
+        .issuer_name(subject)
+        .public_key(key.public_key())
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(now - datetime.timedelta(minutes=5))
+        .not_valid_after(now + datetime.timedelta(days=DAYS))
+        .add_extension(x509.SubjectAlternativeName(_san(names)), critical=False)  # type: ignore[arg-type]
+        .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+        .sign(key, hashes.SHA256())
+    )
+    key_bytes = key.private_bytes(
+        serialization.Encoding.PEM,
+        serialization.PrivateFormat.PKCS8,
+        serialization.NoEncryption(),
+    )
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        _write(key_path, key_bytes, 0o600)
+        _write(cert_path, cert.public_bytes(serialization.Encoding.PEM), 0o644)
+    except OSError as exc:
+        raise AppmodeError(
+            f"cannot keep the page's certificate in {folder}: {exc.strerror or exc}; "
+            "give your own with --cert FILE --key FILE"
+        ) from None
+    return cert_path, key_path
+
+
+def _write(path: Path, data: bytes, mode: int) -> None:
+    """Write whole or not at all (a temporary file beside it, then renamed)."""
+    tmp = temporary_beside(path)
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, mode)
+        with os.fdopen(fd, "wb") as out:
+            out.write(data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def server_context(cert: Path, key: Path) -> ssl.SSLContext:
+    """A TLS context serving `cert`; a clear error for files that are not a pair."""
+    context = ssl.create_default_context(ssl.Purpose.CLIENT_AUTH)
+    try:
+        context.load_cert_chain(cert, key)
+    except (OSError, ssl.SSLError) as exc:
+        raise AppmodeError(
+            f"cannot serve HTTPS with {cert} and {key}: {getattr(exc, 'strerror', None) or exc}; "
+            "give a PEM certificate and its key"
+        ) from None
+    return context
+
+
+def fingerprint(cert: Path) -> str:
+    """The certificate's SHA-256 fingerprint, as browsers show it (AB:CD:…)."""
+    der = ssl.PEM_cert_to_DER_cert(cert.read_text(encoding="ascii"))
+    digest = hashlib.sha256(der).hexdigest().upper()
+    return ":".join(digest[i : i + 2] for i in range(0, len(digest), 2))
