@@ -182,6 +182,10 @@ class BaseSession(ABC):
     def stop(self) -> None:
         """Stop the car now."""
 
+    def steer(self, x: float, y: float) -> None:
+        """An analog stick (x right, y forward, each −1…1), where the port takes one."""
+        raise AppmodeError("this port takes no analog steering: drive with the pad")
+
     title: ClassVar[str] = "appmode drive"
     """What a view calls the session."""
 

@@ -250,9 +250,25 @@ class ControlSession(BaseSession):
             if not self.busy:
                 self.query(["system_mode"])
             return
-        fields = velocity_for(MOTIONS[name], self.speed, drive)
+        self._drive_motion(MOTIONS[name], name, drive)
+
+    def steer(self, x: float, y: float) -> None:
+        """An analog stick (x right, y forward, each −1…1): a velocity frame of the
+        speed scaled by how far it is pushed. It lasts while it is held (repeated)."""
+        if self.link_down():
+            return
+        self.driving.press("stick", self.now())  # a stick that is let go stops the car
+        drive = self.drive
+        if drive is None:
+            self._drive("forward")  # says the drive type is being read, and reads it
+            return
+        motion = Motion("stick", (x, y, 0.0), (y, x))
+        self._drive_motion(motion, f"stick x {x:+.2f} y {y:+.2f}", drive)
+
+    def _drive_motion(self, motion: Motion, shown: str, drive: DriveType) -> None:
+        fields = velocity_for(motion, self.speed, drive)
         if self._send(lambda: self.host.velocity(**fields)):
-            self.in_force = name
+            self.in_force = shown
             self.rotation = None
 
     def stop(self) -> None:

@@ -13,6 +13,7 @@ import json
 import time
 from typing import Any
 
+from appmode.errors import AppmodeError
 from appmode.host.state import TRACE_SECONDS, HostState
 from appmode.protocol import app
 from appmode.session.base import BaseSession, Quit, ShowHelp, ShowStatus
@@ -99,7 +100,7 @@ class Bridge:
         if kind == "waves":
             (self.waves.add if message.get("on") is True else self.waves.discard)(page)
             return None
-        if kind not in ("press", "hold", "release", "stop", "command"):
+        if kind not in ("press", "hold", "stick", "release", "stop", "command"):
             return {"t": "error", "text": f"unknown message {kind!r}: ignored"}
         if page is not self.driver:
             return {"t": "error", "text": "this page watches: take over to drive"}
@@ -108,6 +109,8 @@ class Bridge:
             if key is None:
                 return {"t": "error", "text": f"no key {message.get('key')!r} here"}
             self.session.press(key)
+        elif kind == "stick":
+            return self._stick(message.get("x"), message.get("y"))
         elif kind in ("release", "stop"):
             self.session.stop()
         else:
@@ -124,6 +127,17 @@ class Bridge:
                 if cell == name:
                     return session.grid_key(r, c)
         return name if isinstance(name, str) and name in session.hold_keys.values() else None
+
+    def _stick(self, x: object, y: object) -> dict[str, Any] | None:
+        """An analog stick's position, each axis −1…1 (repeated while it is held)."""
+        if not (_unit(x) and _unit(y)):
+            return {"t": "error", "text": "a stick's x and y are numbers in −1…1"}
+        assert isinstance(x, (int, float)) and isinstance(y, (int, float))
+        try:
+            self.session.steer(round(float(x), 2), round(float(y), 2))
+        except AppmodeError as exc:
+            return {"t": "error", "text": str(exc)}
+        return None
 
     def _take(self, page: object) -> dict[str, Any] | None:
         """A watcher takes over: the car stops first, and the page that drove sees it
@@ -191,3 +205,8 @@ def _traces(state: HostState | None, now: float) -> dict[str, Any] | None:
         for i, name in enumerate(("pitch", "roll", "yaw", "battery"))
     ]
     return {"seconds": TRACE_SECONDS, "series": series}
+
+
+def _unit(value: object) -> bool:
+    """A number in −1…1 (not a bool, not NaN)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and -1 <= value <= 1

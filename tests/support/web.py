@@ -33,8 +33,15 @@ class WebProcess:
         return self.address.rsplit("=", 1)[1]
 
     def sent(self) -> list[str]:
-        """What the board received, one unit a line."""
+        """What the board received on its APP port, one unit a line."""
         return sent_lines(self.record) if self.record.exists() else []
+
+    def frames(self) -> list[str]:
+        """What the board received on its control port, a frame a line (hex)."""
+        if not self.record.exists():
+            return []
+        lines = self.record.read_text().splitlines()
+        return [line.split(" ", 2)[2] for line in lines if " 2> " in line]
 
     def stop(self, sig: int = signal.SIGTERM) -> tuple[int, str]:
         if self.proc.poll() is None:
@@ -48,13 +55,20 @@ class WebProcess:
 
 
 @contextmanager
-def web_process(tmp_path: Path, *args: str) -> Iterator[WebProcess]:
+def web_process(tmp_path: Path, *args: str, uart2: bool = False) -> Iterator[WebProcess]:
     """A board on a pty recording what it receives, and `appmode web` driving it (its
-    data folder, where a certificate is kept, in `tmp_path`)."""
+    data folder, where a certificate is kept, in `tmp_path`); with `uart2`, over the
+    board's control port."""
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet") as board:
         proc = subprocess.Popen(
-            appmode_cmd("web", board.url, "--listen", "127.0.0.1:0", *args),
+            appmode_cmd(
+                "web",
+                *((board.uart2, "--uart2") if uart2 else (board.url,)),
+                "--listen",
+                "127.0.0.1:0",
+                *args,
+            ),
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
@@ -83,3 +97,14 @@ def wait_sent(web: WebProcess, wanted: str, timeout: float = 5.0) -> list[str]:
             return sent
         time.sleep(0.02)
     raise AssertionError(f"the board's last unit is not {wanted!r}: {web.sent()[-8:]}")
+
+
+def wait_frame(web: WebProcess, wanted: str, timeout: float = 5.0) -> list[str]:
+    """Wait until the control port's last frame starts with `wanted`; the frames."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        frames = web.frames()
+        if frames and frames[-1].startswith(wanted):
+            return frames
+        time.sleep(0.02)
+    raise AssertionError(f"the control port's last frame is not {wanted}…: {web.frames()[-5:]}")

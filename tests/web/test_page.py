@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser, CDPSession, Page, sync_playwright
 
-from tests.support.web import WebProcess, wait_sent, web_process
+from tests.support.web import WebProcess, wait_frame, wait_sent, web_process
 
 CHROMIUM = "/usr/bin/chromium"
 
@@ -238,3 +238,33 @@ def test_a_second_page_watches_and_takes_over_only_when_asked(
         wait_sent(web, "Z")
         first.get_by_text("another page drives").wait_for()
         second.get_by_text("This page drives the car.").wait_for()
+
+
+STOP_FRAME = "FF FE 01 00 00 00 00 00 00 00"
+
+
+def test_over_uart2_the_analog_pad_s_deflection_is_the_speed(
+    browser: Browser, tmp_path: Path
+) -> None:
+    with web_process(tmp_path, uart2=True) as web:
+        page = browser.new_page()
+        page.goto(web.address)
+        page.get_by_text("settings read").wait_for(timeout=10_000)
+        box = page.get_by_role("application").bounding_box()
+        assert box is not None
+        cx, cy, radius = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2, box["width"] / 2
+        page.mouse.move(cx, cy - radius / 2)  # half way forward: y = half the speed
+        page.mouse.down()
+        frames = wait_frame(web, "FF FE 01 00 00 00 96")  # y 150 of the speed 300
+        page.mouse.move(cx, cy - radius)  # all the way: y 300
+        wait_frame(web, "FF FE 01 00 00 01 2C")
+        page.wait_for_timeout(600)  # held still: the frames stay
+        assert not web.frames()[-1].startswith(STOP_FRAME)
+        page.mouse.up()
+        frames = wait_frame(web, STOP_FRAME)
+        assert len(frames) > 2
+        page.get_by_label("degrees").fill("45")
+        page.get_by_role("button", name="Turn", exact=True).click()
+        turn = wait_frame(web, "FF FE 01")
+        assert int(turn[-1].split()[-1], 16) & 0x10, "angle mode's bit (§9.1)"
+        page.close()

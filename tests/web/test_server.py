@@ -15,7 +15,7 @@ from typing import Any
 
 import aiohttp
 
-from tests.support.web import WebProcess, wait_sent, web_process
+from tests.support.web import WebProcess, wait_frame, wait_sent, web_process
 
 
 def get(
@@ -272,3 +272,38 @@ def test_ending_the_server_while_driving_stops_the_car_last(tmp_path: Path) -> N
             code, err = web.stop()
             assert code == 0 and "Traceback" not in err, err
             assert web.sent()[-1] == "Z", web.sent()[-5:]
+
+
+def test_a_stick_that_goes_quiet_stops_the_car_and_the_app_port_takes_none(
+    tmp_path: Path,
+) -> None:
+    async def quiet_stick(web: WebProcess) -> float:
+        async with aiohttp.ClientSession() as session:
+            socket = await page(session, web)
+            while "settings read" not in (await status(socket))["messages"]:
+                pass
+            await socket.send_json({"t": "stick", "x": 0.5, "y": 1})
+            wait_frame(web, "FF FE 01 00 96 01 2C")  # x 150, y 300
+            pushed = time.monotonic()
+            wait_frame(web, "FF FE 01 00 00 00 00 00 00 00", timeout=3)
+            stopped = time.monotonic() - pushed
+            for bad in ({"x": 2, "y": 0}, {"x": True, "y": 0}, {"x": "1", "y": 0}, {}):
+                await socket.send_json({"t": "stick", **bad})
+                assert "−1…1" in await error(socket)
+            await socket.close()
+            return stopped
+
+    with web_process(tmp_path, uart2=True) as web:
+        assert 0.2 <= asyncio.run(quiet_stick(web)) < 1.5
+
+    async def app_port(web: WebProcess) -> None:
+        async with aiohttp.ClientSession() as session:
+            socket = await page(session, web)
+            await ready(socket)
+            await socket.send_json({"t": "stick", "x": 0, "y": 1})
+            assert "no analog steering" in await error(socket)
+            await socket.close()
+
+    (tmp_path / "app").mkdir()
+    with web_process(tmp_path / "app") as web:
+        asyncio.run(app_port(web))

@@ -127,6 +127,50 @@ $("command").addEventListener("submit", (event) => {
   $("line").value = "";
 });
 
+// ---------------------------------------------------------------- the analog pad (UART2)
+
+const stick = { id: null, x: 0, y: 0, beat: null };
+
+function stickAt(event) {
+  const box = $("stick").getBoundingClientRect();
+  const radius = box.width / 2;
+  let x = (event.clientX - box.left - radius) / radius;
+  let y = -(event.clientY - box.top - radius) / radius;
+  const length = Math.hypot(x, y);
+  if (length > 1) { x /= length; y /= length; }
+  const round = (v) => Math.round(v * 20) / 20;
+  [x, y] = [round(x), round(y)];
+  $("knob").style.transform = `translate(${x * radius}px, ${-y * radius}px)`;
+  if (x !== stick.x || y !== stick.y || stick.beat === null) {
+    stick.x = x;
+    stick.y = y;
+    send({ t: "stick", x, y });
+  }
+}
+
+$("stick").addEventListener("pointerdown", (event) => {
+  event.preventDefault();
+  $("stick").setPointerCapture(event.pointerId);
+  stick.id = event.pointerId;
+  stick.beat = null;
+  stickAt(event);
+  stick.beat = setInterval(() => send({ t: "stick", x: stick.x, y: stick.y }), HEARTBEAT_MS);
+});
+$("stick").addEventListener("pointermove", (event) => {
+  if (event.pointerId === stick.id) stickAt(event);
+});
+for (const name of ["pointerup", "pointercancel", "lostpointercapture"]) {
+  $("stick").addEventListener(name, (event) => {
+    if (event.pointerId !== stick.id) return;
+    stick.id = null;
+    clearInterval(stick.beat);
+    stick.beat = null;
+    $("knob").style.transform = "";
+    send({ t: "release" });
+  });
+}
+$("rotate").addEventListener("click", () => command(`rotate ${$("angle").value.trim()}`));
+
 // ---------------------------------------------------------------- pages of the page
 
 function showTab(name) {
@@ -339,6 +383,7 @@ function showStatus(message) {
   $("take").hidden = driving;
   document.body.classList.toggle("watching", !driving);
   $("pages").hidden = !message.commands.includes("page");
+  $("analog").hidden = !message.commands.includes("velocity");
   showRows(message.rows);
   showPad(message.cells, message.lit, message.extra);
   showValues(message.rows);
