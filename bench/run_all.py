@@ -36,6 +36,7 @@ import replay_timing
 import serial
 import startup
 import uart2
+import web
 from common import board, cpu_seconds, percentile, share_and_floor
 
 from appmode.board.firmware import TICK, Board
@@ -468,6 +469,7 @@ def main() -> None:
         ("conform timing", lambda: bench_conform_timing(200 if quick else 600)),
         ("minibalance", lambda: minibalance.rows(30 if quick else 100)),
         ("uart2", lambda: uart2.rows(quick)),
+        ("web", lambda: web.rows(quick)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

@@ -5,6 +5,7 @@ closed or hidden page stops the car."""
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -62,8 +63,12 @@ def test_holding_a_cell_drives_and_lifting_the_finger_stops(
         wait_sent(web, "A")
         page.wait_for_timeout(800)  # held: the heartbeats keep it going
         assert web.sent()[-1] == "A"
+        rising = [y for _, y in a_records(web)][-6:]
+        assert rising[-1] > rising[0] > 0 or rising[-1] == rising[0] > 0, rising
+        released = time.monotonic()
         page.mouse.up()
         wait_sent(web, "Z")
+        assert time.monotonic() - released < 0.3, "the stop reaches the board within 0.3 s"
         assert page.locator("#badge").inner_text() == "REAL BOARD"
 
 
@@ -151,6 +156,7 @@ def test_tilting_drives_past_the_dead_zone_and_level_stops(
         wait_sent(web, "C")
         tilt(40, 0)  # level again: stop
         wait_sent(web, "Z")
+        assert "I" in web.sent(), "tilt drives on the gravity page, as the app does"
         page.screenshot(path=str(tmp_path / "tilt.png"))
 
 
@@ -268,3 +274,31 @@ def test_over_uart2_the_analog_pad_s_deflection_is_the_speed(
         turn = wait_frame(web, "FF FE 01")
         assert int(turn[-1].split()[-1], 16) & 0x10, "angle mode's bit (§9.1)"
         page.close()
+
+
+def a_records(web: WebProcess) -> list[tuple[float, int]]:
+    """(time, y) of the A records the board sent."""
+    found = []
+    for line in web.record.read_text().splitlines():
+        parts = line.split(" ", 2)
+        if len(parts) == 3 and parts[1] == "<" and parts[2].startswith("{A"):
+            found.append((float(parts[0]), int(parts[2][2:].split(":")[1])))
+    return found
+
+
+def test_a_network_that_drops_while_holding_stops_the_car(browser: Browser, tmp_path: Path) -> None:
+    with web_process(tmp_path) as web:
+        page = phone(browser, web)
+        cdp = page.context.new_cdp_session(page)
+        x, y = centre(page, "forward")
+        page.mouse.move(x, y)
+        page.mouse.down()
+        wait_sent(web, "A")
+        cdp.send("Network.enable")
+        cdp.send(  # nothing gets through any more, the open websocket included
+            "Network.emulateNetworkConditions",
+            {"offline": True, "latency": 0, "downloadThroughput": 0, "uploadThroughput": 0},
+        )
+        page.context.set_offline(True)
+        wait_sent(web, "Z", timeout=3)
+        page.context.close()

@@ -228,6 +228,7 @@ async function tiltOn() {
   }
   tilt.on = true;
   $("tilt-on").setAttribute("aria-pressed", "true");
+  if (status && status.commands.includes("page")) command("page gravity"); // the app's I
   tiltNote("Tilting drives; inside the circle the car stops.");
   setTimeout(() => {
     if (tilt.on && tilt.beta === null) tiltNote("No tilt sensor answered: this device has none.");
@@ -235,6 +236,7 @@ async function tiltOn() {
 }
 
 function tiltOff() {
+  if (tilt.on && status && status.commands.includes("page")) command("page direction");
   tilt.on = false;
   $("tilt-on").setAttribute("aria-pressed", "false");
   release("tilt");

@@ -1,0 +1,181 @@
+"""appmode web in a real browser (Chromium under Playwright): how long from a finger on
+the ↑ cell to the `A` on the board's wire, what the server costs while pages watch, and
+what the page weighs.
+
+The latency bench is its own board: it opens a pty pair, gives `appmode web` the slave
+and reads the master, so each byte is timed where the board would read it.
+`--screenshots DIR` saves the page at 360×640 and 1280×800 (docs/ keeps them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pty
+import select
+import subprocess
+import sys
+import time
+import tty
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from common import board, cpu_seconds, percentile
+from playwright.sync_api import Browser, Page, sync_playwright
+
+CHROMIUM = "/usr/bin/chromium"
+ROOT = Path(__file__).resolve().parent.parent
+ASSETS = ROOT / "appmode" / "web" / "static"
+
+
+@contextmanager
+def web(url: str, *args: str) -> Iterator[tuple[subprocess.Popen[str], str]]:
+    """`appmode web URL` on a free port: the process and the page's address."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "web", url, "--listen", "127.0.0.1:0", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        if not line.startswith("web: "):
+            raise SystemExit(f"appmode web did not start: {line!r}")
+        yield proc, line.split(" ", 1)[1].strip()
+    finally:
+        proc.terminate()
+        proc.wait(10)
+
+
+def open_page(browser: Browser, address: str, width: int = 360, height: int = 640) -> Page:
+    page = browser.new_page(viewport={"width": width, "height": height})
+    page.goto(address)
+    page.locator("#status .row").first.wait_for(timeout=10_000)
+    return page
+
+
+def read_until(fd: int, wanted: bytes, timeout: float = 2.0) -> float:
+    """Read the board's side until `wanted` comes; when it came."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        ready, _, _ = select.select([fd], [], [], 0.05)
+        if ready:
+            data = os.read(fd, 4096)
+            if wanted in data:
+                return time.monotonic()
+    raise SystemExit(f"the board never read {wanted!r}")
+
+
+def latency(browser: Browser, presses: int) -> list[float]:
+    """Seconds from the pointer going down on ↑ to the `A` reaching the board."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    tty.setraw(master)
+    took = []
+    with web(os.ttyname(slave)) as (_, address):
+        page = open_page(browser, address)
+        box = page.get_by_role("button", name="forward", exact=True).bounding_box()
+        assert box is not None
+        page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+        time.sleep(0.5)
+        os.read(master, 4096)  # the session's start
+        for _ in range(presses):
+            down = time.monotonic()
+            page.mouse.down()
+            took.append(read_until(master, b"A") - down)
+            page.mouse.up()
+            read_until(master, b"Z")
+        page.close()
+    os.close(master)
+    os.close(slave)
+    return took
+
+
+def server_cpu(browser: Browser, pages: int, seconds: float) -> float:
+    """The web process's share of a core while `pages` pages show a streaming board."""
+    with board("--pty") as url, web(url) as (proc, address):
+        opened = [open_page(browser, address) for _ in range(pages)]
+        time.sleep(1.0)
+        start, begun = cpu_seconds(proc.pid), time.monotonic()
+        time.sleep(seconds)
+        share = (cpu_seconds(proc.pid) - start) / (time.monotonic() - begun)
+        for page in opened:
+            page.close()
+    return share
+
+
+def weight_and_paint(browser: Browser) -> tuple[int, float]:
+    """The page's bytes (its three assets) and its first contentful paint (ms)."""
+    size = sum(path.stat().st_size for path in ASSETS.iterdir())
+    with web("sim://") as (_, address):
+        page = open_page(browser, address)
+        paint = page.evaluate(
+            "() => performance.getEntriesByName('first-contentful-paint')[0].startTime"
+        )
+        page.close()
+    return size, float(paint)
+
+
+def screenshots(browser: Browser, folder: Path) -> None:
+    folder.mkdir(parents=True, exist_ok=True)
+    with web("sim://") as (_, address):
+        for width, height, name in ((360, 640, "web-phone.png"), (1280, 800, "web-desktop.png")):
+            page = open_page(browser, address, width, height)
+            page.get_by_text("parameters read").wait_for(timeout=10_000)
+            box = page.get_by_role("button", name="forward", exact=True).bounding_box()
+            assert box is not None
+            page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+            page.mouse.down()
+            time.sleep(1.0)  # the car under way, its velocity shown
+            page.screenshot(path=str(folder / name))
+            page.mouse.up()
+            page.close()
+            time.sleep(0.3)
+
+
+def rows(quick: bool) -> list[tuple[str, str, str]]:
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM)
+        try:
+            took = [t * 1000 for t in latency(browser, 50 if quick else 200)]
+            one = server_cpu(browser, 1, 5 if quick else 15)
+            ten = server_cpu(browser, 10, 5 if quick else 15)
+            size, paint = weight_and_paint(browser)
+        finally:
+            browser.close()
+    return [
+        (
+            "web: pointer-down on ↑ to A on the board",
+            f"p50 {percentile(took, 50):.1f} ms, p99 {percentile(took, 99):.1f} ms "
+            f"(n={len(took)}, Chromium)",
+            "p99 < 30 ms",
+        ),
+        ("web: server CPU, one page streaming", f"{one * 100:.2f} % of a core", "< 3 %"),
+        ("web: server CPU, ten pages watching", f"{ten * 100:.2f} % of a core", ""),
+        (
+            "web: page weight, first paint",
+            f"{size / 1000:.1f} KB, first contentful paint {paint:.0f} ms",
+            "< 150 KB, < 300 ms",
+        ),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="fewer presses, shorter runs")
+    parser.add_argument("--screenshots", metavar="DIR", help="save the page's screenshots there")
+    args = parser.parse_args()
+    if args.screenshots:
+        with sync_playwright() as playwright:
+            browser = playwright.chromium.launch(executable_path=CHROMIUM)
+            screenshots(browser, Path(args.screenshots))
+            browser.close()
+        return
+    for label, result, target in rows(args.quick):
+        print(f"{label}: {result} (target {target or '—'})")
+
+
+if __name__ == "__main__":
+    main()
