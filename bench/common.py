@@ -15,22 +15,31 @@ from contextlib import contextmanager
 
 
 @contextmanager
-def board(*args: str) -> Iterator[str]:
-    """Run `appmode board ARGS`; yield the URL it prints."""
+def started(command: str, *args: str) -> Iterator[tuple[subprocess.Popen[str], str]]:
+    """Run `appmode COMMAND ARGS` until the block ends; yield the process and what its
+    first line says after `NAME: ` (the URL a board or the page prints)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "appmode", "board", "--quiet", *args],
+        [sys.executable, "-m", "appmode", command, *args],
         stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
         text=True,
     )
     try:
         assert proc.stdout is not None
         line = proc.stdout.readline()
-        if not line.startswith("port: "):
-            raise SystemExit(f"board did not start: {line!r}")
-        yield line.split(" ", 1)[1].strip()
+        if ": " not in line:
+            raise SystemExit(f"appmode {command} did not start: {line!r}")
+        yield proc, line.split(": ", 1)[1].strip()
     finally:
         proc.terminate()
         proc.wait(10)
+
+
+@contextmanager
+def board(*args: str) -> Iterator[str]:
+    """Run `appmode board ARGS`; yield the URL it prints."""
+    with started("board", "--quiet", *args) as (_, url):
+        yield url
 
 
 def percentile(values: list[float], q: float) -> float:

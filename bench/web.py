@@ -14,14 +14,12 @@ import os
 import pty
 import select
 import subprocess
-import sys
 import time
 import tty
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager
 from pathlib import Path
 
-from common import board, cpu_seconds, percentile
+from common import board, cpu_seconds, percentile, started
 from playwright.sync_api import Browser, Page, sync_playwright
 
 CHROMIUM = "/usr/bin/chromium"
@@ -29,24 +27,9 @@ ROOT = Path(__file__).resolve().parent.parent
 ASSETS = ROOT / "appmode" / "web" / "static"
 
 
-@contextmanager
-def web(url: str, *args: str) -> Iterator[tuple[subprocess.Popen[str], str]]:
+def web(url: str, *args: str) -> AbstractContextManager[tuple[subprocess.Popen[str], str]]:
     """`appmode web URL` on a free port: the process and the page's address."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "appmode", "web", url, "--listen", "127.0.0.1:0", *args],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        text=True,
-    )
-    try:
-        assert proc.stdout is not None
-        line = proc.stdout.readline()
-        if not line.startswith("web: "):
-            raise SystemExit(f"appmode web did not start: {line!r}")
-        yield proc, line.split(" ", 1)[1].strip()
-    finally:
-        proc.terminate()
-        proc.wait(10)
+    return started("web", url, "--listen", "127.0.0.1:0", *args)
 
 
 def open_page(browser: Browser, address: str, width: int = 360, height: int = 640) -> Page:
@@ -111,8 +94,11 @@ def weight_and_paint(browser: Browser) -> tuple[int, float]:
     size = sum(path.stat().st_size for path in ASSETS.iterdir())
     with web("sim://") as (_, address):
         page = open_page(browser, address)
-        paint = page.evaluate(
-            "() => performance.getEntriesByName('first-contentful-paint')[0].startTime"
+        paint = page.evaluate(  # the entry may come after the load: wait for it
+            """() => new Promise((done) => new PerformanceObserver((list) => {
+                const fcp = list.getEntriesByName('first-contentful-paint')[0];
+                if (fcp) done(fcp.startTime);
+            }).observe({type: 'paint', buffered: true}))"""
         )
         page.close()
     return size, float(paint)

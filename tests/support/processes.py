@@ -77,18 +77,24 @@ class BoardProcess:
 
     def stop(self, sig: int = signal.SIGTERM) -> str:
         """Stop it (SIGTERM by default); return its stderr."""
-        if self.proc.poll() is None:
-            self.proc.send_signal(sig)
-        try:
-            _, err = self.proc.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            _, err = self.proc.communicate()
-        return err
+        return stop_process(self.proc, sig)
 
     def kill(self) -> None:
         self.proc.kill()
         self.proc.communicate()
+
+
+def stop_process(proc: subprocess.Popen[str], sig: int = signal.SIGTERM) -> str:
+    """Send `sig` to a process still running, wait for its end (kill it after 10 s);
+    return its stderr."""
+    if proc.poll() is None:
+        proc.send_signal(sig)
+    try:
+        _, err = proc.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        _, err = proc.communicate()
+    return err
 
 
 @contextmanager

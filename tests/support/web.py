@@ -13,7 +13,14 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from tests.support.processes import ROOT, BoardProcess, appmode_cmd, board_process, sent_lines
+from tests.support.processes import (
+    ROOT,
+    BoardProcess,
+    appmode_cmd,
+    board_process,
+    sent_lines,
+    stop_process,
+)
 
 
 @dataclass
@@ -44,13 +51,8 @@ class WebProcess:
         return [line.split(" ", 2)[2] for line in lines if " 2> " in line]
 
     def stop(self, sig: int = signal.SIGTERM) -> tuple[int, str]:
-        if self.proc.poll() is None:
-            self.proc.send_signal(sig)
-        try:
-            _, err = self.proc.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            _, err = self.proc.communicate()
+        """Stop it (SIGTERM by default): its exit status and stderr."""
+        err = stop_process(self.proc, sig)
         return self.proc.returncode, err
 
 
