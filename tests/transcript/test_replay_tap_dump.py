@@ -64,7 +64,10 @@ def test_plan_speed_and_loops() -> None:
     times: list[float] = []
     start = time.monotonic()
     play(plan(entries, "host"), lambda d: times.append(time.monotonic() - start), speed=2, loops=2)
-    assert [round(t, 2) for t in times] == [0.0, 0.1, 0.3, 0.3, 0.4, 0.6]
+    due = [0.0, 0.1, 0.3, 0.3, 0.4, 0.6]  # half the transcript's times, twice over
+    assert len(times) == len(due)
+    late = [t - d for t, d in zip(times, due, strict=True)]
+    assert all(-0.001 <= x < 0.05 for x in late), late  # never early; a loaded machine lags
 
 
 def test_replay_as_host_drives_a_board_and_ends_with_z(tmp_path: Path) -> None:
