@@ -18,6 +18,7 @@ import sys
 from collections.abc import Awaitable, Callable
 from contextlib import suppress
 from importlib import resources
+from typing import Any
 
 from aiohttp import WSMsgType, web
 
@@ -163,19 +164,23 @@ class WebServer:
         return socket
 
     async def _send_status(self, socket: web.WebSocketResponse) -> None:
+        """The page's status whenever it changed, until its connection ends (a send to a
+        connection that broke ends it too: the receiving side then sees it close)."""
         shown = ""
-        while not socket.closed:
-            text = json.dumps(self.bridge.status(socket))
-            if text != shown:
-                shown = text
-                await socket.send_str(text)
-            await asyncio.sleep(SEND)
+        with suppress(ConnectionError, RuntimeError):
+            while not socket.closed:
+                text = json.dumps(self.bridge.status(socket))
+                if text != shown:
+                    shown = text
+                    await socket.send_str(text)
+                await asyncio.sleep(SEND)
 
     # ------------------------------------------------------------ running
 
     async def run(self, announce: Callable[[WebServer], None]) -> None:
         """Serve until an ending signal (or Ctrl-C); the session ticks meanwhile."""
         loop = asyncio.get_running_loop()
+        loop.set_exception_handler(_one_line)
         ended = asyncio.Event()
 
         def on_signal() -> None:
@@ -191,6 +196,14 @@ class WebServer:
                         await asyncio.wait_for(ended.wait(), REFRESH)
             finally:
                 await self.stop()
+
+
+def _one_line(loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
+    """What the event loop would print with a traceback, in a line."""
+    error = context.get("exception")
+    print(
+        f"appmode web: {context.get('message')}{f': {error!r}' if error else ''}", file=sys.stderr
+    )
 
 
 def _refused(text: str) -> web.Response:
