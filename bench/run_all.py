@@ -2,7 +2,8 @@
 
 Decoder throughput, CPU cost of `appmode board` and `appmode drive`, boards one process
 serves, board-model steps, console key-to-byte latency, 60 s floods, paced throughput,
-{Q:P} round trip, replay timing and start-up. `--quick` shortens the long ones.
+{Q:P} round trip, replay timing, start-up, the control port and the web page in Chromium.
+`--quick` shortens the long ones.
 """
 
 from __future__ import annotations
