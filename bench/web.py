@@ -25,6 +25,9 @@ from playwright.sync_api import Browser, Page, sync_playwright
 CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).resolve().parent.parent
 ASSETS = ROOT / "appmode" / "web" / "static"
+PAUSE = 0.05
+"""Seconds between a release and the next press: a page may send 60 messages a second
+(bridge.RATE); pressing faster than a person can meets that limit, not the latency."""
 
 
 def web(url: str, *args: str) -> AbstractContextManager[tuple[subprocess.Popen[str], str]]:
@@ -70,6 +73,7 @@ def latency(browser: Browser, presses: int) -> list[float]:
             took.append(read_until(master, b"A") - down)
             page.mouse.up()
             read_until(master, b"Z")
+            time.sleep(PAUSE)
         page.close()
     os.close(master)
     os.close(slave)

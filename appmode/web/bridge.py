@@ -87,7 +87,9 @@ class Bridge:
         if bucket is None:
             return {"t": "error", "text": "this page is not connected"}
         if not bucket.take():
-            return {"t": "error", "text": "too many messages: slow down"}
+            if page is self.driver and self.session.driving.current is not None:
+                self.session.stop()  # a page that floods loses the car: stopped, once
+            return {"t": "error", "text": "too many messages: slow down (the car is stopped)"}
         if len(text) > MAX_MESSAGE:
             return {"t": "error", "text": f"message over {MAX_MESSAGE} bytes: ignored"}
         try:

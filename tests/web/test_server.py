@@ -223,10 +223,15 @@ def test_bad_messages_get_an_error_and_change_nothing(tmp_path: Path) -> None:
                     break
             else:
                 raise AssertionError("an over-long message did not close the websocket")
-            flood = await page(session, web)
+            await socket.close()
+            flood = await page(session, web)  # the driver now
+            await status(flood)
+            await flood.send_json({"t": "press", "key": "forward"})
+            wait_sent(web, "A")
             for _ in range(400):
-                await flood.send_str('{"t": "stop"}')
+                await flood.send_json({"t": "hold", "key": "forward"})
             assert "too many" in await error(flood)
+            wait_sent(web, "Z")  # a page that floods loses the car
             await flood.close()
             assert (await status(await page(session, web)))["t"] == "status", "still serving"
 
