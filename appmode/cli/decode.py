@@ -86,7 +86,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    layout = layout_for(None, args.profile)
+    layout = layout_for(None, args.profile) if args.profile else None  # None: the sheet's
     if args.file in (None, "-"):
         run_decode(sys.stdin.buffer, sys.stdout, args.source, layout=layout)
         return 0

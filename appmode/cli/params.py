@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from contextlib import ExitStack
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
-from appmode.board.profiles import SHEET, Profile
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     Subparsers,
@@ -20,7 +18,9 @@ from appmode.cli.options import (
 )
 from appmode.errors import AppmodeError
 from appmode.protocol import params
-from appmode.protocol.render import params_table
+
+if TYPE_CHECKING:  # imported when the command runs: start-up stays short
+    from appmode.board.profiles import Profile
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -131,12 +131,15 @@ def run_params(
     record: str | None,
     out: TextIO,
     verify: bool = False,
-    profile: Profile = SHEET,
+    profile: Profile,
 ) -> int:
     """Read the parameters; set each (verified by reading back), save, and print them;
     or check them against what was saved (`verify`)."""
+    import json
+
     from appmode.cli.hostio import open_host
     from appmode.host import saves
+    from appmode.protocol.render import params_table
 
     changes = [parse_assignment(text) for text in assignments]  # all checked first
     saved = saves.recall(url) if verify else None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from contextlib import ExitStack
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
@@ -20,19 +20,18 @@ from appmode.cli.options import (
     profile_for,
     stop_again_for,
 )
-from appmode.host import control_tokens
-from appmode.protocol.layouts import VELOCITY, ALayout
-from appmode.protocol.render import describe, line
+from appmode.host.token_help import APP_TOKENS, CONTROL_TOKENS
+
+if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
+    from appmode.protocol.layouts import ALayout
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
     send = sub.add_parser(
         "send",
         help=COMMANDS["send"],
-        description="Send tokens in order and print the records that come back. Tokens: "
-        "letters (A-H drive, I J K pages, Z stop; 'JAZ' sends three), frames ({Q:P}, "
-        "{Q:W}, {0:800}), escaped bytes (\\x01) and waits (wait:0.5). Z is always sent "
-        "last, so the car is never left moving.",
+        description=f"Send tokens in order and print the records that come back: "
+        f"{APP_TOKENS}. Z is always sent last, so the car is never left moving.",
     )
     add_url(send)
     send.add_argument("tokens", nargs="+", metavar="TOKEN", help="what to send")
@@ -47,7 +46,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--raw", action="store_true", help="send frames even if the board would reject them"
     )
     send.add_argument("--json", action="store_true", help="print JSON Lines")
-    add_uart2(send, "send over the board's control port; " + control_tokens.HELP)
+    add_uart2(send, "send over the board's control port; " + CONTROL_TOKENS)
     send.add_argument(
         "--no-report",
         action="store_true",
@@ -95,7 +94,7 @@ def run_send(
     as_json: bool,
     record: str | None,
     out: TextIO,
-    layout: ALayout = VELOCITY,
+    layout: ALayout,
     stop_again: bytes | None = None,
     frames_stop: bool = False,
 ) -> int:
@@ -105,6 +104,7 @@ def run_send(
     from appmode.cli.hostio import open_host, show
     from appmode.host.tokens import Wait, parse_token
     from appmode.protocol.app_decoders import HostDecoder
+    from appmode.protocol.render import describe, line
 
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:

@@ -16,8 +16,8 @@ from appmode.host.control_tokens import Step, parse_setting, parse_token, perfor
 from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
 from appmode.protocol import control, params, reader, settings
-from appmode.protocol.control_view import settings_table
-from appmode.protocol.render import line, view
+from appmode.protocol.control_view import settings_table, view
+from appmode.protocol.render import line
 from appmode.text import counted, wrapped
 
 QUIET_UART2 = (

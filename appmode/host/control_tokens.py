@@ -6,17 +6,13 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from appmode.errors import AppmodeError
+from appmode.host.token_help import CONTROL_TOKENS as HELP
 from appmode.host.tokens import Wait, parse_wait
 from appmode.protocol import control, params, settings
 
 if TYPE_CHECKING:
     from appmode.host.control_client import ControlHost
 
-HELP = (
-    "tokens are velocity:X,Y,Z (diff-gyro: velocity:LEFT,RIGHT), rotate:DEGREES, "
-    "motors:A,B,C[,D], position:X,Y,Z, read:NAME, set:NAME=VALUE, save, load, defaults, "
-    "stop, wait:SECONDS and raw hex (FFFE0100000000000000)"
-)
 WORDS = ("velocity", "rotate", "motors", "position", "read", "set")
 
 

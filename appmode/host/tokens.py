@@ -5,15 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from appmode.errors import AppmodeError
+from appmode.host.token_help import APP_TOKENS as HELP
 from appmode.protocol import app, app_decoders
 from appmode.protocol.directions import LETTERS, PAGE_LETTERS, STOP_LETTER
 from appmode.protocol.escaping import unescape
 
 SINGLE = LETTERS + "".join(PAGE_LETTERS) + STOP_LETTER
-HELP = (
-    "tokens are letters (A–H drive, I J K pages, Z stop; 'JAZ' sends three), frames "
-    "({Q:P}, {Q:W}, {0:800}), escaped bytes (\\x01) and waits (wait:0.5)"
-)
 
 
 @dataclass(frozen=True, slots=True)

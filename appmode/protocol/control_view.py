@@ -1,10 +1,12 @@
-"""Views of the control port's events (docs/protocol.md §8–§12): JSON and one-line text."""
+"""Views of the control port's events (docs/protocol.md §8–§12): JSON and one-line text;
+`view` shows an event of either port."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from appmode.protocol import control, settings
+from appmode.protocol import app, control, render, settings
+from appmode.protocol.layouts import VELOCITY, ALayout
 
 EVENTS = (
     control.VelocityFrame,
@@ -108,3 +110,14 @@ def settings_table(values: dict[str, int]) -> str:
             f"{setting.range_text:<14} {setting.default:>7}{flag}"
         )
     return "\n".join(rows)
+
+
+def view(
+    event: app.Event | control.HostEvent | control.BoardEvent, layout: ALayout = VELOCITY
+) -> tuple[dict[str, Any], str, str | None]:
+    """An event of either port for people and machines: its JSON body, its
+    description, and how to show its bytes (hex pairs on UART2; None: escaped text)."""
+    if isinstance(event, EVENTS):
+        shown = hex_text(event.raw)
+        return to_json(event), describe(event), shown
+    return render.to_json(event, layout), render.describe(event, layout), None

@@ -7,8 +7,8 @@ nothing else in appmode spells out a parameter's name, range or default.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from enum import IntEnum
+from typing import NamedTuple
 
 from appmode.errors import InvalidValue
 
@@ -16,11 +16,11 @@ U16 = 0xFFFF
 U32 = 0xFFFF_FFFF
 
 
-@dataclass(frozen=True, slots=True)
-class Param:
-    """One parameter of the `{n:v}` / `{C…}$` set."""
+class Param(NamedTuple):
+    """One parameter of the `{n:v}` / `{C…}$` set (a table row: a named tuple is cheaper to
+    load than a dataclass, and `appmode params --help` lists these)."""
 
-    index: int
+    index: int  # type: ignore[assignment]  # the field shadows tuple.index(), on purpose
     name: str
     label: str
     maximum: int
@@ -86,8 +86,7 @@ DRIVE_MASK = 0b111
 _DRIVES: dict[int, DriveType] = {drive.value: drive for drive in DriveType}
 
 
-@dataclass(frozen=True, slots=True)
-class ModeBit:
+class ModeBit(NamedTuple):
     """One named bit (or field) of system_mode."""
 
     bit: int

@@ -7,7 +7,6 @@ from collections.abc import Iterable, Iterator
 from typing import Any
 
 from appmode.protocol import app as p
-from appmode.protocol import control, control_view
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape, text_part
 from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, ALayout
@@ -193,17 +192,6 @@ def coalesce(events: Iterable[p.Event]) -> Iterator[p.Event]:
 
 def _joined(run: list[p.Noise | p.Garbage]) -> p.Noise | p.Garbage:
     return run[0] if len(run) == 1 else type(run[0])(b"".join(e.raw for e in run))
-
-
-def view(
-    event: p.Event | control.HostEvent | control.BoardEvent, layout: ALayout = VELOCITY
-) -> tuple[dict[str, Any], str, str | None]:
-    """An event of either port for people and machines: its JSON body, its
-    description, and how to show its bytes (hex pairs on UART2; None: escaped text)."""
-    if isinstance(event, control_view.EVENTS):
-        shown = control_view.hex_text(event.raw)
-        return control_view.to_json(event), control_view.describe(event), shown
-    return to_json(event, layout), describe(event, layout), None
 
 
 RAW_WIDTH = 34

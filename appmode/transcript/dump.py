@@ -14,10 +14,11 @@ from appmode.board.profiles import PROFILES
 from appmode.errors import AppmodeError, InvalidValue
 from appmode.files import check_writable, say_if_fifo, write_whole
 from appmode.protocol import app, control
+from appmode.protocol.control_view import view
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
 from appmode.protocol.reader import RECEIVED, RECEIVED2, PortsReader
-from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, line, view
+from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, line
 from appmode.protocol.transcript import (
     DIRECTIONS,
     Directive,
