@@ -273,30 +273,110 @@ class _Gathering:
         self.events: list[object] = []
 
 
-class ControlBoardByteAtATime(_Gathering):
-    """A host's way of reading UART2's replies and 4-wheel encoder reports byte by byte."""
+MAX_RUN = control.MAX_RUN
+OUTSIDE, FF_RUN = control_decoders._OUTSIDE, control_decoders._FF_RUN
+
+
+class ControlBoardByteAtATime:
+    """A host's way of reading UART2's board bytes one at a time, finding the very events
+    ReplyDecoder (4 wheels) finds: `#` replies, encoder reports (a `24` whose 34th byte is
+    `19`; else the bytes after it are read again), the reference firmware's status bursts
+    (`FF` and up to two bytes that are no `FF`), runs of `FF`, and runs of other bytes,
+    MAX_RUN at a time."""
+
+    REPORT_LEN = 2 + 8 * 4
+
+    def __init__(self) -> None:
+        self.events: list[object] = []
+        self.garbage = bytearray()
+        self.gathering = bytearray()  # a reply, a report or a burst under way
+        self.ffs = 0  # FF bytes in a row, not yet reported
 
     def feed(self, data: bytes) -> None:
         for byte in data:
-            if self.need:
-                self.buf.append(byte)
-                if len(self.buf) == self.need:
-                    self.need = 0
-                    self._done(bytes(self.buf))
-            elif byte == control.REPLY or byte == control.REPORT:
-                self.buf = bytearray([byte])
-                self.need = control.REPLY_LEN if byte == control.REPLY else 34
+            gathering = self.gathering
+            if gathering:
+                self._gather(gathering, byte)
+            elif self.ffs:
+                self._after_ff(byte)
+            elif byte == 0xFF:
+                self._garbage()
+                self.ffs = 1
+            elif byte == control.REPLY:
+                self._garbage()
+                gathering.append(byte)
+            elif byte == control.REPORT:
+                gathering.append(byte)
+            else:
+                self._outside(byte)
 
-    def _done(self, raw: bytes) -> None:
-        if raw[0] == control.REPLY:
-            read = settings.READ_BY_REPLY.get(raw[1])
+    def _gather(self, gathering: bytearray, byte: int) -> None:
+        first = gathering[0]
+        if first == 0xFF:  # a status burst
+            if byte == 0xFF:
+                self._event(control.Status(bytes(gathering)))
+                self.ffs = 1
+                return
+            gathering.append(byte)
+            if len(gathering) == control.STATUS_MAX:
+                self._event(control.Status(bytes(gathering)))
+            return
+        gathering.append(byte)
+        if first == control.REPLY and len(gathering) == control.REPLY_LEN:
+            read = settings.READ_BY_REPLY.get(gathering[1])
             signed = read is not None and read.signed
-            self.events.append(
-                control.Reply(raw[1], int.from_bytes(raw[2:], "big", signed=signed), raw)
-            )
-        elif raw[-1] == control.REPORT_END:
+            value = int.from_bytes(gathering[2:], "big", signed=signed)
+            self._event(control.Reply(gathering[1], value, bytes(gathering)))
+        elif first == control.REPORT and len(gathering) == self.REPORT_LEN:
+            raw = bytes(gathering)
+            gathering.clear()
+            if byte != control.REPORT_END:  # no report: its 24 is a byte outside, and
+                self._outside(raw[0])  # what follows is read again
+                self.feed(raw[1:])
+                return
+            self._garbage()
             values = [int.from_bytes(raw[i : i + 4], "big", signed=True) for i in range(1, 33, 4)]
             self.events.append(control.EncoderReport(tuple(values[0::2]), tuple(values[1::2]), raw))
+
+    def _after_ff(self, byte: int) -> None:
+        if byte == 0xFF:
+            self.ffs += 1
+            if self.ffs == MAX_RUN + 2:  # as the decoder: MAX_RUN of them, one kept
+                self.events.append(control.Garbage(b"\xff" * MAX_RUN, FF_RUN))
+                self.ffs -= MAX_RUN
+            return
+        if self.ffs > 1:
+            self.events.append(control.Garbage(b"\xff" * (self.ffs - 1), FF_RUN))
+        self.ffs = 0
+        self.gathering += bytes((0xFF, byte))
+
+    def _event(self, event: object) -> None:
+        self.events.append(event)
+        self.gathering.clear()
+
+    def _outside(self, byte: int) -> None:
+        self.garbage.append(byte)
+        if len(self.garbage) == MAX_RUN:
+            self._garbage()
+
+    def _garbage(self) -> None:
+        if self.garbage:
+            self.events.append(control.Garbage(bytes(self.garbage), OUTSIDE))
+            self.garbage.clear()
+
+    def flush(self) -> None:
+        """What the stream ends with, reported as ReplyDecoder.flush does."""
+        if self.ffs:
+            if self.ffs > 1:
+                self.events.append(control.Garbage(b"\xff" * (self.ffs - 1), FF_RUN))
+            self.events.append(control.Status(b"\xff"))
+        elif self.gathering[:1] == b"\xff":
+            self.events.append(control.Status(bytes(self.gathering)))
+        elif self.garbage or self.gathering:
+            raw = bytes(self.garbage + self.gathering)
+            self.events.append(control.Garbage(raw, "truncated reply or report at end of stream"))
+        self.garbage.clear()
+        self.gathering.clear()
 
 
 class ControlHostByteAtATime(_Gathering):
@@ -379,10 +459,35 @@ def _seconds(make: Callable[[], Any], data: bytes, chunk: int) -> float:
     return time.perf_counter() - start
 
 
+SAME_EVENTS = ("UART2 board decoder",)
+"""The decoders whose byte loops find the very events they find, run for run (checked on
+every input; the APP board decoder's loop finds them with runs of garbage joined, which
+bench/decode_command.py checks in its output)."""
+
+
+def check_same_events(name: str, data: bytes, chunk: int) -> None:
+    """Raise unless decoder `name` and its byte loop find the same events in `data`."""
+    ours, loop = DECODERS[name]
+    decoder, reader = ours(), loop()
+    found = [e for i in range(0, len(data), chunk) for e in decoder.feed(data[i : i + chunk])]
+    found += decoder.flush()
+    reader.feed(data)
+    reader.flush()
+    same = len(found) == len(reader.events) and all(
+        type(a) is type(b) and a == b and a.raw == b.raw
+        for a, b in zip(found, reader.events, strict=False)
+    )
+    if not same:
+        raise AssertionError(f"{name}: its byte loop finds other events than it does")
+
+
 def against_byte_loops(megabytes: float, chunk: int = 4096) -> dict[str, list[tuple[str, float]]]:
     """For each decoder: (input, its speed over its byte loop's) on every input, the best
     of three runs each."""
     inputs = streams(int(megabytes * 1e6))
+    for name in SAME_EVENTS:
+        for data in inputs.values():
+            check_same_events(name, data, chunk)
     out: dict[str, list[tuple[str, float]]] = {}
     for name, (ours, loop) in DECODERS.items():
         out[name] = [
