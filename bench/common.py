@@ -12,6 +12,7 @@ import time
 import tty
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 
 
 @contextmanager
@@ -72,17 +73,39 @@ def wakeups(pid: int) -> int:
     raise SystemExit(f"no voluntary_ctxt_switches in /proc/{pid}/status")
 
 
-def share_and_floor(
-    pid: int, seconds: float, read: Callable[[], int], rounds: int = 3
-) -> tuple[float, float, float, float]:
+def written(pid: int) -> tuple[int, int]:
+    """The write calls process `pid` has made and the bytes they wrote (/proc/PID/io)."""
+    with open(f"/proc/{pid}/io") as io:
+        fields = dict(line.split(":") for line in io)
+    return int(fields["syscw"]), int(fields["wchar"])
+
+
+@dataclass(frozen=True)
+class Share:
+    """A process's CPU share beside its floor (medians of the rounds)."""
+
+    share: float
+    """% of a core."""
+    floor: float
+    """% of a core a bare loop takes with the same wake-ups and writes."""
+    wakeups: float
+    """The process's wake-ups a second."""
+    writes: float
+    """Its write calls a second."""
+    received: float
+    """Bytes a second the reader got."""
+
+
+def share_and_floor(pid: int, seconds: float, read: Callable[[], int], rounds: int = 3) -> Share:
     """Process `pid`'s CPU share (%) while `read()` is called every 50 ms, and its floor
-    (`wakeup_floor` at the same wake-up rate), measured in turn for `rounds` rounds of
-    `seconds` each so that both see the same machine; medians of the rounds. Also the
-    wake-ups a second and the bytes a second `read` returned."""
-    shares, floors, rates, volumes = [], [], [], []
+    (`wakeup_floor` with the same wake-ups, write calls and bytes a second), measured in
+    turn for `rounds` rounds of `seconds` each so that both see the same machine; medians
+    of the rounds."""
+    shares, floors, rates, calls, volumes = [], [], [], [], []
     for _ in range(rounds):
         read()  # what came while the floor ran
         start_cpu, start, woken, got = cpu_seconds(pid), time.monotonic(), wakeups(pid), 0
+        writes, wrote = written(pid)
         while time.monotonic() - start < seconds:
             time.sleep(0.05)  # a client reading in batches: its wake-ups are not the board's
             got += read()
@@ -90,31 +113,45 @@ def share_and_floor(
         shares.append((cpu_seconds(pid) - start_cpu) / elapsed * 100)
         rates.append((wakeups(pid) - woken) / elapsed)
         volumes.append(got / elapsed)
-        floors.append(wakeup_floor(seconds, rates[-1]))
+        now_writes, now_wrote = written(pid)
+        calls.append((now_writes - writes) / elapsed)
+        floors.append(wakeup_floor(seconds, rates[-1], calls[-1], (now_wrote - wrote) / elapsed))
+    median = statistics.median
+    return Share(median(shares), median(floors), median(rates), median(calls), median(volumes))
+
+
+def floor_row(cpu: Share) -> tuple[str, str, str]:
+    """The benchmark table's row for `cpu`'s floor."""
     return (
-        statistics.median(shares),
-        statistics.median(floors),
-        statistics.median(rates),
-        statistics.median(volumes),
+        "its floor: a bare loop, same wake-ups and pty writes",
+        f"{cpu.floor:.2f} % of a core ({cpu.wakeups:.0f} wake-ups/s, {cpu.writes:.0f} writes/s)",
+        "",
     )
 
 
-def wakeup_floor(seconds: float, rate: float) -> float:
+def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> float:
     """CPU of a loop doing nothing but what trickled output needs: `rate` timed wake-ups
-    a second, each writing 4 bytes into a pty (the machine's cost, not appmode's)."""
+    a second, and `writes` write calls a second into a pty, `volume` bytes a second in
+    all (the machine's cost, not appmode's)."""
     master, slave = os.openpty()
     tty.setraw(slave)
     idle, _ = os.pipe()
     sel = selectors.DefaultSelector()
     sel.register(idle, selectors.EVENT_READ)
+    per_wakeup = writes / max(rate, 1e-9)
+    chunk = b"x" * max(1, round(volume / max(writes, 1e-9)))
     start_cpu, start = time.process_time(), time.monotonic()
+    owed = 0.0
     count = 0
     while time.monotonic() - start < seconds:
         sel.select(1 / rate)
-        os.write(master, b"abcd")
-        count += 1
-        if count % 64 == 0:
-            os.read(slave, 4096)
+        owed += per_wakeup
+        while owed >= 1:
+            os.write(master, chunk)
+            owed -= 1
+            count += 1
+            if count % 64 == 0:
+                os.read(slave, 65536)
     share = (time.process_time() - start_cpu) / (time.monotonic() - start) * 100
     sel.close()
     for fd in (master, slave, idle):

@@ -21,7 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import serial
-from common import percentile, share_and_floor
+from common import floor_row, percentile, share_and_floor
 
 from appmode.protocol import control, control_decoders
 from appmode.protocol.params import DriveType
@@ -166,7 +166,7 @@ def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
         port.write(control.encode(report))
         port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
         time.sleep(0.5)
-        share, floor, rate, received = share_and_floor(
+        cpu = share_and_floor(
             proc.pid,
             seconds / 3,
             lambda: len(port.read(port.in_waiting)) + len(app_port.read(app_port.in_waiting)),
@@ -175,15 +175,11 @@ def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
     return [
         (
             "board serving both ports, encoder report on (mecanum, driving)",
-            f"{share:.2f} % of a core ({received:,.0f} bytes/s read from both ports); "
-            f"{share - floor:+.2f} % over its floor",
+            f"{cpu.share:.2f} % of a core ({cpu.received:,.0f} bytes/s read from both ports); "
+            f"{cpu.share - cpu.floor:+.2f} % over its floor",
             "< 2 % of a core; within 0.3 % of its floor",
         ),
-        (
-            "its floor: a bare loop, same wake-ups and pty writes",
-            f"{floor:.2f} % of a core ({rate:.0f} wake-ups/s)",
-            "",
-        ),
+        floor_row(cpu),
     ]
 
 
