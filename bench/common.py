@@ -3,6 +3,7 @@ process's CPU and wake-ups."""
 
 from __future__ import annotations
 
+import math
 import os
 import selectors
 import statistics
@@ -10,7 +11,7 @@ import subprocess
 import sys
 import time
 import tty
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -41,6 +42,15 @@ def board(*args: str) -> Iterator[str]:
     """Run `appmode board ARGS`; yield the URL it prints."""
     with started("board", "--quiet", *args) as (_, url):
         yield url
+
+
+def fitted_slope(xs: Sequence[float], ys: Sequence[float]) -> tuple[float, float]:
+    """The least-squares slope of ys over xs, and its standard error."""
+    fit = statistics.linear_regression(xs, ys)
+    mean = statistics.fmean(xs)
+    spread = sum((x - mean) ** 2 for x in xs)
+    residuals = sum((y - (fit.slope * x + fit.intercept)) ** 2 for x, y in zip(xs, ys, strict=True))
+    return fit.slope, math.sqrt(residuals / (len(xs) - 2) / spread)
 
 
 def percentile(values: list[float], q: float) -> float:

@@ -11,17 +11,17 @@ the time between two reads. Target: at least 99.5 %, never above 100 %.
 from __future__ import annotations
 
 import argparse
-import statistics
 import time
 
 import serial
-from common import board
+from common import board, fitted_slope
 
 LINE_RATE = 960.0
 
 
-def measure(seconds: float) -> float:
-    """Bytes a second a client receives from a saturated, paced board over a pty."""
+def measure(seconds: float) -> tuple[float, float]:
+    """Bytes a second a client receives from a saturated, paced board over a pty, and the
+    fit's standard error."""
     with board("--pty") as url:
         port = serial.Serial(url, 9600, timeout=0.01)
         port.write(b"".join(b"{%d:4294967295}" % n for n in range(2, 8)))
@@ -48,18 +48,18 @@ def measure(seconds: float) -> float:
             if now - start >= seconds:
                 break
         port.close()
-    return statistics.linear_regression(times, totals).slope
+    return fitted_slope(times, totals)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--seconds", type=float, default=10.0, help="measuring window")
     args = parser.parse_args()
-    rate = measure(args.seconds)
-    share = rate / LINE_RATE * 100
+    rate, error = measure(args.seconds)
     print(
-        f"paced throughput over a pty: {rate:.1f} bytes/s over {args.seconds:.0f} s "
-        f"= {share:.3f} % of {LINE_RATE:.0f} bytes/s (target >= 99.5 %, <= 100 %)"
+        f"paced throughput over a pty: {rate:.2f} bytes/s (±{error:.2f}) over "
+        f"{args.seconds:.0f} s = {rate / LINE_RATE * 100:.3f} % of {LINE_RATE:.0f} bytes/s "
+        "(target >= 99.5 %, <= 100 %)"
     )
 
 

@@ -347,11 +347,12 @@ def bench_flood(seconds: float, paced: bool, garbage: bool) -> Row:
 
 
 def bench_links(quick: bool) -> list[Row]:
-    rate = link_pacing.measure(5.0 if quick else 10.0)
+    rate, error = link_pacing.measure(5.0 if quick else 10.0)
     rows = [
         (
             "paced throughput over a pty",
-            f"{rate:.2f} bytes/s = {rate / 9.6:.3f} % of 960 (slope of bytes over time)",
+            f"{rate:.2f} bytes/s (±{error:.2f}) = {rate / 9.6:.3f} % of 960 (slope of bytes "
+            "over time)",
             ">= 99.5 %, <= 100 %",
         )
     ]
