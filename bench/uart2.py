@@ -152,9 +152,8 @@ def throughput_rows(frames: int) -> list[tuple[str, str, str]]:
     return [
         (
             f"UART2 paced input, {frames:,} reads back to back",
-            f"{rate / 11520 * 100:.3f} % (±{error / 11520 * 100:.3f}) of 11,520 bytes/s (slope "
-            "of replies over time), "
-            f"all {frames:,} answered",
+            f"{rate / 11520 * 100:.3f} % (±{error / 11520 * 100:.3f}) of 11,520 bytes/s "
+            f"(slope of replies over time), all {frames:,} answered",
             "≥ 99.5 %, never above 100 %",
         )
     ]

@@ -75,16 +75,17 @@ def play(
         for loop in range(loops):
             for t, data in items:
                 deadline = start + (loop * period + t) / speed
-                while (left := deadline - clock()) > 0:
-                    if left <= EARLY:
-                        sleep(left)
+                wake = deadline - EARLY  # the first sleep ends here, the second at the deadline
+                while (now := clock()) < deadline:
+                    if now >= wake:
+                        sleep(deadline - now)
                         continue
                     if idle is not None:
                         idle()
-                    if progress is not None and clock() - shown >= 0.2:
-                        shown = clock()
+                    if progress is not None and now - shown >= 0.2:
+                        shown = now
                         progress(shown - start, total)
-                    left -= EARLY
+                    left = wake - now
                     sleep(min(left, 0.05) if idle is not None or progress is not None else left)
                 write(data)
                 lateness.append(clock() - deadline)

@@ -19,7 +19,7 @@ import pytest
 import serial
 
 from appmode.protocol.transcript import parse_transcript, read_transcript
-from appmode.transcript.replay import plan, play
+from appmode.transcript.replay import EARLY, plan, play
 from tests.support.processes import ROOT, board_process, run
 
 SESSION = """# appmode transcript v1
@@ -55,6 +55,24 @@ def test_play_keeps_absolute_deadlines_on_a_virtual_clock() -> None:
     )
     assert max(late) <= 0.0041, "overshoot never accumulates"
     assert sent[-1][0] == pytest.approx(0.99, abs=0.005)
+
+
+def test_play_sleeps_to_just_before_each_deadline_then_to_it() -> None:
+    clock = {"now": 0.0}
+    slept: list[float] = []
+
+    def sleep(seconds: float) -> None:  # exact: wakes when asked
+        if seconds < 0:
+            raise ValueError("sleep length must be non-negative")  # as time.sleep
+        assert len(slept) < 10, f"sleeps without end: {slept}"
+        slept.append(seconds)
+        clock["now"] += seconds
+
+    late = play(
+        [(0.01, b"A"), (0.02, b"B")], lambda d: None, clock=lambda: clock["now"], sleep=sleep
+    )
+    assert late == [0.0, 0.0], "never early, never late on an exact clock"
+    assert slept == pytest.approx([0.01 - EARLY, EARLY, 0.01 - EARLY, EARLY])
 
 
 def test_plan_speed_and_loops() -> None:
