@@ -7,10 +7,9 @@ bytes. The decoders are in `app_decoders`; what ends a session with the car stop
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 from appmode.protocol import params
 from appmode.protocol.directions import LETTERS, PAGE_LETTERS
+from appmode.protocol.slotted import Frozen, Slotted
 
 LBRACE, RBRACE, DOLLAR, COLON = 0x7B, 0x7D, 0x24, 0x3A
 MAX_FRAME = 50
@@ -22,91 +21,120 @@ MAX_RUN = 64
 SEPARATOR = COLON
 
 
-def _raw() -> bytes:
-    return field(default=b"", compare=False, repr=False)
-
-
 # ---------------------------------------------------------------- host → board commands
+# Commands are immutable and hashable; each names its fields in `__slots__` and the ones
+# compared and shown in `_shown` (protocol/slotted.py). `raw` is the bytes it came from.
 
 
-@dataclass(frozen=True, slots=True)
-class Move:
+class Move(Frozen):
     """Drive in direction 1…8: letters A–H, or the raw bytes 0x01–0x08 when `numeric`."""
 
+    __slots__ = _fields = ("direction", "numeric", "raw")
+    _shown = ("direction", "numeric")
     direction: int
-    numeric: bool = False
-    raw: bytes = _raw()
+    numeric: bool
+    raw: bytes
+
+    def __init__(self, direction: int, numeric: bool = False, raw: bytes = b"") -> None:
+        self._fill(direction, numeric, raw)
 
     @property
     def letter(self) -> str:
         return LETTERS[self.direction - 1]
 
 
-@dataclass(frozen=True, slots=True)
-class Stop:
+class Stop(Frozen):
     """`Z`: stop."""
 
-    raw: bytes = _raw()
+    __slots__ = _fields = ("raw",)
+    raw: bytes
+
+    def __init__(self, raw: bytes = b"") -> None:
+        self._fill(raw)
 
 
-@dataclass(frozen=True, slots=True)
-class SwitchPage:
+class SwitchPage(Frozen):
     """`I` (gravity) or `J` (joystick): the direction page; `K`: the button page."""
 
+    __slots__ = _fields = ("letter", "raw")
+    _shown = ("letter",)
     letter: str
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, letter: str, raw: bytes = b"") -> None:
+        self._fill(letter, raw)
 
 
-@dataclass(frozen=True, slots=True)
-class ReadParams:
+class ReadParams(Frozen):
     """`{Q:P}`: ask for a C record. `separator` is the byte in position 2 (§2.2)."""
 
-    separator: int = SEPARATOR
-    raw: bytes = _raw()
+    __slots__ = _fields = ("separator", "raw")
+    _shown = ("separator",)
+    separator: int
+    raw: bytes
+
+    def __init__(self, separator: int = SEPARATOR, raw: bytes = b"") -> None:
+        self._fill(separator, raw)
 
     @property
     def warning(self) -> str | None:
         return _separator_warning(self.separator)
 
 
-@dataclass(frozen=True, slots=True)
-class SaveParams:
+class SaveParams(Frozen):
     """`{Q:W}`: save the running parameters to non-volatile memory."""
 
-    separator: int = SEPARATOR
-    raw: bytes = _raw()
+    __slots__ = _fields = ("separator", "raw")
+    _shown = ("separator",)
+    separator: int
+    raw: bytes
+
+    def __init__(self, separator: int = SEPARATOR, raw: bytes = b"") -> None:
+        self._fill(separator, raw)
 
     @property
     def warning(self) -> str | None:
         return _separator_warning(self.separator)
 
 
-@dataclass(frozen=True, slots=True)
-class SetParam:
+class SetParam(Frozen):
     """`{n:v}`: set parameter n to v (always within range when decoded)."""
 
+    __slots__ = _fields = ("index", "value", "raw")
+    _shown = ("index", "value")
     index: int
     value: int
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, index: int, value: int, raw: bytes = b"") -> None:
+        self._fill(index, value, raw)
 
     @property
     def name(self) -> str:
         return params.PARAMS[self.index].name
 
 
-@dataclass(frozen=True, slots=True)
-class Noise:
+class Noise(Frozen):
     """A byte outside any frame that is no command: the board stops (§2.1)."""
 
+    __slots__ = _fields = ("raw",)
+    _shown = ("raw",)
     raw: bytes
 
+    def __init__(self, raw: bytes) -> None:
+        self._fill(raw)
 
-@dataclass(frozen=True, slots=True)
-class BadFrame:
+
+class BadFrame(Frozen):
     """A `{…}` frame the board discards: over-long, unknown, or a bad set frame."""
 
+    __slots__ = _fields = ("raw", "reason")
+    _shown = ("raw", "reason")
     raw: bytes
     reason: str
+
+    def __init__(self, raw: bytes, reason: str) -> None:
+        self._fill(raw, reason)
 
 
 Command = Move | Stop | SwitchPage | ReadParams | SaveParams | SetParam
@@ -123,41 +151,61 @@ def _separator_warning(separator: int) -> str | None:
 
 # ---------------------------------------------------------------- board → host records
 # Records, and what a decoder reports of bytes that are none, are not frozen: a frozen
-# dataclass costs three to four times as much to build, and the decoders build hundreds
-# of thousands a second (bench/decoder.py). Treat them as immutable all the same.
+# class costs three to four times as much to build, and the decoders build hundreds of
+# thousands a second (bench/decoder.py). Treat them as immutable all the same. A
+# record's `terminated` is False when its `$` was missing.
 
 
-@dataclass(slots=True)
-class Velocity:
+class Velocity(Slotted):
     """`{A x:y:z:0}$`: body velocity, lateral (right +), forward (+), rotation (cw +)."""
 
-    x: int
-    y: int
-    z: int
-    extra: int = 0
-    terminated: bool = field(default=True, compare=False, repr=False)
-    raw: bytes = _raw()
+    __slots__ = _fields = ("x", "y", "z", "extra", "terminated", "raw")
+    _shown = ("x", "y", "z", "extra")
+
+    def __init__(
+        self, x: int, y: int, z: int, extra: int = 0, terminated: bool = True, raw: bytes = b""
+    ) -> None:
+        self.x = x
+        self.y = y
+        self.z = z
+        self.extra = extra
+        self.terminated = terminated
+        self.raw = raw
 
 
-@dataclass(slots=True)
-class Attitude:
+class Attitude(Slotted):
     """`{B pitch:roll:yaw:battery}$`: degrees and battery percent."""
 
-    pitch: int
-    roll: int
-    yaw: int
-    battery: int
-    terminated: bool = field(default=True, compare=False, repr=False)
-    raw: bytes = _raw()
+    __slots__ = _fields = ("pitch", "roll", "yaw", "battery", "terminated", "raw")
+    _shown = ("pitch", "roll", "yaw", "battery")
+
+    def __init__(
+        self,
+        pitch: int,
+        roll: int,
+        yaw: int,
+        battery: int,
+        terminated: bool = True,
+        raw: bytes = b"",
+    ) -> None:
+        self.pitch = pitch
+        self.roll = roll
+        self.yaw = yaw
+        self.battery = battery
+        self.terminated = terminated
+        self.raw = raw
 
 
-@dataclass(slots=True)
-class ParamsRecord:
+class ParamsRecord(Slotted):
     """`{C p0:…:p8}$`: the nine parameters in index order."""
 
-    values: tuple[int, ...]
-    terminated: bool = field(default=True, compare=False, repr=False)
-    raw: bytes = _raw()
+    __slots__ = _fields = ("values", "terminated", "raw")
+    _shown = ("values",)
+
+    def __init__(self, values: tuple[int, ...], terminated: bool = True, raw: bytes = b"") -> None:
+        self.values = values
+        self.terminated = terminated
+        self.raw = raw
 
     def as_dict(self) -> dict[str, int]:
         return {p.name: v for p, v in zip(params.PARAMS, self.values, strict=True)}
@@ -175,29 +223,40 @@ class ParamsRecord:
         )
 
 
-@dataclass(slots=True)
-class OtherRecord:
+class OtherRecord(Slotted):
     """A well-formed record whose letter this protocol does not define."""
 
-    letter: str
-    values: tuple[int, ...]
-    terminated: bool = field(default=True, compare=False, repr=False)
-    raw: bytes = _raw()
+    __slots__ = _fields = ("letter", "values", "terminated", "raw")
+    _shown = ("letter", "values")
+
+    def __init__(
+        self, letter: str, values: tuple[int, ...], terminated: bool = True, raw: bytes = b""
+    ) -> None:
+        self.letter = letter
+        self.values = values
+        self.terminated = terminated
+        self.raw = raw
 
 
-@dataclass(slots=True)
-class Malformed:
+class Malformed(Slotted):
     """Bytes from `{` that do not make a record: truncated, over-long or ill-formed."""
 
-    raw: bytes
-    reason: str
+    __slots__ = _fields = ("raw", "reason")
+    _shown = ("raw", "reason")
+
+    def __init__(self, raw: bytes, reason: str) -> None:
+        self.raw = raw
+        self.reason = reason
 
 
-@dataclass(slots=True)
-class Garbage:
+class Garbage(Slotted):
     """A run of bytes outside any record."""
 
-    raw: bytes
+    __slots__ = _fields = ("raw",)
+    _shown = ("raw",)
+
+    def __init__(self, raw: bytes) -> None:
+        self.raw = raw
 
 
 Record = Velocity | Attitude | ParamsRecord | OtherRecord

@@ -7,8 +7,9 @@ the grid. A motion is given as unit factors of S (parameter 0, max speed).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from enum import Enum
+
+from appmode.protocol.slotted import Frozen
 
 LETTERS = "ABCDEFGH"
 """Direction 1…8 is LETTERS[n - 1]; the same byte values 0x01…0x08 are accepted raw."""
@@ -26,13 +27,18 @@ PAGE_NAMES: dict[str, str] = {"I": "gravity", "J": "joystick", "K": "button"}
 STOP_LETTER = "Z"
 
 
-@dataclass(frozen=True, slots=True)
-class Motion:
+class Motion(Frozen):
     """A physical motion: omni/mecanum factors (x, y, z) and differential factors (y, z)."""
 
+    __slots__ = _fields = _shown = ("name", "holonomic", "differential")
     name: str
     holonomic: tuple[float, float, float]
     differential: tuple[float, float]
+
+    def __init__(
+        self, name: str, holonomic: tuple[float, float, float], differential: tuple[float, float]
+    ) -> None:
+        self._fill(name, holonomic, differential)
 
 
 _MOTIONS = (

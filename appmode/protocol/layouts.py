@@ -4,13 +4,21 @@ that shows or checks the fields picks a layout (`--profile`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from appmode.protocol.slotted import Frozen
 
 
-@dataclass(frozen=True, slots=True)
-class ALayout:
+class ALayout(Frozen):
     """One reading of `{A<f0>:<f1>:<f2>:<f3>}$`."""
 
+    __slots__ = _fields = _shown = (
+        "name",
+        "fields",
+        "motion",
+        "scale",
+        "signed",
+        "labels",
+        "battery",
+    )
     name: str
     fields: tuple[str, str, str, str]
     """The fields' names (JSON keys), in order."""
@@ -22,8 +30,20 @@ class ALayout:
     """Whether the motion fields carry a sign (else they are magnitudes)."""
     labels: tuple[str, str, str, str]
     """The fields' names for people."""
-    battery: int | None = None
+    battery: int | None
     """The field holding the battery percentage, if any."""
+
+    def __init__(
+        self,
+        name: str,
+        fields: tuple[str, str, str, str],
+        motion: tuple[int, ...],
+        scale: float,
+        signed: bool,
+        labels: tuple[str, str, str, str],
+        battery: int | None = None,
+    ) -> None:
+        self._fill(name, fields, motion, scale, signed, labels, battery)
 
     def speed(self, values: tuple[int, ...]) -> float:
         """The largest speed the motion fields show, in the board's velocity unit."""
