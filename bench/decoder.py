@@ -95,9 +95,11 @@ class ByteAtATime:
     def _record(self) -> None:
         fields = self.fields
         if self.letter == 0x41 and len(fields) == 4:
-            self.records.append(Velocity(*fields))
+            x, y, z, extra = fields
+            self.records.append(Velocity(x, y, z, extra))
         elif self.letter == 0x42 and len(fields) == 4:
-            self.records.append(Attitude(*fields))
+            pitch, roll, yaw, battery = fields
+            self.records.append(Attitude(pitch, roll, yaw, battery))
         elif self.letter == 0x43 and len(fields) == 9:
             self.records.append(ParamsRecord(tuple(fields)))
 

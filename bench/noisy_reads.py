@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 
 from appmode.errors import AppmodeError
@@ -28,7 +29,11 @@ def session(seed: int) -> tuple[int, int, list[str]]:
         link = host.link
         assert isinstance(link, SimSerial) and link.board is not None
         board = link.board
-        for name, run in (("read", host.read_params), ("set", lambda: host.set_param(5, 4242))):
+        runs: tuple[tuple[str, Callable[[], tuple[int, ...]]], ...] = (
+            ("read", host.read_params),
+            ("set", lambda: host.set_param(5, 4242)),
+        )
+        for name, run in runs:
             try:
                 values = run()
             except AppmodeError:

@@ -23,7 +23,7 @@ from contextlib import contextmanager
 import serial
 from common import fitted_slope, floor_row, percentile, share_and_floor
 
-from appmode.protocol import control, control_decoders
+from appmode.protocol import control, control_decoders, settings
 from appmode.protocol.params import DriveType
 
 TICK = 0.010
@@ -165,7 +165,7 @@ def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
         serial.Serial(uart2, 115200, timeout=0.1) as port,
         serial.Serial(app, 9600, timeout=0.1) as app_port,
     ):
-        report = control.SetSetting(control.settings.BY_NAME["system_mode"], 0x41)
+        report = control.SetSetting(settings.BY_NAME["system_mode"], 0x41)
         port.write(control.encode(report))
         port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
         time.sleep(0.5)
