@@ -4,6 +4,10 @@ The server runs in a child process (`--serve`), which reports its own CPU time a
 late each board ran after its wake-up was due (the 4 ms timing grid: its p99 is what a
 client sees as jitter); the parent reads every board's APP port and counts its records.
 Target: 1,000 boards within one core at 20 records/s each, grid p99 < 5 ms.
+
+With `--no-io` the boards are served in this process on a virtual clock, with endpoints
+that only count what they are given: the server's own Python, free of the pty writes,
+the scheduler and this machine's CPU accounting (a steadier figure to optimise by).
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ import sys
 import time
 import tty
 from functools import partial
+from typing import Any
 
 from common import percentile
 
@@ -64,6 +69,51 @@ def serve(count: int) -> None:
             flush=True,
         )
         server.close()
+
+
+class Counting:
+    """An endpoint that counts the writes it is given (no I/O)."""
+
+    baud = None
+
+    def __init__(self, sel: object, log: object) -> None:
+        self.writes = 0
+
+    def write(self, data: bytes) -> None:
+        self.writes += 1
+
+    def pause(self, paused: bool) -> None:
+        """Nothing waits: never paused."""
+
+    def close(self) -> None:
+        """Nothing to close."""
+
+
+def without_io(count: int, seconds: float) -> tuple[float, float]:
+    """Serve `count` boards for `seconds` of a virtual clock (after one second of warm-up),
+    as fast as they go: (% of a core at real time, µs a write)."""
+    endpoints: list[Counting] = []
+
+    def make(sel: object, log: object) -> Any:
+        endpoints.append(Counting(sel, log))
+        return endpoints[-1]
+
+    boards = [Board(now=on) for on in switched_on(count, SHEET)]
+    server = BoardServer(
+        [make] * count, boards, pace=True, log=lambda text: None, make_uart2=[make] * count
+    )
+    clock = 0.0
+    server.now = lambda: clock  # type: ignore[method-assign]
+    while clock < 1.0:
+        clock = server._step()
+    writes = sum(e.writes for e in endpoints)
+    start = time.perf_counter()
+    while clock < 1.0 + seconds:
+        clock = server._step()
+    elapsed = time.perf_counter() - start
+    writes = sum(e.writes for e in endpoints) - writes
+    server.close()
+    return elapsed / seconds * 100, elapsed / writes * 1e6
 
 
 def measure(count: int, seconds: float, read: bool = True) -> dict[str, float]:
@@ -119,10 +169,16 @@ def main() -> None:
     parser.add_argument("counts", nargs="*", type=int, default=[200, 500, 1000])
     parser.add_argument("--seconds", type=float, default=15.0)
     parser.add_argument("--unread", action="store_true", help="nobody opens the ports")
+    parser.add_argument("--no-io", action="store_true", help="serve in-process, no I/O")
     parser.add_argument("--serve", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.serve:
         serve(args.serve)
+        return
+    if args.no_io:
+        for count in args.counts:
+            share, micros = without_io(count, args.seconds)
+            print(f"{count:5d} boards, no I/O: {share:5.1f} % of a core, {micros:.2f} µs a write")
         return
     for count in args.counts:
         r = measure(count, args.seconds, not args.unread)
