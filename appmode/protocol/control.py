@@ -7,12 +7,11 @@ decoders are in `control_decoders`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 from appmode.errors import InvalidValue
 from appmode.protocol import app, params, settings
 from appmode.protocol.params import DriveType
 from appmode.protocol.settings import Read, Setting, StoreOp
+from appmode.protocol.slotted import Frozen, Slotted
 
 HEADER = b"\xff\xfe"
 VELOCITY, MOTORS, POSITION, SETTINGS = 0x01, 0x02, 0x03, 0x80
@@ -32,10 +31,6 @@ STOP = bytes([0xFF, 0xFE, VELOCITY, 0, 0, 0, 0, 0, 0, 0])
 """The control port's `Z`: a velocity frame of zeros (§8.3)."""
 
 
-def _raw() -> bytes:
-    return field(default=b"", compare=False, repr=False)
-
-
 def motor_count(drive: DriveType) -> int:
     """Motors of a drive type: 3 on an omni, 4 on the others (§9.2)."""
     return 3 if drive is DriveType.OMNI else 4
@@ -44,84 +39,113 @@ def motor_count(drive: DriveType) -> int:
 # ---------------------------------------------------------------- host → board frames
 
 
-@dataclass(frozen=True, slots=True)
-class VelocityFrame:
+class VelocityFrame(Frozen):
     """Mode `01`: three signed fields and angle mode (§9.1). What the fields mean depends
     on the drive type: x, y, z (omni, mecanum); reserved, y, z (diff); left, right,
     reserved (diff-gyro). With `angle`, the third field is an angle in 0.1°."""
 
+    __slots__ = _fields = ("a", "b", "c", "angle", "raw")
+    _shown = ("a", "b", "c", "angle")
     a: int
     b: int
     c: int
-    angle: bool = False
-    raw: bytes = _raw()
+    angle: bool
+    raw: bytes
+
+    def __init__(self, a: int, b: int, c: int, angle: bool = False, raw: bytes = b"") -> None:
+        self._fill(a, b, c, angle, raw)
 
     @property
     def values(self) -> tuple[int, int, int]:
         return (self.a, self.b, self.c)
 
 
-@dataclass(frozen=True, slots=True)
-class MotorFrame:
+class MotorFrame(Frozen):
     """Mode `02`: a signed speed for each motor, 3 or 4 (§9.2)."""
 
+    __slots__ = _fields = ("speeds", "raw")
+    _shown = ("speeds",)
     speeds: tuple[int, ...]
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, speeds: tuple[int, ...], raw: bytes = b"") -> None:
+        self._fill(speeds, raw)
 
     @property
     def values(self) -> tuple[int, ...]:
         return self.speeds
 
 
-@dataclass(frozen=True, slots=True)
-class PositionFrame:
+class PositionFrame(Frozen):
     """Mode `03`: signed x, y, z displacements (§9.3)."""
 
+    __slots__ = _fields = ("x", "y", "z", "raw")
+    _shown = ("x", "y", "z")
     x: int
     y: int
     z: int
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, x: int, y: int, z: int, raw: bytes = b"") -> None:
+        self._fill(x, y, z, raw)
 
 
-@dataclass(frozen=True, slots=True)
-class SetSetting:
+class SetSetting(Frozen):
     """Mode `80`, SS 01–0A: set a setting (always within range when decoded)."""
 
+    __slots__ = _fields = ("setting", "value", "raw")
+    _shown = ("setting", "value")
     setting: Setting
     value: int
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, setting: Setting, value: int, raw: bytes = b"") -> None:
+        self._fill(setting, value, raw)
 
 
-@dataclass(frozen=True, slots=True)
-class StoreFrame:
+class StoreFrame(Frozen):
     """Mode `80`, SS 00: load, defaults or save (§10)."""
 
+    __slots__ = _fields = ("op", "raw")
+    _shown = ("op",)
     op: StoreOp
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, op: StoreOp, raw: bytes = b"") -> None:
+        self._fill(op, raw)
 
 
-@dataclass(frozen=True, slots=True)
-class ReadFrame:
+class ReadFrame(Frozen):
     """Mode `80`, a read's SS (§11): ask for a `#` reply."""
 
+    __slots__ = _fields = ("read", "raw")
+    _shown = ("read",)
     read: Read
-    raw: bytes = _raw()
+    raw: bytes
+
+    def __init__(self, read: Read, raw: bytes = b"") -> None:
+        self._fill(read, raw)
 
 
-@dataclass(frozen=True, slots=True)
-class BadFrame:
+class BadFrame(Frozen):
     """A whole frame the board discards: a value out of range, an unknown SS."""
 
+    __slots__ = _fields = _shown = ("raw", "reason")
     raw: bytes
     reason: str
 
+    def __init__(self, raw: bytes, reason: str) -> None:
+        self._fill(raw, reason)
 
-@dataclass(slots=True)
-class Garbage:
+
+class Garbage(Slotted):
     """Bytes outside any frame or reply, an unknown mode's header, or a truncated frame."""
 
-    raw: bytes
-    reason: str = "bytes outside any frame"
+    __slots__ = _fields = _shown = ("raw", "reason")
+
+    def __init__(self, raw: bytes, reason: str = "bytes outside any frame") -> None:
+        self.raw = raw
+        self.reason = reason
 
 
 HostFrame = VelocityFrame | MotorFrame | PositionFrame | SetSetting | StoreFrame | ReadFrame
@@ -132,13 +156,16 @@ HostEvent = HostFrame | BadFrame | Garbage
 # as immutable all the same.
 
 
-@dataclass(slots=True)
-class Reply:
+class Reply(Slotted):
     """`23 NN b3 b2 b1 b0`: the answer to a read (§11)."""
 
-    id: int
-    value: int
-    raw: bytes = _raw()
+    __slots__ = _fields = ("id", "value", "raw")
+    _shown = ("id", "value")
+
+    def __init__(self, id: int, value: int, raw: bytes = b"") -> None:
+        self.id = id
+        self.value = value
+        self.raw = raw
 
     @property
     def read(self) -> Read | None:
@@ -150,22 +177,29 @@ class Reply:
         return read.name if read else f"0x{self.id:02X}"
 
 
-@dataclass(slots=True)
-class EncoderReport:
+class EncoderReport(Slotted):
     """`24 …  19`: target and actual speed of each wheel (§12)."""
 
-    targets: tuple[int, ...]
-    actuals: tuple[int, ...]
-    raw: bytes = _raw()
+    __slots__ = _fields = ("targets", "actuals", "raw")
+    _shown = ("targets", "actuals")
+
+    def __init__(
+        self, targets: tuple[int, ...], actuals: tuple[int, ...], raw: bytes = b""
+    ) -> None:
+        self.targets = targets
+        self.actuals = actuals
+        self.raw = raw
 
 
-@dataclass(slots=True)
-class Status:
+class Status(Slotted):
     """`FF …`: what reaches the host of the 12-byte status the reference firmware writes
     after each APP record (§13.1): `FF`, then up to two bytes (`FE` and the gyro's low
     byte on the compiled firmware). Not an error: a host lets it pass."""
 
-    raw: bytes
+    __slots__ = _fields = _shown = ("raw",)
+
+    def __init__(self, raw: bytes) -> None:
+        self.raw = raw
 
 
 STATUS_MAX = 3

@@ -7,6 +7,7 @@ import pickle
 
 import pytest
 
+from appmode.protocol import control
 from appmode.protocol.app import (
     Attitude,
     BadFrame,
@@ -31,6 +32,8 @@ def test_equal_by_class_and_shown_fields_not_by_raw() -> None:
     assert Garbage(b"x") != Garbage(b"y")  # an error event's bytes are what it is
     assert BadFrame(b"{x}", "unknown frame") != BadFrame(b"{x}", "other")
     assert Move(1) != (1, False, b"")
+    assert control.Reply(0x41, 500, b"#A") == control.Reply(0x41, 500)
+    assert control.Garbage(b"x") != Garbage(b"x")  # the two ports' garbage are not one type
 
 
 def test_repr_shows_the_fields_and_not_raw() -> None:
@@ -38,6 +41,7 @@ def test_repr_shows_the_fields_and_not_raw() -> None:
     assert repr(Stop(b"Z")) == "Stop()"
     assert repr(Garbage(b"xx")) == "Garbage(raw=b'xx')"
     assert repr(SetParam(0, 800, b"{0:800}")) == "SetParam(index=0, value=800)"
+    assert repr(control.PositionFrame(1, 2, 3, b"\xff")) == "PositionFrame(x=1, y=2, z=3)"
 
 
 def test_commands_and_rows_are_immutable_and_hashable() -> None:
@@ -68,6 +72,9 @@ def test_records_are_not_hashable() -> None:
         ParamsRecord((1, 2, 3, 4, 5, 6, 7, 8, 9), raw=b"{C...}$"),
         MOTIONS["forward"],
         SCALED,
+        control.VelocityFrame(1, -2, 3, angle=True, raw=b"\xff\xfe\x01"),
+        control.EncoderReport((1, 2, 3, 4), (5, 6, 7, 8), raw=b"$"),
+        control.Garbage(b"\x00", "bytes outside any frame"),
     ],
 )
 def test_copies_and_pickles_keep_every_field(value: object) -> None:
