@@ -42,7 +42,10 @@ class Line:
     def __init__(self, baud: int | None) -> None:
         self.baud = baud
         self.byte_time = byte_time(baud)
-        self._bursts: deque[tuple[float, bytes]] = deque()  # (first byte's start, data)
+        self.bursts: deque[tuple[float, bytes]] = deque()
+        """(first byte's start, data) of each burst not wholly delivered: to be read only.
+        Truthy while the line carries bytes, as `len` is, and cheaper to test (a served
+        board tests its lines on every pass)."""
         self._taken = 0  # bytes of the first burst already delivered
         self._queued = 0  # bytes of every burst, the first's delivered ones included
         self._free_at = float("-inf")
@@ -55,24 +58,28 @@ class Line:
         if not data:
             return
         start = max(now, self._free_at)
-        self._bursts.append((start, bytes(data)))
+        self.bursts.append((start, bytes(data)))
         self._queued += len(data)
         self._free_at = start + len(data) * self.byte_time
 
     def next_due(self) -> float | None:
         """When the next byte is delivered, or None when the line is idle."""
-        if not self._bursts:
+        if not self.bursts:
             return None
-        start, _ = self._bursts[0]
+        start, _ = self.bursts[0]
         return start + (self._taken + 1) * self.byte_time
 
     def last_due(self) -> float | None:
         """When the last byte queued is delivered, or None when the line is idle."""
-        return self._free_at if self._bursts else None
+        return self._free_at if self.bursts else None
 
     def take(self, now: float) -> bytes:
         """Every byte delivered by `now`."""
-        return b"".join(data[first:end] for _, data, first, end in self._delivered(now))
+        spans = self._delivered(now)
+        if len(spans) == 1:  # the usual case: part of one burst
+            _, data, first, end = spans[0]
+            return data[first:end]
+        return b"".join(data[first:end] for _, data, first, end in spans)
 
     def take_timed(self, now: float) -> list[tuple[float, bytes]]:
         """Bytes delivered by `now`, each run with its delivery time.
@@ -94,8 +101,8 @@ class Line:
         line lets go of them."""
         out: list[tuple[float, bytes, int, int]] = []
         step = self.byte_time
-        while self._bursts:
-            start, data = self._bursts[0]
+        while self.bursts:
+            start, data = self.bursts[0]
             if step == 0.0:
                 if start > now:
                     break
@@ -107,7 +114,7 @@ class Line:
             if due < len(data):
                 self._taken = max(self._taken, due)
                 break
-            self._bursts.popleft()
+            self.bursts.popleft()
             self._queued -= len(data)
             self._taken = 0
         return out

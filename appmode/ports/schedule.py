@@ -57,6 +57,8 @@ class Served:
                 continue
             port = wire.ports[name]
             to_host = port.to_host
+            if sends[index] == math.inf and not to_host.bursts and not port.to_board.bursts:
+                continue  # nothing planned, nothing on its lines (and so no read pending)
             step = to_host.byte_time
             mine = sends[index] + step  # the port's next output: its first byte
             first = to_host.next_due()
@@ -80,18 +82,24 @@ class Served:
                 due = mine
         return due
 
-    def pump(self, now: float) -> None:
+    def pump(self, now: float) -> bool:
+        """Write what the lines deliver by `now`, running the board first when it is due
+        or has input; whether it ran (else it made no notes and its input is as it was)."""
         wire = self.wire
         ports = wire.ports
-        if now >= self.board_due or ports[APP].to_board or ports[UART2].to_board:
+        ran = now >= self.board_due or bool(
+            ports[APP].to_board.bursts or ports[UART2].to_board.bursts
+        )
+        if ran:
             wire.run(now)
         for name, endpoint in self.endpoints.items():
-            line = wire.ports[name].to_host
-            out = line.take(now) if line else b""
+            line = ports[name].to_host
+            out = line.take(now) if line.bursts else b""
             if out and self.faults is not None:
                 out = self.faults[1].apply(out)
             if out:
                 endpoint.write(out)
+        return ran
 
     def receive(self, data: bytes, now: float, port: str) -> None:
         self.pump(now)  # what was due before these bytes came

@@ -234,9 +234,9 @@ class BoardServer:
             if self.lateness is not None:
                 self.lateness.append(now - due)
             one = self._served[index]
-            one.pump(now)
-            self._log_notes(one)
-            one.throttle()
+            if one.pump(now):
+                self._log_notes(one)
+                one.throttle()
             ran.append(index)
         for index in ran:
             self._reschedule(index)

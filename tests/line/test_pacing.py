@@ -44,6 +44,25 @@ def test_no_drift_over_a_million_bytes() -> None:
     assert last == pytest.approx(1_000_000 * BYTE, abs=1e-6)
 
 
+@pytest.mark.parametrize("baud", [9600, None])
+def test_take_gives_every_byte_once_in_order_and_bursts_say_whether_any_remain(
+    baud: int | None,
+) -> None:
+    line = Line(baud)
+    sent, got = b"", b""
+    for k in range(200):
+        now = k * 0.0025
+        if k % 7 == 0:  # two bursts at once: a take may end one and start the next
+            for data in (bytes([65 + k % 26]) * (1 + k % 5), b"%d" % k):
+                line.push(data, now)
+                sent += data
+        got += line.take(now)
+        assert bool(line.bursts) == (len(line) > 0)
+    got += line.take(10.0)
+    assert got == sent
+    assert not line.bursts and len(line) == 0
+
+
 def test_unpaced_line_delivers_at_once() -> None:
     line = Line(None)
     line.push(b"abc", 2.0)
