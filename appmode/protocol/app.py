@@ -65,8 +65,8 @@ class SwitchPage(Frozen):
         self._fill(letter, raw)
 
 
-class ReadParams(Frozen):
-    """`{Q:P}`: ask for a C record. `separator` is the byte in position 2 (§2.2)."""
+class _QFrame(Frozen):
+    """A `{Q?x}` frame. `separator` is the byte in position 2 (§2.2)."""
 
     __slots__ = _fields = ("separator", "raw")
     _shown = ("separator",)
@@ -81,20 +81,16 @@ class ReadParams(Frozen):
         return _separator_warning(self.separator)
 
 
-class SaveParams(Frozen):
+class ReadParams(_QFrame):
+    """`{Q:P}`: ask for a C record."""
+
+    __slots__ = ()
+
+
+class SaveParams(_QFrame):
     """`{Q:W}`: save the running parameters to non-volatile memory."""
 
-    __slots__ = _fields = ("separator", "raw")
-    _shown = ("separator",)
-    separator: int
-    raw: bytes
-
-    def __init__(self, separator: int = SEPARATOR, raw: bytes = b"") -> None:
-        self._fill(separator, raw)
-
-    @property
-    def warning(self) -> str | None:
-        return _separator_warning(self.separator)
+    __slots__ = ()
 
 
 class SetParam(Frozen):

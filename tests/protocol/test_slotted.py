@@ -14,6 +14,8 @@ from appmode.protocol.app import (
     Garbage,
     Move,
     ParamsRecord,
+    ReadParams,
+    SaveParams,
     SetParam,
     Stop,
     Velocity,
@@ -28,6 +30,7 @@ def test_equal_by_class_and_shown_fields_not_by_raw() -> None:
     assert Velocity(1, 2, 3) != Velocity(1, 2, 4)
     assert Velocity(1, 2, 3, 0) != Attitude(1, 2, 3, 0)
     assert Move(1) != Move(1, numeric=True)
+    assert ReadParams() != SaveParams()  # the same fields, two frames
     assert Stop(b"Z") == Stop()
     assert Garbage(b"x") != Garbage(b"y")  # an error event's bytes are what it is
     assert BadFrame(b"{x}", "unknown frame") != BadFrame(b"{x}", "other")
