@@ -7,7 +7,9 @@ measured the same way for both: against start + its time, with the start that ma
 none early (each player's start is its own; a process scheduled late once at its
 start would otherwise shift that player's whole run). Prints median, p99 and max
 lateness, and the drift: the slope of lateness over a run (ms per minute, a
-least-squares fit, not one sample).
+least-squares fit, not one sample). `play` keeps its deadlines with exact wake-ups (no
+timer slack; on Linux 6.12+ a short slice, appmode/ports/wakeups.py); MessageSync runs
+as python-can ships it.
 
 `--load busy` runs two busy processes beside them, `--load pytest` the test suite.
 Needs python-can for the comparison: pip install python-can.

@@ -2,10 +2,11 @@
 
 Each send's deadline is computed from the start (start + t / speed), never by adding up
 sleeps, so a late send does not make every later one late (python-can's MessageSync
-idea). It is waited for by sleeping with exact wake-ups (`ports.wakeups`), in two
-sleeps: to EARLY before it, then to it. The second is short, so the processor waits for
-it in a shallow idle state and wakes at once: its p99 lateness is about half of one
-sleep's, idle and under load. A last stretch waited awake instead is ahead on an idle
+idea). It is waited for by sleeping with exact wake-ups (`ports.wakeups`: no timer
+slack, and on Linux 6.12+ a short slice, so that a busy machine runs the replay at once
+when it wakes), in two sleeps: to EARLY before it, then to it. The second is short, so
+the processor waits for it in a shallow idle state and wakes at once: its p99 lateness
+is about half of one sleep's. A last stretch waited awake instead is ahead on an idle
 machine but, with every core busy, the scheduler makes a process that spins wait and it
 ends milliseconds late (bench/replay_timing.py). As the host, the replay ends with `Z`,
 like every host session.

@@ -1,14 +1,24 @@
-"""Exact wake-ups: a 1 µs timer slack while a deadline is kept, the old one after."""
+"""Exact wake-ups: a 1 µs timer slack and a short slice while a deadline is kept, the
+old ones after."""
 
 from __future__ import annotations
 
 import ctypes
+import platform
+import subprocess
 import sys
 import time
 
 import pytest
 
-from appmode.ports.wakeups import PR_GET_TIMERSLACK, SLACK_NS, exact_wakeups
+from appmode.ports.wakeups import (
+    PR_GET_TIMERSLACK,
+    SLACK_NS,
+    SLICE_NS,
+    SchedAttr,
+    exact_wakeups,
+    sched_attr,
+)
 from appmode.transcript.replay import play
 
 linux = pytest.mark.skipif(sys.platform != "linux", reason="timer slack is Linux's")
@@ -41,3 +51,39 @@ def test_a_replay_is_never_early() -> None:
     late = play([(k * 0.003, b"A") for k in range(30)], lambda _: sent.append(time.monotonic()))
     assert min(late) >= 0
     assert all(s - start >= k * 0.003 for k, s in enumerate(sent))
+
+
+def current() -> SchedAttr:
+    attr = sched_attr(ctypes.CDLL(None))
+    assert attr is not None, f"sched_getattr failed on {platform.machine()}"
+    return attr
+
+
+@linux
+def test_the_slice_is_short_inside_and_restored_after() -> None:
+    before = current()
+    with exact_wakeups():
+        inside = current()
+    after = current()
+    assert (inside.policy, inside.nice) == (before.policy, before.nice)
+    # Kernels before 6.12 have no slice per thread and report none.
+    assert inside.runtime == (SLICE_NS if before.runtime else 0)
+    assert (after.policy, after.nice, after.runtime) == (
+        before.policy,
+        before.nice,
+        before.runtime,
+    )
+
+
+@linux
+def test_a_niced_thread_keeps_its_nice_value() -> None:
+    code = (
+        "import ctypes, os\n"
+        "from appmode.ports.wakeups import exact_wakeups, sched_attr\n"
+        "os.nice(5)\n"
+        "with exact_wakeups():\n"
+        "    print(sched_attr(ctypes.CDLL(None)).nice)\n"
+        "print(sched_attr(ctypes.CDLL(None)).nice)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["5", "5"]
