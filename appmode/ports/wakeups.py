@@ -27,9 +27,14 @@ SCHED_ATTR = {  # (sched_setattr, sched_getattr) by machine
     "aarch64": (274, 275),
     "arm64": (274, 275),
     "riscv64": (274, 275),
+    "loongarch64": (274, 275),
     "armv7l": (380, 381),
     "armv6l": (380, 381),
     "i686": (351, 352),
+    "i386": (351, 352),
+    "ppc64le": (355, 356),
+    "ppc64": (355, 356),
+    "s390x": (345, 346),
 }
 
 
