@@ -28,6 +28,7 @@ SCHED_ATTR = {  # (sched_setattr, sched_getattr) by machine
     "arm64": (274, 275),
     "riscv64": (274, 275),
     "loongarch64": (274, 275),
+    "armv8l": (380, 381),
     "armv7l": (380, 381),
     "armv6l": (380, 381),
     "i686": (351, 352),
@@ -36,6 +37,17 @@ SCHED_ATTR = {  # (sched_setattr, sched_getattr) by machine
     "ppc64": (355, 356),
     "s390x": (345, 346),
 }
+IN_32_BITS = {"x86_64": "i686", "aarch64": "armv7l", "arm64": "armv7l"}
+"""The machine whose numbers a 32-bit program uses on these 64-bit kernels (a Raspberry
+Pi's 32-bit system on its 64-bit kernel, say): `platform.machine` names the kernel's."""
+
+
+def syscall_numbers(machine: str, pointer_bytes: int) -> tuple[int, int] | None:
+    """(sched_setattr, sched_getattr) for a program of `pointer_bytes` pointers on a
+    kernel of `machine`, or None for a machine not in SCHED_ATTR."""
+    if pointer_bytes == 4:
+        machine = IN_32_BITS.get(machine, machine)
+    return SCHED_ATTR.get(machine)
 
 
 class SchedAttr(ctypes.Structure):
@@ -82,9 +94,13 @@ def _slack(libc: ctypes.CDLL) -> Iterator[None]:
             libc.prctl(PR_SET_TIMERSLACK, old, 0, 0, 0)
 
 
+def _numbers() -> tuple[int, int] | None:
+    return syscall_numbers(platform.machine(), ctypes.sizeof(ctypes.c_void_p))
+
+
 def sched_attr(libc: ctypes.CDLL) -> SchedAttr | None:
     """This thread's scheduling attributes, or None where they cannot be read."""
-    numbers = SCHED_ATTR.get(platform.machine())
+    numbers = _numbers()
     attr = SchedAttr()
     if numbers is None or libc.syscall(numbers[1], 0, ctypes.byref(attr), 48, 0) != 0:
         return None
@@ -92,8 +108,9 @@ def sched_attr(libc: ctypes.CDLL) -> SchedAttr | None:
 
 
 def _set(libc: ctypes.CDLL, attr: SchedAttr, runtime: int) -> bool:
+    numbers = _numbers()
     new = SchedAttr(48, attr.policy, 0, attr.nice, 0, runtime)
-    return bool(libc.syscall(SCHED_ATTR[platform.machine()][0], 0, ctypes.byref(new), 0) == 0)
+    return numbers is not None and libc.syscall(numbers[0], 0, ctypes.byref(new), 0) == 0
 
 
 @contextmanager

@@ -18,6 +18,7 @@ from appmode.ports.wakeups import (
     SchedAttr,
     exact_wakeups,
     sched_attr,
+    syscall_numbers,
 )
 from appmode.transcript.replay import play
 
@@ -87,3 +88,12 @@ def test_a_niced_thread_keeps_its_nice_value() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["5", "5"]
+
+
+def test_a_32_bit_program_uses_its_own_syscall_numbers_on_a_64_bit_kernel() -> None:
+    assert syscall_numbers("x86_64", 8) == (314, 315)
+    assert syscall_numbers("x86_64", 4) == (351, 352)  # i386's, not x86_64's
+    assert syscall_numbers("aarch64", 8) == (274, 275)
+    assert syscall_numbers("aarch64", 4) == (380, 381)  # 32-bit ARM's
+    assert syscall_numbers("armv7l", 4) == (380, 381)
+    assert syscall_numbers("mips", 4) is None  # not known: nothing is called
