@@ -22,6 +22,7 @@ SLACK_NS = 1000
 SLICE_NS = 100_000
 """The slice asked for: the kernel's shortest (0.1 ms)."""
 SCHED_OTHER = 0
+SCHED_FLAG_RESET_ON_FORK = 0x01
 SCHED_ATTR = {  # (sched_setattr, sched_getattr) by machine
     "x86_64": (314, 315),
     "aarch64": (274, 275),
@@ -108,8 +109,10 @@ def sched_attr(libc: ctypes.CDLL) -> SchedAttr | None:
 
 
 def _set(libc: ctypes.CDLL, attr: SchedAttr, runtime: int) -> bool:
+    """`attr`'s policy, nice value and reset-on-fork flag, with a slice of `runtime`."""
     numbers = _numbers()
-    new = SchedAttr(48, attr.policy, 0, attr.nice, 0, runtime)
+    flags = attr.flags & SCHED_FLAG_RESET_ON_FORK
+    new = SchedAttr(48, attr.policy, flags, attr.nice, 0, runtime)
     return numbers is not None and libc.syscall(numbers[0], 0, ctypes.byref(new), 0) == 0
 
 

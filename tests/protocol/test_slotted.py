@@ -71,6 +71,7 @@ def test_records_are_not_hashable() -> None:
         Move(2, numeric=True, raw=b"\x02"),
         Stop(b"Z"),
         SetParam(1, 100, b"{1:100}"),
+        ReadParams(0x3B, b"{Q;P}"),
         Velocity(1, -2, 3, 4, terminated=False, raw=b"{A1:-2:3:4}"),
         ParamsRecord((1, 2, 3, 4, 5, 6, 7, 8, 9), raw=b"{C...}$"),
         MOTIONS["forward"],
@@ -83,7 +84,8 @@ def test_records_are_not_hashable() -> None:
 def test_copies_and_pickles_keep_every_field(value: object) -> None:
     for twin in (copy.copy(value), copy.deepcopy(value), pickle.loads(pickle.dumps(value))):
         assert type(twin) is type(value)
-        assert all(getattr(twin, f) == getattr(value, f) for f in value.__slots__)  # type: ignore[attr-defined]
+        fields = value._fields  # type: ignore[attr-defined]
+        assert fields and all(getattr(twin, f) == getattr(value, f) for f in fields)
 
 
 def test_patterns_match_fields_in_constructor_order() -> None:
