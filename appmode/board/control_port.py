@@ -200,7 +200,7 @@ class ControlPort:
         core = self.core
         command = core.command
         if isinstance(command, control.MotorFrame) and core.uart2_control:
-            return tuple(map(float, command.speeds))
+            return motor_speeds(command, core.drive_type)
         return kinematics.wheels(core.drive_type, *core.target_velocity)
 
     def _wheels(self) -> tuple[float, ...]:
@@ -232,6 +232,14 @@ class ControlPort:
             index = read.ss - settings.SPEED_BASE
         encoders = self._encoders(wheels)
         return encoders[index] if index < len(encoders) else 0  # no wheel D on an omni
+
+
+def motor_speeds(frame: control.MotorFrame, drive: DriveType) -> tuple[float, ...]:
+    """A motor frame's speeds for the motors of `drive`: a frame taken before the drive
+    type changed (§10) drives a motor it did not name at 0, and names one too many
+    (wheel D on an omni) for nothing (§9.2)."""
+    count = control.motor_count(drive)
+    return tuple(map(float, (frame.speeds + (0,) * count)[:count]))
 
 
 def clamp(value: float, limit: float) -> float:

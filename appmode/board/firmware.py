@@ -22,7 +22,7 @@ from collections import deque
 from appmode.board import kinematics
 from appmode.board.app_port import AppPort
 from appmode.board.chip import float32
-from appmode.board.control_port import REPORT_MS, ControlPort, clamp
+from appmode.board.control_port import REPORT_MS, ControlPort, clamp, motor_speeds
 from appmode.board.core import UART3, Core, Note
 from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
@@ -301,7 +301,7 @@ class Board:
         if isinstance(command, control.VelocityFrame):
             x, y, z = self._velocity_target(command, speed)
         elif isinstance(command, control.MotorFrame):
-            x, y, z = kinematics.body(core.drive_type, tuple(map(float, command.speeds)))
+            x, y, z = kinematics.body(core.drive_type, motor_speeds(command, core.drive_type))
         elif core.position_goal is not None:
             travel = (vehicle.travel_x, vehicle.travel_y, vehicle.travel_z)
             x, y, z = (

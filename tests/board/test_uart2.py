@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+from hypothesis import given
+from hypothesis import settings as hypothesis_settings
+from hypothesis import strategies as st
+
 from appmode.board.firmware import Board
-from appmode.board.profiles import MINIBALANCE
+from appmode.board.profiles import MINIBALANCE, SHEET, Profile
 from appmode.board.store import MemoryStore
 from appmode.protocol import app, app_decoders, control, control_decoders, params, settings
 from appmode.protocol.control import MotorFrame, PositionFrame, SetSetting, encode
@@ -142,6 +146,25 @@ def test_s9_2_omni_three_motors_and_wheel_d_reads_zero() -> None:
     assert read(board, "speed_d", 1.6) == 0
 
 
+def test_s9_2_a_motor_frame_outlives_a_change_of_drive_type() -> None:
+    """A 3-motor frame then a 4-wheel type: motor 4 runs at 0 (the board used to raise
+    at its next tick); and back to an omni: motor 4 is ignored."""
+    board = Board()
+    board.receive_uart2(encode(MotorFrame((100, 100, 100))), 0.0)
+    set_setting(board, "system_mode", 0x41, 0.5)  # mecanum, encoder report on
+    reports = [
+        e
+        for e in control_decoders.ReplyDecoder(4).feed(board.poll_uart2(3.0))
+        if isinstance(e, control.EncoderReport)
+    ]
+    assert reports and reports[-1].targets == (100, 100, 100, 0)
+    assert round(board.vehicle.vy) == 75  # the mecanum body of (100, 100, 100, 0)
+    board.receive_uart2(encode(MotorFrame((300, 300, 300, 300))), 3.0)
+    set_setting(board, "system_mode", 0x40, 3.5)  # omni
+    board.advance(6.0)
+    assert round(board.vehicle.vz) == 300 and round(board.vehicle.vy) == 0
+
+
 def test_s9_3_position_mode_moves_by_the_clamped_displacement_and_holds() -> None:
     board = Board()
     set_setting(board, "max_position", 400, 0.0)
@@ -273,3 +296,50 @@ def test_each_port_plans_only_what_it_sends() -> None:
     uart3, uart2 = board.next_sends()
     assert uart3 == float("inf") and uart2 < 0.2, "APP mode: records on UART2, UART3 idle"
     assert board.next_slot() == uart2
+
+
+speed = st.integers(-1000, 1000)
+frame = st.one_of(
+    st.builds(
+        lambda a, b, c, angle: control.VelocityFrame(a, b, c, angle),
+        speed,
+        speed,
+        speed,
+        st.booleans(),
+    ),
+    st.builds(lambda v: MotorFrame(tuple(v)), st.lists(speed, min_size=3, max_size=4)),
+    st.builds(PositionFrame, speed, speed, speed),
+    st.builds(  # any drive type, encoder report and APP mode on or off
+        lambda mode: SetSetting(settings.BY_NAME["system_mode"], mode),
+        st.sampled_from([0, 1, 2, 3]).flatmap(
+            lambda drive: st.sampled_from([drive, drive | 0x40, drive | 0x80, drive | 0xC0])
+        ),
+    ),
+    st.sampled_from(settings.READS).map(control.ReadFrame),
+).map(encode) | st.sampled_from([b"A", b"Z", b"{Q:P}", b"{8:1}", b"{8:64}"]).map(
+    lambda b: b"app" + b
+)
+
+
+@hypothesis_settings(max_examples=150, deadline=None)
+@given(
+    st.sampled_from([SHEET, MINIBALANCE]),
+    st.lists(st.tuples(st.floats(0, 0.5), frame), max_size=20),
+)
+def test_property_no_sequence_of_valid_frames_stops_the_board(
+    profile: Profile, steps: list[tuple[float, bytes]]
+) -> None:
+    """Whatever valid frames come on either port, in any order (a drive type changed
+    under a motor frame, APP mode on and off, reads), the board keeps running: its
+    records go on, on one port or the other."""
+    board = Board(profile=profile, drive=DriveType.OMNI if profile.drive_types else None)
+    now = 0.0
+    for gap, data in steps:
+        now += gap
+        if data.startswith(b"app"):
+            board.receive(data[3:], now)
+        else:
+            board.receive_uart2(data, now)
+        board.poll(now)
+        board.poll_uart2(now)
+    assert board.poll(now + 2.0) + board.poll_uart2(now + 2.0)
