@@ -92,8 +92,7 @@ class ControlPort:
             and core.profile.answers_reads
         ):
             targets = self._encoders(self._wheel_targets())
-            actuals = self._encoders(self._wheels())
-            core.out2 += control.encode(control.EncoderReport(targets, actuals))
+            core.out2 += control.encode_report(targets, self._encoders(self._wheels()))
 
     def angle_mode(self, frame: control.VelocityFrame) -> bool:
         return frame.angle and self.core.drive_type is not DriveType.DIFF_GYRO
@@ -209,10 +208,10 @@ class ControlPort:
 
     def _encoders(self, values: tuple[float, ...]) -> tuple[int, ...]:
         """Wheel values as the encoders give them: whole, signed by encoder_reverse."""
-        sign = -1 if self.core.mode("encoder_reverse") else 1
-        count = control.motor_count(self.core.drive_type)
-        values = (values + (0.0,) * count)[:count]
-        return tuple(int32(sign * value) for value in values)
+        core = self.core
+        sign = -1 if core.mode("encoder_reverse") else 1
+        count = control.motor_count(core.drive_type)
+        return tuple([int32(sign * value) for value in (values + (0.0,) * count)[:count]])
 
     def _read_value(self, read: settings.Read) -> int:
         """The value a read's reply carries (§11)."""

@@ -71,6 +71,8 @@ class Board:
         self._copy_ms = 0.0 if profile.firmware_uart2 else math.inf  # the next COPY_MS tick
         self._target_for: tuple[object, ...] | None = None  # what _target was worked out for
         self._target_is: tuple[float, float, float] = (0.0, 0.0, 0.0)  # and what it was
+        self._velocity_for: tuple[object, ...] | None = None  # a velocity frame's, the same
+        self._velocity_is: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     # ------------------------------------------------------------ what others read
 
@@ -299,7 +301,12 @@ class Board:
         command, vehicle = core.command, core.vehicle
         x = y = z = 0.0
         if isinstance(command, control.VelocityFrame):
-            x, y, z = self._velocity_target(command, speed)
+            # worked out again only when what it depends on changed (100 times a second)
+            key = (command, speed, core.params[params.SYSTEM_MODE])
+            if key != self._velocity_for:
+                self._velocity_for = key
+                self._velocity_is = self._velocity_target(command, speed)
+            x, y, z = self._velocity_is
         elif isinstance(command, control.MotorFrame):
             x, y, z = kinematics.body(core.drive_type, motor_speeds(command, core.drive_type))
         elif core.position_goal is not None:

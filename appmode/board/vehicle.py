@@ -63,14 +63,18 @@ class Vehicle:
 
     def step(self, target: tuple[float, float, float], dt: float) -> None:
         """Advance by `dt` seconds toward the target velocity (x, y, z)."""
-        if not (self.vx or self.vy or self.vz or any(target)):  # at rest, staying so
+        old_x, old_y, vz = self.vx, self.vy, self.vz
+        if not (old_x or old_y or vz or any(target)):  # at rest, staying so
             self.rest(1, dt)
             return
         alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
-        old_x, old_y = self.vx, self.vy
-        self.vx = _approach(self.vx, target[0], alpha)
-        self.vy = _approach(self.vy, target[1], alpha)
-        self.vz = _approach(self.vz, target[2], alpha)
+        tx, ty, tz = target
+        vx = old_x + (tx - old_x) * alpha  # each axis a first-order lag, snapped at SNAP
+        vy = old_y + (ty - old_y) * alpha
+        vz += (tz - vz) * alpha
+        self.vx = tx if abs(tx - vx) < SNAP else vx
+        self.vy = ty if abs(ty - vy) < SNAP else vy
+        self.vz = tz if abs(tz - vz) < SNAP else vz
         self._move(old_x, old_y, dt)
 
     def rest(self, steps: int, dt: float) -> None:
@@ -111,23 +115,20 @@ class Vehicle:
         self._move(old_x, old_y, dt)
 
     def _move(self, old_x: float, old_y: float, dt: float) -> None:
-        self.pitch = (self.vy - old_y) / dt * TILT_GAIN
-        self.roll = (self.vx - old_x) / dt * TILT_GAIN
-        self.heading = (self.heading + self.vz * YAW_GAIN * dt) % 360.0
-        self.travel_x += self.vx * dt
-        self.travel_y += self.vy * dt
-        self.travel_z += self.vz * dt
-        rad = math.radians(self.heading)
-        self.east += (self.vx * math.cos(rad) + self.vy * math.sin(rad)) * dt
-        self.north += (self.vy * math.cos(rad) - self.vx * math.sin(rad)) * dt
-        speed = abs(self.vx) + abs(self.vy) + abs(self.vz)
+        vx, vy, vz = self.vx, self.vy, self.vz
+        self.pitch = (vy - old_y) / dt * TILT_GAIN
+        self.roll = (vx - old_x) / dt * TILT_GAIN
+        self.heading = heading = (self.heading + vz * YAW_GAIN * dt) % 360.0
+        self.travel_x += vx * dt
+        self.travel_y += vy * dt
+        self.travel_z += vz * dt
+        rad = math.radians(heading)
+        cos, sin = math.cos(rad), math.sin(rad)
+        self.east += (vx * cos + vy * sin) * dt
+        self.north += (vy * cos - vx * sin) * dt
+        speed = abs(vx) + abs(vy) + abs(vz)
         self.centivolts = max(0.0, self.centivolts - (IDLE_DRAIN + LOAD_DRAIN * speed) * dt)
 
     @property
     def battery(self) -> int:
         return battery_percent(self.centivolts)
-
-
-def _approach(value: float, target: float, alpha: float) -> float:
-    value += (target - value) * alpha
-    return target if abs(target - value) < SNAP else value

@@ -7,6 +7,8 @@ decoders are in `control_decoders`.
 
 from __future__ import annotations
 
+import struct
+
 from appmode.errors import InvalidValue
 from appmode.protocol import app, params, settings
 from appmode.protocol.params import DriveType
@@ -304,11 +306,19 @@ def encode(item: HostFrame | Reply | EncoderReport) -> bytes:
     if isinstance(item, Reply):
         signed = item.read is not None and item.read.signed
         return bytes([REPLY, item.id]) + item.value.to_bytes(4, "big", signed=signed)
-    out = bytearray([REPORT])
-    for target, actual in zip(item.targets, item.actuals, strict=True):
-        out += target.to_bytes(4, "big", signed=True) + actual.to_bytes(4, "big", signed=True)
-    out.append(REPORT_END)
-    return bytes(out)
+    return encode_report(item.targets, item.actuals)
+
+
+def encode_report(targets: tuple[int, ...], actuals: tuple[int, ...]) -> bytes:
+    """An encoder report's bytes (§12): what `encode` gives for `EncoderReport(targets,
+    actuals)`, without making one (a board sends one every 50 ms)."""
+    speeds = [v for pair in zip(targets, actuals, strict=True) for v in pair]
+    try:
+        return struct.pack(f">B{len(speeds)}iB", REPORT, *speeds, REPORT_END)
+    except struct.error:
+        raise InvalidValue(
+            f"a report's speeds are signed 32-bit: targets {targets}, actuals {actuals}"
+        ) from None
 
 
 def _u16s(values: tuple[int, ...]) -> bytes:

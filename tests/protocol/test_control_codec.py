@@ -187,6 +187,17 @@ def test_s12_encoder_report_34_bytes_or_26_on_an_omni() -> None:
     assert assert_split_invariant(partial(ReplyDecoder, 3), encode(three)) == [three]
 
 
+def test_s12_encoder_report_bytes_and_its_range() -> None:
+    """Each speed signed 32-bit big-endian, target then actual per wheel; beyond 32 bits
+    a ValueError that says so."""
+    report = EncoderReport((1, -2, 2**31 - 1), (-(2**31), 5, 0))
+    assert encode(report) == hexes(
+        "24 00000001 80000000 FFFFFFFE 00000005 7FFFFFFF 00000000 19".replace(" ", "")
+    )
+    with pytest.raises(ValueError, match="signed 32-bit"):
+        encode(EncoderReport((2**31, 0, 0), (0, 0, 0)))
+
+
 def test_s12_a_report_without_its_end_byte_is_garbage() -> None:
     bad = encode(EncoderReport((1, 2, 3, 4), (5, 6, 7, 8)))[:-1] + b"\x00"
     events = decode_whole(ReplyDecoder, bad + encode(Reply(1, 500)))
