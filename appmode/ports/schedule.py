@@ -41,6 +41,13 @@ class Served:
     board_due: float = -math.inf
     """When the board itself next has something to do, as `wakeup` last found: before
     then a pump only writes what its lines deliver."""
+    sends: tuple[float, float] | None = None
+    """When the board next sends on each port, as it said since it last ran; None: to
+    be asked (`changed`)."""
+
+    def changed(self) -> None:
+        """The board ran, or was replaced, outside `pump`: ask it again when it sends."""
+        self.sends = None
 
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
@@ -49,7 +56,9 @@ class Served:
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
         board = wire.board
-        sends = board.next_sends()
+        sends = self.sends
+        if sends is None:  # the board ran: else its plans are as they were
+            sends = self.sends = board.next_sends()
         self.board_due = min(sends)
         due = math.inf
         for index, name in enumerate(PORTS):
@@ -92,6 +101,7 @@ class Served:
         )
         if ran:
             wire.run(now)
+            self.sends = None
         for name, endpoint in self.endpoints.items():
             line = ports[name].to_host
             out = line.take(now) if line.bursts else b""

@@ -144,10 +144,11 @@ class BoardServer:
     def look(self, index: int, see: Callable[[Board], T]) -> T:
         """`see(board)` for board `index` run to now, between two steps of the server."""
         with self.lock:
-            wire = self._served[index].wire
-            wire.run(self.now())
+            one = self._served[index]
+            one.wire.run(self.now())
+            one.changed()
             self._reschedule(index)
-            return see(wire.board)
+            return see(one.wire.board)
 
     def now(self) -> float:
         """The boards' clock: seconds since the server started."""
@@ -166,6 +167,7 @@ class BoardServer:
                 old.tap,
                 old.ports[UART2].to_host.baud,
             )
+            one.changed()
             self._reschedule(index)
         self._wake()
 
