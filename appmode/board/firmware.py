@@ -177,7 +177,7 @@ class Board:
         behind = (due - core.tick_ms) // TICK_MS
         if behind > MAX_CATCH_UP:
             skipped = behind - MAX_CATCH_UP
-            self._control(skipped)
+            self._control(skipped, at_once=True)
             core.tick_ms += skipped * TICK_MS
             if telemetry.record_ms < core.tick_ms:
                 period = core.profile.period_ms or TICK_MS
@@ -198,6 +198,7 @@ class Board:
                 self.control_port.tick()
                 core.tick_ms += TICK_MS
                 self._rest(due)
+                self._steps(due)
             else:
                 telemetry.send_record()
 
@@ -224,6 +225,28 @@ class Board:
         ticks = int(last - core.tick_ms) // TICK_MS + 1
         vehicle.rest(ticks, TICK)
         core.tick_ms += ticks * TICK_MS
+
+    def _steps(self, due: int) -> None:
+        """Run at once the control ticks up to the next other event (by `due`) on a board
+        whose ticks only step the car (it does not ramp), each exactly as alone, an
+        encoder report's tick last (it reports after it; reads are answered at the tick
+        before, the first after they came). A driving car costs one call per record, not
+        five."""
+        core = self.core
+        profile = core.profile
+        if profile.ramp is not None or profile.firmware_uart2:
+            return
+        telemetry = self.telemetry
+        last = min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
+        if core.mode("encoder_report"):
+            last = min(last, -(-core.tick_ms // REPORT_MS) * REPORT_MS)
+        if last < core.tick_ms:
+            return
+        ticks = int(last - core.tick_ms) // TICK_MS + 1
+        self._control(ticks)
+        core.tick_ms += (ticks - 1) * TICK_MS
+        self.control_port.tick()  # the last tick's: the encoder report, if one is due
+        core.tick_ms += TICK_MS
 
     # ------------------------------------------------------------ I/O-free edges
 
@@ -259,8 +282,9 @@ class Board:
 
     # ------------------------------------------------------------ the control loop
 
-    def _control(self, ticks: int) -> None:
-        """`ticks` control ticks of TICK seconds."""
+    def _control(self, ticks: int, *, at_once: bool = False) -> None:
+        """`ticks` control ticks of TICK seconds; `at_once` (catching up after a stall):
+        the APP port's direction moves the car in one step of them all."""
         core = self.core
         profile, vehicle = core.profile, core.vehicle
         speed = core.params[params.MAX_SPEED]
@@ -270,12 +294,15 @@ class Board:
             self._drive_firmware_uart2(ticks)
             return
         if core.uart2_control and not core.mode("app_mode"):
-            for _ in range(min(ticks, MAX_RAMP)):  # beyond that the car has long settled
-                self._drive_uart2(speed)
+            self._drive_uart2(speed, min(ticks, MAX_RAMP))  # beyond, the car has settled
             return
         if profile.ramp is None:
-            core.target_velocity = self._target(speed)
-            vehicle.step(core.target_velocity, ticks * TICK)
+            core.target_velocity = target = self._target(speed)
+            if at_once:
+                vehicle.step(target, ticks * TICK)
+            else:
+                for _ in range(ticks):
+                    vehicle.step(target, TICK)
         else:
             pushes = self._pushes() if core.powered(core.tick_ms) else (0, 0, 0)
             rounding = float32 if profile.float32 else float
@@ -294,9 +321,26 @@ class Board:
         core.target_velocity = (vehicle.vx, vehicle.vy, vehicle.vz)
         vehicle.step(core.target_velocity, ticks * TICK)
 
-    def _drive_uart2(self, speed: float) -> None:
-        """One control tick with UART2 in control: its last motion frame, angle mode's
-        pending rotation, position mode's goal (§9)."""
+    def _drive_uart2(self, speed: float, ticks: int) -> None:
+        """`ticks` control ticks with UART2 in control: its last motion frame, angle
+        mode's pending rotation, position mode's goal (§9)."""
+        core = self.core
+        vehicle = core.vehicle
+        for tick in range(ticks):
+            if not core.pending_angle and core.position_goal is None:
+                # the target holds: the car only steps toward it (exactly as tick by tick)
+                core.target_velocity = target = self._uart2_target(speed)
+                for _ in range(ticks - tick):
+                    vehicle.step(target, TICK)
+                return
+            core.target_velocity = self._uart2_target(speed)
+            vehicle.step(core.target_velocity, TICK)
+            if core.pending_angle:
+                left = core.pending_angle - vehicle.vz * YAW_GAIN * TICK * 10
+                core.pending_angle = left if left * core.pending_angle > 0 else 0.0
+
+    def _uart2_target(self, speed: float) -> tuple[float, float, float]:
+        """The velocity UART2 asks for this tick."""
         core = self.core
         command, vehicle = core.command, core.vehicle
         x = y = z = 0.0
@@ -317,11 +361,7 @@ class Board:
             )
         if core.pending_angle:
             z = math.copysign(speed * ANGLE_SPEED, core.pending_angle)
-        core.target_velocity = (x, y, z)
-        vehicle.step(core.target_velocity, TICK)
-        if core.pending_angle:
-            left = core.pending_angle - vehicle.vz * YAW_GAIN * TICK * 10
-            core.pending_angle = left if left * core.pending_angle > 0 else 0.0
+        return (x, y, z)
 
     def _velocity_target(
         self, frame: control.VelocityFrame, speed: float

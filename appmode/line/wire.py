@@ -117,8 +117,8 @@ class Wire:
 
     def _deliver(self, now: float) -> None:
         to_app, to_uart2 = self.ports[APP].to_board, self.ports[UART2].to_board
-        app = to_app.take_timed(now) if to_app else []
-        uart2 = to_uart2.take_timed(now) if to_uart2 else []
+        app = to_app.take_timed(now) if to_app.bursts else []
+        uart2 = to_uart2.take_timed(now) if to_uart2.bursts else []
         if not uart2:
             for when, data in app:
                 self.board.receive(data, when)

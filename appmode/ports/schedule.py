@@ -120,7 +120,9 @@ class Served:
     def throttle(self) -> None:
         """Read no more while INPUT_BACKLOG bytes wait for the simulated line."""
         ports = self.wire.ports
-        if not (ports[APP].to_board or ports[UART2].to_board or any(self.paused.values())):
+        if not (
+            ports[APP].to_board.bursts or ports[UART2].to_board.bursts or any(self.paused.values())
+        ):
             return  # nothing waits, nothing is paused
         for name, endpoint in self.endpoints.items():
             full = len(self.wire.ports[name].to_board) >= INPUT_BACKLOG

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -13,7 +14,8 @@ from appmode.board.firmware import SLOT, Board
 from appmode.board.profiles import MINIBALANCE, SHEET, Profile
 from appmode.board.store import JsonFileStore, MemoryStore
 from appmode.board.vehicle import battery_percent, wrap_degrees
-from appmode.protocol import params
+from appmode.protocol import control, params
+from appmode.protocol import settings as board_settings
 from appmode.protocol.app import Attitude, ParamsRecord, Velocity
 from appmode.protocol.app_decoders import BoardDecoder
 from appmode.protocol.params import DriveType
@@ -366,3 +368,45 @@ def test_an_idle_car_run_in_one_go_is_the_car_run_tick_by_tick(profile: Profile)
     assert run(0.5) == fine
     assert run(0.047) == fine
     assert fine[1] < Board(profile=profile).vehicle.centivolts  # the battery did drain
+
+
+@pytest.mark.parametrize(
+    "profile",
+    [SHEET, dataclasses.replace(SHEET, period_ms=70), MINIBALANCE],
+    ids=["sheet", "records-every-70-ms", "minibalance"],
+)
+def test_a_driving_car_run_in_one_go_is_the_car_run_tick_by_tick(profile: Profile) -> None:
+    """Issue 28.4: the ticks of a driving car between two records are run at once; what
+    both ports send, and where the car ends, are exactly those of a car run in steps
+    shorter than a tick: driven from either port, with the encoder report (also when it
+    does not fall with a record), a read, an angle to turn and a position to reach."""
+    mecanum = control.SetSetting(board_settings.BY_NAME["system_mode"], 0x41)
+    frames = [
+        (1.0, "app", b"A"),
+        (2.5, "app", b"G"),
+        (3.0, "uart2", control.encode(mecanum)),
+        (3.2, "uart2", control.encode(control.velocity(DriveType.MECANUM, 100, 300, 20))),
+        (4.013, "uart2", control.encode(control.read("speed_b"))),
+        (5.0, "uart2", control.encode(control.velocity(DriveType.MECANUM, y=200, angle=900))),
+        (7.0, "uart2", control.encode(control.PositionFrame(300, -200, 0))),
+        (9.0, "uart2", control.encode(control.MotorFrame((100, 200, 300, 400)))),
+        (11.0, "uart2", control.STOP),
+    ]
+
+    def run(step: float) -> tuple[bytes, bytes, tuple[float, ...]]:
+        board, t, pending = Board(profile=profile), 0.0, list(frames)
+        out, out2 = bytearray(), bytearray()
+        while t < 13.0:
+            t = min(t + step, 13.0)
+            while pending and pending[0][0] <= t:
+                when, port, data = pending.pop(0)
+                (board.receive if port == "app" else board.receive_uart2)(data, when)
+            out += board.poll(t)
+            out2 += board.poll_uart2(t)
+        v = board.vehicle
+        return bytes(out), bytes(out2), (v.east, v.north, v.heading, v.centivolts)
+
+    fine = run(0.003)
+    assert len(fine[1]) > 500  # encoder reports (status bursts on the reference firmware)
+    assert run(0.5) == fine
+    assert run(0.047) == fine
