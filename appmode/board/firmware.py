@@ -197,15 +197,16 @@ class Board:
                     self._control(1)
                 self.control_port.tick()
                 core.tick_ms += TICK_MS
-                self._rest(due)
-                self._steps(due)
+                if not self._rest(due):
+                    self._steps(due)
             else:
                 telemetry.send_record()
 
-    def _rest(self, due: int) -> None:
+    def _rest(self, due: int) -> bool:
         """Run at once the control ticks up to the next other event (by `due`) while the
         car rests and stays at rest: all such a tick does is drain the battery (exact:
-        Vehicle.rest drains it tick by tick). An idle car costs no 100 Hz step."""
+        Vehicle.rest drains it tick by tick). An idle car costs no 100 Hz step. Whether
+        it ran any."""
         core = self.core
         vehicle = core.vehicle
         if (
@@ -217,14 +218,15 @@ class Board:
             or core.reads
             or core.mode("encoder_report")
         ):
-            return
+            return False
         telemetry = self.telemetry
         last = min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
         if last < core.tick_ms or core.powered(core.tick_ms) != core.powered(int(last)):
-            return  # no tick before the next event, or the motors' power comes on
+            return False  # no tick before the next event, or the motors' power comes on
         ticks = int(last - core.tick_ms) // TICK_MS + 1
         vehicle.rest(ticks, TICK)
         core.tick_ms += ticks * TICK_MS
+        return True
 
     def _steps(self, due: int) -> None:
         """Run at once the control ticks up to the next other event (by `due`) on a board
