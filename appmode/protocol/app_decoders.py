@@ -151,6 +151,7 @@ class HostDecoder:
                 else:
                     out += [single[b] for b in gap]
                     pos += len(gap)
+            self._skip_len = 0  # the frame's `{` ends an over-long frame's rest, if open
             out.append(parse(frame))
             pos += len(frame)
         pos = general(buf, pos, len(buf), out)

@@ -126,6 +126,14 @@ def test_s2_2_over_long_frame_is_discarded_whole_and_reported() -> None:
     assert "discarded" in events[-2].reason
 
 
+def test_s2_2_a_brace_ends_an_over_long_frame_also_where_a_whole_frame_follows() -> None:
+    """The `{` that cuts an over-long frame at its 51st byte starts a frame that is read;
+    a `}` after that frame is noise, not the over-long frame's end (whole, the decoder
+    took it for that; split, it did not: found by fuzz/fuzz_decoders.py)."""
+    events = assert_split_invariant(HostDecoder, b"{" + b"x" * 49 + b"{Q:P}}A")
+    assert [type(e) for e in events] == [BadFrame, ReadParams, Noise, Move]
+
+
 def test_s2_2_over_long_garbage_never_grows_the_buffer() -> None:
     decoder = HostDecoder()
     events = decoder.feed(b"{" + b"x" * 100_000)
