@@ -219,14 +219,20 @@ class Board:
             or core.mode("encoder_report")
         ):
             return False
-        telemetry = self.telemetry
-        last = min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
+        last = self._last_tick(due)
         if last < core.tick_ms or core.powered(core.tick_ms) != core.powered(int(last)):
             return False  # no tick before the next event, or the motors' power comes on
         ticks = int(last - core.tick_ms) // TICK_MS + 1
         vehicle.rest(ticks, TICK)
         core.tick_ms += ticks * TICK_MS
         return True
+
+    def _last_tick(self, due: int) -> float:
+        """The last millisecond (by `due`) at which a control tick comes before every other
+        event: a record of the same millisecond comes after its tick, a copy or a burst
+        before."""
+        telemetry = self.telemetry
+        return min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
 
     def _steps(self, due: int) -> None:
         """Run at once the control ticks up to the next other event (by `due`) on a board
@@ -238,8 +244,7 @@ class Board:
         profile = core.profile
         if profile.ramp is not None or profile.firmware_uart2:
             return
-        telemetry = self.telemetry
-        last = min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
+        last = self._last_tick(due)
         if core.mode("encoder_report"):
             last = min(last, -(-core.tick_ms // REPORT_MS) * REPORT_MS)
         if last < core.tick_ms:
@@ -329,14 +334,13 @@ class Board:
         core = self.core
         vehicle = core.vehicle
         for tick in range(ticks):
+            core.target_velocity = target = self._uart2_target(speed)
             if not core.pending_angle and core.position_goal is None:
                 # the target holds: the car only steps toward it (exactly as tick by tick)
-                core.target_velocity = target = self._uart2_target(speed)
                 for _ in range(ticks - tick):
                     vehicle.step(target, TICK)
                 return
-            core.target_velocity = self._uart2_target(speed)
-            vehicle.step(core.target_velocity, TICK)
+            vehicle.step(target, TICK)
             if core.pending_angle:
                 left = core.pending_angle - vehicle.vz * YAW_GAIN * TICK * 10
                 core.pending_angle = left if left * core.pending_angle > 0 else 0.0
