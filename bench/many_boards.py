@@ -20,6 +20,7 @@ import signal
 import statistics
 import subprocess
 import sys
+import threading
 import time
 import tty
 from functools import partial
@@ -37,7 +38,8 @@ from appmode.protocol.app_decoders import BoardDecoder
 
 def serve(count: int) -> None:
     """Serve `count` boards (both ports on ptys, as `appmode board --count`) until
-    SIGTERM; then print CPU seconds, wall seconds and the grid's lateness as JSON."""
+    SIGTERM; then print CPU seconds, wall seconds and the grid's lateness as JSON, from a
+    second after the parent's go (from the go in a shorter run)."""
     make = partial(PtyEndpoint, link=None, baud=None)
     server = BoardServer(
         [make] * count,
@@ -49,9 +51,17 @@ def serve(count: int) -> None:
     signal.signal(signal.SIGTERM, lambda *_: server.stop())
     for i in range(count):
         print(server.urls(i)["app"], flush=True)
-    sys.stdin.readline()  # the parent has opened every port: measure from here
+    sys.stdin.readline()  # the parent has opened every port
+    start = {"cpu": time.process_time(), "wall": time.monotonic()}  # until measure() runs
     server.lateness = []
-    cpu, wall = time.process_time(), time.monotonic()
+
+    def measure() -> None:
+        """From here: a second after the parent's go, once the boards that fell due while
+        it opened the ports have run (the first pass ran them 0.1 s late, all at once)."""
+        start.update(cpu=time.process_time(), wall=time.monotonic())
+        server.lateness = []
+
+    threading.Timer(1.0, measure).start()
     try:
         server.run()
     finally:
@@ -59,8 +69,8 @@ def serve(count: int) -> None:
         print(
             json.dumps(
                 {
-                    "cpu": time.process_time() - cpu,
-                    "wall": time.monotonic() - wall,
+                    "cpu": time.process_time() - start["cpu"],
+                    "wall": time.monotonic() - start["wall"],
                     "p50": statistics.median(late),
                     "p99": percentile(late, 99),
                     "max": max(late),
