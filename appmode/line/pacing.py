@@ -75,6 +75,20 @@ class Line:
 
     def take(self, now: float) -> bytes:
         """Every byte delivered by `now`."""
+        bursts, step = self.bursts, self.byte_time
+        if len(bursts) == 1 and step:  # the usual case on a paced line: one burst
+            start, data = bursts[0]
+            size, taken = len(data), self._taken
+            due = int((now - start) / step + 1e-9)
+            if due < size:
+                if due <= taken:
+                    return b""
+                self._taken = due
+                return data[taken:due]
+            bursts.popleft()
+            self._queued -= size
+            self._taken = 0
+            return data[taken:]
         spans = self._delivered(now)
         if len(spans) == 1:  # the usual case: part of one burst
             _, data, first, end = spans[0]

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from appmode.board.firmware import Board
 from appmode.line.pacing import Line, byte_time
@@ -111,3 +113,24 @@ def test_wire_backlog_to_the_host_is_bounded() -> None:
         wire.pump(k * 0.05 + 0.01)
     assert len(wire.to_host) <= 960 + 128
     assert wire.dropped > 0
+
+
+@given(
+    st.lists(
+        st.tuples(st.floats(0, 0.05), st.binary(max_size=12), st.sampled_from([9600, 115200])),
+        max_size=40,
+    )
+)
+def test_take_gives_what_take_timed_gives_by_then(steps: list[tuple[float, bytes, int]]) -> None:
+    """`take`'s one-burst path gives exactly the bytes the general one gives: a twin
+    line read with `take_timed` at the same times."""
+    baud = steps[0][2] if steps else 9600
+    line, twin = Line(baud), Line(baud)
+    now = 0.0
+    for gap, data, _ in steps:
+        now += gap
+        line.push(data, now)
+        twin.push(data, now)
+        now += gap / 2
+        assert line.take(now) == b"".join(data for _, data in twin.take_timed(now))
+        assert len(line) == len(twin) and bool(line.bursts) == bool(twin.bursts)
