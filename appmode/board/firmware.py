@@ -282,6 +282,16 @@ class Board:
         self.core.out2.clear()
         return out
 
+    def poll_ports(self, now: float) -> tuple[bytes, bytes]:
+        """What `poll` and `poll_uart2` give, in one run of the board."""
+        self.advance(now)
+        core = self.core
+        out3, out2 = core.out3, core.out2
+        app, uart2 = bytes(out3), bytes(out2)
+        out3.clear()
+        out2.clear()
+        return app, uart2
+
     def take_notes(self) -> list[Note]:
         notes = list(self.core.notes)
         self.core.notes.clear()

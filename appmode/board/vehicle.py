@@ -67,8 +67,12 @@ class Vehicle:
         if not (old_x or old_y or vz or any(target)):  # at rest, staying so
             self.rest(1, dt)
             return
-        alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
         tx, ty, tz = target
+        if old_x == tx and old_y == ty and vz == tz:  # at the target: the lag keeps it there
+            self.vx, self.vy, self.vz = tx, ty, tz
+            self._move(old_x, old_y, dt)
+            return
+        alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
         vx = old_x + (tx - old_x) * alpha  # each axis a first-order lag, snapped at SNAP
         vy = old_y + (ty - old_y) * alpha
         vz += (tz - vz) * alpha

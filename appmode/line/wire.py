@@ -88,32 +88,46 @@ class Wire:
         self.run(now)
         return self.ports[port].to_host.take_timed(now)
 
-    def run(self, now: float) -> None:
-        """Run the board to `now`: its input delivered, what it sends on the lines."""
+    def run(self, now: float) -> tuple[float, float]:
+        """Run the board to `now`: its input delivered, what it sends on the lines. When
+        the board next sends on each port (`Board.next_sends`), as it stands after."""
         board = self.board
-        slot = board.next_slot()
+        to_app, to_uart2 = self.ports[APP].to_board, self.ports[UART2].to_board
+        sends = board.next_sends()
+        slot = min(sends)
         if now - slot > MAX_LAG:  # stalled (suspend, debugger): catch up at once
             self._deliver(now)
             self._send(now)
-            slot = board.next_slot()
+            sends = board.next_sends()
+            slot = min(sends)
         while slot <= now:
-            self._deliver(slot)
+            if to_app.bursts or to_uart2.bursts:
+                self._deliver(slot)
             self._send(slot)
-            slot = board.next_slot()
-        self._deliver(now)
+            sends = board.next_sends()
+            slot = min(sends)
+        if to_app.bursts or to_uart2.bursts:
+            self._deliver(now)
+            sends = board.next_sends()  # what came may ask for a reply
+        return sends
 
     def _send(self, when: float) -> None:
-        for name, data in ((APP, self.board.poll(when)), (UART2, self.board.poll_uart2(when))):
-            if not data:
-                continue
-            port = self.ports[name]
-            line = port.to_host
-            if len(line) > MAX_BACKLOG[name]:
-                port.dropped += len(data)  # the line cannot carry it: bounded, like a FIFO
-                continue
-            if self.tap is not None:
-                self.tap(port.received, when, data)
-            line.push(data, when)
+        app, uart2 = self.board.poll_ports(when)
+        if app:
+            self._queue(APP, app, when)
+        if uart2:
+            self._queue(UART2, uart2, when)
+
+    def _queue(self, name: str, data: bytes, when: float) -> None:
+        """What the board sent on port `name` at `when` goes on the line to the host."""
+        port = self.ports[name]
+        line = port.to_host
+        if len(line) > MAX_BACKLOG[name]:
+            port.dropped += len(data)  # the line cannot carry it: bounded, like a FIFO
+            return
+        if self.tap is not None:
+            self.tap(port.received, when, data)
+        line.push(data, when)
 
     def _deliver(self, now: float) -> None:
         to_app, to_uart2 = self.ports[APP].to_board, self.ports[UART2].to_board

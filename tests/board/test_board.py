@@ -410,3 +410,34 @@ def test_a_driving_car_run_in_one_go_is_the_car_run_tick_by_tick(profile: Profil
     assert len(fine[1]) > 500  # encoder reports (status bursts on the reference firmware)
     assert run(0.5) == fine
     assert run(0.047) == fine
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.tuples(st.floats(0.001, 0.2), st.sampled_from([b"A", b"C", b"Z", b"{Q:P}"]))))
+def test_poll_ports_is_poll_then_poll_uart2(inputs: list[tuple[float, bytes]]) -> None:
+    """One run of the board for both ports gives what polling each port gives."""
+    one, twin = Board(drive=DriveType.MECANUM), Board(drive=DriveType.MECANUM)
+    for board in (one, twin):
+        board.receive_uart2(
+            control.encode(control.SetSetting(board_settings.BY_NAME["system_mode"], 0x41)), 0.0
+        )
+    now = 0.0
+    for gap, data in inputs:
+        now += gap
+        one.receive(data, now)
+        twin.receive(data, now)
+        assert one.poll_ports(now) == (twin.poll(now), twin.poll_uart2(now))
+
+
+@pytest.mark.parametrize("target", [(0.0, 300.0, 0.0), (-0.0, -120.5, 40.0), (250.0, 0.0, -0.0)])
+def test_a_car_at_its_target_stays_there_and_moves_at_it(
+    target: tuple[float, float, float],
+) -> None:
+    car = Board().vehicle
+    car.vx, car.vy, car.vz = target
+    before = dataclasses.replace(car)
+    car.step(target, 0.01)
+    assert (car.vx, car.vy, car.vz) == target
+    assert (car.pitch, car.roll) == (0.0, 0.0)
+    assert car.travel_y - before.travel_y == target[1] * 0.01
+    assert car.centivolts < before.centivolts
