@@ -117,7 +117,9 @@ class PtyEndpoint:
         return self._misread(data, to_board=True)
 
     def write(self, data: bytes) -> None:
-        self._out.write(self._misread(data, to_board=False), self._write_master)
+        if self.baud is not None:
+            data = self._misread(data, to_board=False)
+        self._out.write(data, self._write_master)
 
     def _misread(self, data: bytes, *, to_board: bool) -> bytes:
         """With a line rate, what each side reads when the client set another one."""

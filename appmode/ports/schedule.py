@@ -49,43 +49,49 @@ class Served:
         """The board ran, or was replaced, outside `pump`: ask it again when it sends."""
         self.sends = None
 
+    def __post_init__(self) -> None:
+        self._grid = tuple(
+            (index, name, RUN[name], self.phase * RUN[name])
+            for index, name in enumerate(PORTS)
+            if name in self.endpoints
+        )
+        """(index in `sends`, name, run, the grid's offset) of each port served."""
+
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
         grid of RUN seconds: the board has run to then (every byte and record at its own
         time) and the bytes whose stop bit is done are written, never early, never more
         than RUN of wire time at once, and one wake-up serves every board due then."""
         wire = self.wire
-        board = wire.board
         sends = self.sends
         if sends is None:  # the board ran: else its plans are as they were
-            sends = self.sends = board.next_sends()
+            sends = self.sends = wire.board.next_sends()
         self.board_due = min(sends)
         due = math.inf
-        for index, name in enumerate(PORTS):
-            if name not in self.endpoints:
-                continue
-            port = wire.ports[name]
-            to_host = port.to_host
-            if sends[index] == math.inf and not to_host.bursts and not port.to_board.bursts:
+        ports = wire.ports
+        for index, name, run, offset in self._grid:
+            port = ports[name]
+            to_host, to_board = port.to_host, port.to_board
+            mine = sends[index]
+            if mine == math.inf and not to_host.bursts and not to_board.bursts:
                 continue  # nothing planned, nothing on its lines (and so no read pending)
             step = to_host.byte_time
-            mine = sends[index] + step  # the port's next output: its first byte
-            first = to_host.next_due()
+            mine += step  # the port's next output: its first byte
+            first = to_host.next_due() if to_host.bursts else None
             if first is not None and first < mine:
                 mine = first
-            received = port.to_board.next_due()
-            if received is not None and received < mine:
-                mine = received
+            if to_board.bursts:
+                received = to_board.next_due()
+                if received is not None and received < mine:
+                    mine = received
             if step and mine < math.inf:
-                run = RUN[name]
-                offset = self.phase * run
                 mine = math.ceil((mine - offset) / run - 1e-9) * run + offset
             if name == UART2 and step:
                 # a reply is due within its tick: run the board at the slot, and write a
                 # burst shorter than a run whole when its last stop bit is done
-                mine = min(mine, board.next_reply())
+                mine = min(mine, wire.board.next_reply())
                 last = to_host.last_due()
-                if first is not None and last is not None and last - first < RUN[name]:
+                if first is not None and last is not None and last - first < run:
                     mine = min(mine, last)
             if mine < due:
                 due = mine
@@ -100,11 +106,12 @@ class Served:
             ports[APP].to_board.bursts or ports[UART2].to_board.bursts
         )
         if ran:
-            wire.run(now)
-            self.sends = None
+            self.sends = wire.run(now)
         for name, endpoint in self.endpoints.items():
             line = ports[name].to_host
-            out = line.take(now) if line.bursts else b""
+            if not line.bursts:
+                continue
+            out = line.take(now)
             if out and self.faults is not None:
                 out = self.faults[1].apply(out)
             if out:

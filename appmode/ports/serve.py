@@ -30,6 +30,7 @@ from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
 from appmode.ports.endpoints import Endpoint, Log, MakeEndpoint
 from appmode.ports.schedule import INPUT_BACKLOG, Served
 from appmode.ports.urls import BAUD
+from appmode.ports.wakeups import exact_wakeups
 from appmode.protocol import app
 from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder
@@ -185,6 +186,10 @@ class BoardServer:
             self._wake_read.recv(4096)
 
     def run(self) -> None:
+        with exact_wakeups():  # the boards' grid points kept, also on a busy machine
+            self._serve()
+
+    def _serve(self) -> None:
         while not self._stopped:
             with self.lock:
                 wake = self._step()
@@ -214,28 +219,31 @@ class BoardServer:
     def _reschedule(self, index: int) -> None:
         """Queue board `index` at its next wake-up (an entry queued before is left stale)."""
         due = self._served[index].wakeup()
-        if due == self._due[index]:
+        dues = self._due
+        if due == dues[index]:
             return  # queued already
-        self._due[index] = due
+        dues[index] = due
         if due < math.inf:
-            heapq.heappush(self._queue, (due, index))
-        if len(self._queue) > 4 * len(self._due) + 64:  # stale entries pile up: rebuild
-            self._queue = [(d, i) for i, d in enumerate(self._due) if d < math.inf]
-            heapq.heapify(self._queue)
+            queue = self._queue
+            heapq.heappush(queue, (due, index))
+            if len(queue) > 4 * len(dues) + 64:  # stale entries pile up: rebuild
+                self._queue = [(d, i) for i, d in enumerate(dues) if d < math.inf]
+                heapq.heapify(self._queue)
 
     def _step(self) -> float:
         """Run every board that is due (only those: a heap orders them); when the next
         one is."""
         now = self.now()
-        queue, ran = self._queue, []
+        queue, dues, served, lateness = self._queue, self._due, self._served, self.lateness
+        ran = []
         while queue and queue[0][0] <= now:
             due, index = heapq.heappop(queue)
-            if due != self._due[index]:
+            if due != dues[index]:
                 continue  # stale
-            self._due[index] = math.nan
-            if self.lateness is not None:
-                self.lateness.append(now - due)
-            one = self._served[index]
+            dues[index] = math.nan
+            if lateness is not None:
+                lateness.append(now - due)
+            one = served[index]
             if one.pump(now):
                 self._log_notes(one)
                 one.throttle()

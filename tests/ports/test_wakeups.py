@@ -11,6 +11,8 @@ import time
 
 import pytest
 
+from appmode.board.firmware import Board
+from appmode.ports.serve import BoardServer
 from appmode.ports.wakeups import (
     PR_GET_TIMERSLACK,
     SLACK_NS,
@@ -97,3 +99,45 @@ def test_a_32_bit_program_uses_its_own_syscall_numbers_on_a_64_bit_kernel() -> N
     assert syscall_numbers("aarch64", 4) == (380, 381)  # 32-bit ARM's
     assert syscall_numbers("armv7l", 4) == (380, 381)
     assert syscall_numbers("mips", 4) is None  # not known: nothing is called
+
+
+class Quiet:
+    """An endpoint that takes what it is given (no I/O)."""
+
+    baud = None
+
+    def __init__(self, sel: object, log: object) -> None:
+        """Nothing to open."""
+
+    def write(self, data: bytes) -> None:
+        """Dropped."""
+
+    def pause(self, paused: bool) -> None:
+        """Never paused."""
+
+    def close(self) -> None:
+        """Nothing to close."""
+
+
+@linux
+def test_a_board_server_runs_with_exact_wakeups(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A served board's grid points are kept on a busy machine as a replay's deadlines
+    are: the serving thread runs with the 1 µs slack (and short slice) while it serves."""
+    seen: list[int] = []
+    step = BoardServer._step
+
+    def watched(self: BoardServer) -> float:
+        seen.append(slack())
+        if len(seen) == 3:
+            self.stop()
+        return step(self)
+
+    monkeypatch.setattr(BoardServer, "_step", watched)
+    before = slack()
+    server = BoardServer([Quiet], [Board()], pace=True, log=lambda text: None, make_uart2=[Quiet])
+    try:
+        server.run()
+    finally:
+        server.close()
+    assert seen == [SLACK_NS] * 3
+    assert slack() == before
