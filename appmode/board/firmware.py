@@ -193,6 +193,8 @@ class Board:
             elif telemetry.burst_ms == at:
                 telemetry.send_burst()
             elif core.tick_ms == at:
+                if core.tick_ms and not core.reads and self._steps(due):
+                    continue  # this tick and those after it, in one go
                 if core.tick_ms:
                     self._control(1)
                 self.control_port.tick()
@@ -234,26 +236,27 @@ class Board:
         telemetry = self.telemetry
         return min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
 
-    def _steps(self, due: int) -> None:
+    def _steps(self, due: int) -> bool:
         """Run at once the control ticks up to the next other event (by `due`) on a board
         whose ticks only step the car (it does not ramp), each exactly as alone, an
-        encoder report's tick last (it reports after it; reads are answered at the tick
-        before, the first after they came). A driving car costs one call per record, not
-        five."""
+        encoder report's tick last (it reports after it; the caller answers reads at a
+        tick of its own). A driving car costs one call per record, not five. Whether it
+        ran any."""
         core = self.core
         profile = core.profile
         if profile.ramp is not None or profile.firmware_uart2:
-            return
+            return False
         last = self._last_tick(due)
         if core.mode("encoder_report"):
             last = min(last, -(-core.tick_ms // REPORT_MS) * REPORT_MS)
         if last < core.tick_ms:
-            return
+            return False
         ticks = int(last - core.tick_ms) // TICK_MS + 1
         self._control(ticks)
         core.tick_ms += (ticks - 1) * TICK_MS
         self.control_port.tick()  # the last tick's: the encoder report, if one is due
         core.tick_ms += TICK_MS
+        return True
 
     # ------------------------------------------------------------ I/O-free edges
 
@@ -318,8 +321,7 @@ class Board:
             if at_once:
                 vehicle.step(target, ticks * TICK)
             else:
-                for _ in range(ticks):
-                    vehicle.step(target, TICK)
+                vehicle.step(target, TICK, ticks)
         else:
             pushes = self._pushes() if core.powered(core.tick_ms) else (0, 0, 0)
             rounding = float32 if profile.float32 else float
@@ -346,9 +348,7 @@ class Board:
         for tick in range(ticks):
             core.target_velocity = target = self._uart2_target(speed)
             if not core.pending_angle and core.position_goal is None:
-                # the target holds: the car only steps toward it (exactly as tick by tick)
-                for _ in range(ticks - tick):
-                    vehicle.step(target, TICK)
+                vehicle.step(target, TICK, ticks - tick)  # the target holds
                 return
             vehicle.step(target, TICK)
             if core.pending_angle:

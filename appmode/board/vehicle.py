@@ -61,25 +61,28 @@ class Vehicle:
     travel_z: float = 0.0
     """The body's own x, y, z integrated over time: what the wheel encoders count."""
 
-    def step(self, target: tuple[float, float, float], dt: float) -> None:
-        """Advance by `dt` seconds toward the target velocity (x, y, z)."""
-        old_x, old_y, vz = self.vx, self.vy, self.vz
-        if not (old_x or old_y or vz or any(target)):  # at rest, staying so
-            self.rest(1, dt)
-            return
+    def step(self, target: tuple[float, float, float], dt: float, ticks: int = 1) -> None:
+        """Advance `ticks` steps of `dt` seconds toward the target velocity (x, y, z),
+        each exactly as alone."""
         tx, ty, tz = target
-        if old_x == tx and old_y == ty and vz == tz:  # at the target: the lag keeps it there
-            self.vx, self.vy, self.vz = tx, ty, tz
-            self._move(old_x, old_y, dt)
-            return
-        alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
-        vx = old_x + (tx - old_x) * alpha  # each axis a first-order lag, snapped at SNAP
-        vy = old_y + (ty - old_y) * alpha
-        vz += (tz - vz) * alpha
-        self.vx = tx if abs(tx - vx) < SNAP else vx
-        self.vy = ty if abs(ty - vy) < SNAP else vy
-        self.vz = tz if abs(tz - vz) < SNAP else vz
-        self._move(old_x, old_y, dt)
+        while ticks > 0:
+            old_x, old_y, vz = self.vx, self.vy, self.vz
+            if not (old_x or old_y or vz or tx or ty or tz):  # at rest, staying so
+                self.rest(ticks, dt)
+                return
+            if old_x == tx and old_y == ty and vz == tz:  # at the target: the lag keeps it
+                self.vx, self.vy, self.vz = tx, ty, tz
+                self._move(old_x, old_y, dt, ticks)
+                return
+            alpha = 1.0 - math.exp(-dt / RESPONSE_TAU)
+            vx = old_x + (tx - old_x) * alpha  # each axis a first-order lag, snapped at SNAP
+            vy = old_y + (ty - old_y) * alpha
+            vz += (tz - vz) * alpha
+            self.vx = tx if abs(tx - vx) < SNAP else vx
+            self.vy = ty if abs(ty - vy) < SNAP else vy
+            self.vz = tz if abs(tz - vz) < SNAP else vz
+            self._move(old_x, old_y, dt, 1)
+            ticks -= 1
 
     def rest(self, steps: int, dt: float) -> None:
         """`steps` steps of `dt` at rest: what `step` and `ramp` do then, step by step
@@ -118,20 +121,30 @@ class Vehicle:
         self.vx, self.vy, self.vz = axes
         self._move(old_x, old_y, dt)
 
-    def _move(self, old_x: float, old_y: float, dt: float) -> None:
+    def _move(self, old_x: float, old_y: float, dt: float, ticks: int = 1) -> None:
+        """`ticks` steps of `dt` at the velocity the car has: the tilt of the change from
+        (old_x, old_y) to it, then pose, travel and battery tick by tick."""
         vx, vy, vz = self.vx, self.vy, self.vz
         self.pitch = (vy - old_y) / dt * TILT_GAIN
         self.roll = (vx - old_x) / dt * TILT_GAIN
-        self.heading = heading = (self.heading + vz * YAW_GAIN * dt) % 360.0
-        self.travel_x += vx * dt
-        self.travel_y += vy * dt
-        self.travel_z += vz * dt
-        rad = math.radians(heading)
-        cos, sin = math.cos(rad), math.sin(rad)
-        self.east += (vx * cos + vy * sin) * dt
-        self.north += (vy * cos - vx * sin) * dt
-        speed = abs(vx) + abs(vy) + abs(vz)
-        self.centivolts = max(0.0, self.centivolts - (IDLE_DRAIN + LOAD_DRAIN * speed) * dt)
+        turn = vz * YAW_GAIN * dt
+        drain = (IDLE_DRAIN + LOAD_DRAIN * (abs(vx) + abs(vy) + abs(vz))) * dt
+        heading, east, north = self.heading, self.east, self.north
+        travel_x, travel_y, travel_z = self.travel_x, self.travel_y, self.travel_z
+        centivolts = self.centivolts
+        for _ in range(ticks):
+            heading = (heading + turn) % 360.0
+            travel_x += vx * dt
+            travel_y += vy * dt
+            travel_z += vz * dt
+            rad = math.radians(heading)
+            cos, sin = math.cos(rad), math.sin(rad)
+            east += (vx * cos + vy * sin) * dt
+            north += (vy * cos - vx * sin) * dt
+            centivolts = max(0.0, centivolts - drain)
+        self.heading, self.east, self.north = heading, east, north
+        self.travel_x, self.travel_y, self.travel_z = travel_x, travel_y, travel_z
+        self.centivolts = centivolts
 
     @property
     def battery(self) -> int:

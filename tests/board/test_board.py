@@ -379,13 +379,15 @@ def test_a_driving_car_run_in_one_go_is_the_car_run_tick_by_tick(profile: Profil
     """Issue 28.4: the ticks of a driving car between two records are run at once; what
     both ports send, and where the car ends, are exactly those of a car run in steps
     shorter than a tick: driven from either port, with the encoder report (also when it
-    does not fall with a record), a read, an angle to turn and a position to reach."""
+    does not fall with a record), reads (answered in the tick after them, also while the
+    car speeds up), an angle to turn and a position to reach."""
     mecanum = control.SetSetting(board_settings.BY_NAME["system_mode"], 0x41)
     frames = [
         (1.0, "app", b"A"),
         (2.5, "app", b"G"),
         (3.0, "uart2", control.encode(mecanum)),
         (3.2, "uart2", control.encode(control.velocity(DriveType.MECANUM, 100, 300, 20))),
+        (3.204, "uart2", control.encode(control.read("speed_b"))),  # while it speeds up
         (4.013, "uart2", control.encode(control.read("speed_b"))),
         (5.0, "uart2", control.encode(control.velocity(DriveType.MECANUM, y=200, angle=900))),
         (7.0, "uart2", control.encode(control.PositionFrame(300, -200, 0))),
@@ -441,3 +443,26 @@ def test_a_car_at_its_target_stays_there_and_moves_at_it(
     assert (car.pitch, car.roll) == (0.0, 0.0)
     assert car.travel_y - before.travel_y == target[1] * 0.01
     assert car.centivolts < before.centivolts
+
+
+velocities = st.tuples(*[st.sampled_from([0.0, -0.0, 0.3, 250.0, -120.5])] * 3)
+
+
+@settings(max_examples=200, deadline=None)
+@given(velocities, velocities, st.integers(1, 12), st.floats(0, 359))
+def test_steps_in_one_go_are_the_steps_one_by_one(
+    start: tuple[float, float, float],
+    target: tuple[float, float, float],
+    ticks: int,
+    heading: float,
+) -> None:
+    """`step(target, dt, ticks)` leaves the car exactly where `ticks` steps leave it:
+    at rest, reaching its target on the way, at its target, turning."""
+    one = Board().vehicle
+    one.vx, one.vy, one.vz = start
+    one.heading = heading
+    twin = dataclasses.replace(one)
+    one.step(target, 0.01, ticks)
+    for _ in range(ticks):
+        twin.step(target, 0.01)
+    assert one == twin
