@@ -272,8 +272,13 @@ def test_over_uart2_the_analog_pad_s_deflection_is_the_speed(
         assert len(frames) > 2
         page.get_by_label("degrees").fill("45")
         page.get_by_role("button", name="Turn", exact=True).click()
-        turn = wait_frame(web, "FF FE 01")
-        assert int(turn[-1].split()[-1], 16) & 0x10, "angle mode's bit (§9.1)"
+        deadline = time.monotonic() + 5  # the stop is an 01 frame too: wait for the turn's
+        while not any(
+            frame.startswith("FF FE 01") and int(frame.split()[-1], 16) & 0x10
+            for frame in web.frames()[len(frames) :]
+        ):
+            assert time.monotonic() < deadline, f"no angle mode frame (§9.1): {web.frames()[-5:]}"
+            time.sleep(0.02)
         page.close()
 
 
