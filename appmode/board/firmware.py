@@ -268,9 +268,7 @@ class Board:
     def poll(self, now: float) -> bytes:
         """The telemetry bytes due by `now`."""
         self.advance(now)
-        out = bytes(self.core.out3)
-        self.core.out3.clear()
-        return out
+        return _taken(self.core.out3)
 
     def receive_uart2(self, data: bytes, now: float) -> None:
         """Apply bytes that arrived on the control port at `now` (§8)."""
@@ -281,19 +279,12 @@ class Board:
         """The control port's bytes due by `now`: replies, encoder reports, and records
         while APP mode is on."""
         self.advance(now)
-        out = bytes(self.core.out2)
-        self.core.out2.clear()
-        return out
+        return _taken(self.core.out2)
 
     def poll_ports(self, now: float) -> tuple[bytes, bytes]:
         """What `poll` and `poll_uart2` give, in one run of the board."""
         self.advance(now)
-        core = self.core
-        out3, out2 = core.out3, core.out2
-        app, uart2 = bytes(out3), bytes(out2)
-        out3.clear()
-        out2.clear()
-        return app, uart2
+        return _taken(self.core.out3), _taken(self.core.out2)
 
     def take_notes(self) -> list[Note]:
         notes = list(self.core.notes)
@@ -420,6 +411,13 @@ class Board:
             return (None, None, z)
         x, y, turn = (int(math.copysign(1, f)) if f else 0 for f in motion.holonomic)
         return (x, y, turn or z)
+
+
+def _taken(out: bytearray) -> bytes:
+    """What a port has to send, which it no longer holds."""
+    data = bytes(out)
+    out.clear()
+    return data
 
 
 def _duty(value: int, speed: float) -> float:

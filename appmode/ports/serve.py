@@ -186,6 +186,7 @@ class BoardServer:
             self._wake_read.recv(4096)
 
     def run(self) -> None:
+        """Serve until `stop` or KeyboardInterrupt, with exact wake-ups (ports.wakeups)."""
         with exact_wakeups():  # the boards' grid points kept, also on a busy machine
             self._serve()
 
