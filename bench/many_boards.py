@@ -61,10 +61,13 @@ def serve(count: int) -> None:
         start.update(cpu=time.process_time(), wall=time.monotonic())
         server.lateness = []
 
-    threading.Timer(1.0, measure).start()
+    timer = threading.Timer(1.0, measure)
+    timer.daemon = True  # a run stopped within the second does not wait for it
+    timer.start()
     try:
         server.run()
     finally:
+        timer.cancel()
         late = [x * 1000 for x in server.lateness]
         print(
             json.dumps(

@@ -8,7 +8,7 @@ import selectors
 import signal
 import subprocess
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -103,10 +103,19 @@ def wait_sent(web: WebProcess, wanted: str, timeout: float = 5.0) -> list[str]:
 
 def wait_frame(web: WebProcess, wanted: str, timeout: float = 5.0) -> list[str]:
     """Wait until the control port's last frame starts with `wanted`; the frames."""
+    return wait_frames(
+        web, lambda frames: bool(frames) and frames[-1].startswith(wanted), f"{wanted}…", timeout
+    )
+
+
+def wait_frames(
+    web: WebProcess, found: Callable[[list[str]], bool], what: str, timeout: float = 5.0
+) -> list[str]:
+    """Wait until `found(frames)` holds of the control port's frames; the frames."""
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         frames = web.frames()
-        if frames and frames[-1].startswith(wanted):
+        if found(frames):
             return frames
         time.sleep(0.02)
-    raise AssertionError(f"the control port's last frame is not {wanted}…: {web.frames()[-5:]}")
+    raise AssertionError(f"the control port sent no {what}: {web.frames()[-5:]}")

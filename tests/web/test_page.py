@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from playwright.sync_api import Browser, CDPSession, Page, sync_playwright
 
-from tests.support.web import WebProcess, wait_frame, wait_sent, web_process
+from tests.support.web import WebProcess, wait_frame, wait_frames, wait_sent, web_process
 
 CHROMIUM = "/usr/bin/chromium"
 
@@ -272,13 +272,14 @@ def test_over_uart2_the_analog_pad_s_deflection_is_the_speed(
         assert len(frames) > 2
         page.get_by_label("degrees").fill("45")
         page.get_by_role("button", name="Turn", exact=True).click()
-        deadline = time.monotonic() + 5  # the stop is an 01 frame too: wait for the turn's
-        while not any(
-            frame.startswith("FF FE 01") and int(frame.split()[-1], 16) & 0x10
-            for frame in web.frames()[len(frames) :]
-        ):
-            assert time.monotonic() < deadline, f"no angle mode frame (§9.1): {web.frames()[-5:]}"
-            time.sleep(0.02)
+        wait_frames(  # the stop is an 01 frame too: the turn's is one after it
+            web,
+            lambda now: any(
+                frame.startswith("FF FE 01") and int(frame.split()[-1], 16) & 0x10
+                for frame in now[len(frames) :]
+            ),
+            "velocity frame in angle mode after the stop (§9.1)",
+        )
         page.close()
 
 
