@@ -56,10 +56,10 @@ class Telemetry:
         if self._c_pending:
             self._c_pending = False
             values = tuple(c_int(v) if profile.c_saturates else int(v) for v in core.params)
-            data = app.encode(app.ParamsRecord(values))
+            data = app.record_bytes(b"C", values)
             self.c_on_wire_until = core.boot + at / 1000 + len(data) * APP_BYTE
         else:
-            data = app.encode(self._a_record(at) if self._show_a else self._b_record(at))
+            data = self._a_record(at) if self._show_a else self._b_record(at)
         self._show_a = not self._show_a
         if core.mode("app_mode"):
             core.out2 += data  # §12: records go out on UART2, UART3's transmitter is idle
@@ -84,7 +84,7 @@ class Telemetry:
         volts = core.vehicle.centivolts if core.powered(ms) else 0.0
         return battery_percent(volts, core.profile.battery_floor)
 
-    def _a_record(self, ms: int) -> app.Velocity:
+    def _a_record(self, ms: int) -> bytes:
         core = self.core
         profile, v = core.profile, core.vehicle
         layout = profile.a_layout
@@ -98,15 +98,12 @@ class Telemetry:
             fields[i] = shown if layout.signed else abs(shown) % 256
         if layout.battery is not None:
             fields[layout.battery] = self._battery(ms)
-        return app.Velocity(fields[0], fields[1], fields[2], fields[3])
+        return app.record_bytes(b"A", fields)
 
-    def _b_record(self, ms: int) -> app.Attitude:
+    def _b_record(self, ms: int) -> bytes:
         core = self.core
         profile, v = core.profile, core.vehicle
         yaw = -v.heading if core.mode("gyro_reverse") else v.heading
-        return app.Attitude(
-            self._whole(v.pitch),
-            self._whole(v.roll),
-            wrap_degrees(yaw, profile.yaw_low, profile.truncate),
-            self._battery(ms),
-        )
+        pitch, roll = self._whole(v.pitch), self._whole(v.roll)
+        yaw_shown = wrap_degrees(yaw, profile.yaw_low, profile.truncate)
+        return app.record_bytes(b"B", (pitch, roll, yaw_shown, self._battery(ms)))

@@ -7,6 +7,8 @@ bytes. The decoders are in `app_decoders`; what ends a session with the car stop
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from appmode.protocol import params
 from appmode.protocol.directions import LETTERS, PAGE_LETTERS
 from appmode.protocol.slotted import Frozen, Slotted
@@ -276,8 +278,9 @@ def record_fields(record: Record) -> tuple[str, tuple[int, ...]]:
     return record.letter, record.values
 
 
-def _ints(values: tuple[int, ...] | list[int]) -> bytes:
-    return b":".join(b"%d" % v for v in values)
+def record_bytes(letter: bytes, values: Sequence[int]) -> bytes:
+    """A record's wire bytes: `{`, its letter, its values joined by `:`, `}$`."""
+    return b"{%s%s}$" % (letter, b":".join(b"%d" % v for v in values))
 
 
 def encode(item: Event) -> bytes:
@@ -300,15 +303,15 @@ def encode(item: Event) -> bytes:
         params.check_value(item.index, item.value)
         return b"{%d:%d}" % (item.index, item.value)
     if isinstance(item, Velocity):
-        return b"{A" + _ints([item.x, item.y, item.z, item.extra]) + b"}$"
+        return record_bytes(b"A", (item.x, item.y, item.z, item.extra))
     if isinstance(item, Attitude):
-        return b"{B" + _ints([item.pitch, item.roll, item.yaw, item.battery]) + b"}$"
+        return record_bytes(b"B", (item.pitch, item.roll, item.yaw, item.battery))
     if isinstance(item, ParamsRecord):  # any values: a real board sends what it holds (§3.3)
         if len(item.values) != params.PARAM_COUNT:
             raise ValueError(f"a C record has {params.PARAM_COUNT} values, not {len(item.values)}")
-        return b"{C" + _ints(item.values) + b"}$"
+        return record_bytes(b"C", item.values)
     if isinstance(item, OtherRecord):
         if len(item.letter) != 1 or not item.letter.isalpha() or not item.letter.isascii():
             raise ValueError(f"record letter must be one ASCII letter, not {item.letter!r}")
-        return b"{" + item.letter.encode() + _ints(item.values) + b"}$"
+        return record_bytes(item.letter.encode(), item.values)
     return item.raw
