@@ -92,31 +92,33 @@ def written(pid: int) -> tuple[int, int]:
 
 @dataclass(frozen=True)
 class Share:
-    """A process's CPU share beside its floor (medians of the rounds)."""
+    """A process's CPU share beside its floor, over rounds that measure each in turn."""
 
     share: float
-    """% of a core."""
+    """% of a core (median of the rounds)."""
     floor: float
-    """% of a core a bare loop takes with the same wake-ups and writes."""
+    """% of a core a bare loop takes with the same wake-ups and writes (median)."""
+    over: list[float]
+    """Each round's share less the floor measured right after it, sorted: on a machine
+    whose load comes and goes, a pair measured together is the fair comparison."""
     wakeups: float
-    """The process's wake-ups a second."""
+    """The process's wake-ups a second (median)."""
     writes: float
-    """Its write calls a second."""
+    """Its write calls a second (median)."""
     received: float
-    """Bytes a second the reader got."""
+    """Bytes a second the reader got (median)."""
 
 
-def share_and_floor(pid: int, seconds: float, read: Callable[[], int], rounds: int = 3) -> Share:
+def share_and_floor(pid: int, seconds: float, read: Callable[[], int], rounds: int = 10) -> Share:
     """Process `pid`'s CPU share (%) while `read()` is called every 50 ms, and its floor
     (`wakeup_floor` with the same wake-ups, write calls and bytes a second), measured in
-    turn for `rounds` rounds of `seconds` each so that both see the same machine; medians
-    of the rounds."""
+    turn for `rounds` rounds, `seconds` of each in all."""
     shares, floors, rates, calls, volumes = [], [], [], [], []
     for _ in range(rounds):
         read()  # what came while the floor ran
         start_cpu, start, woken, got = cpu_seconds(pid), time.monotonic(), wakeups(pid), 0
         writes, wrote = written(pid)
-        while time.monotonic() - start < seconds:
+        while time.monotonic() - start < seconds / rounds:
             time.sleep(0.05)  # a client reading in batches: its wake-ups are not the board's
             got += read()
         elapsed = time.monotonic() - start
@@ -125,9 +127,22 @@ def share_and_floor(pid: int, seconds: float, read: Callable[[], int], rounds: i
         volumes.append(got / elapsed)
         now_writes, now_wrote = written(pid)
         calls.append((now_writes - writes) / elapsed)
-        floors.append(wakeup_floor(seconds, rates[-1], calls[-1], (now_wrote - wrote) / elapsed))
+        floors.append(
+            wakeup_floor(seconds / rounds, rates[-1], calls[-1], (now_wrote - wrote) / elapsed)
+        )
     median = statistics.median
-    return Share(median(shares), median(floors), median(rates), median(calls), median(volumes))
+    over = sorted(s - f for s, f in zip(shares, floors, strict=True))
+    return Share(
+        median(shares), median(floors), over, median(rates), median(calls), median(volumes)
+    )
+
+
+def over_floor(cpu: Share) -> str:
+    """How far `cpu` is over its floor: the median of the rounds, and their range."""
+    return (
+        f"{statistics.median(cpu.over):+.2f} % over its floor (median of {len(cpu.over)} "
+        f"rounds; {cpu.over[0]:+.2f} to {cpu.over[-1]:+.2f})"
+    )
 
 
 def floor_row(cpu: Share) -> tuple[str, str, str]:

@@ -38,7 +38,7 @@ import serial
 import startup
 import uart2
 import web
-from common import board, cpu_seconds, floor_row, percentile, share_and_floor
+from common import board, cpu_seconds, floor_row, over_floor, percentile, share_and_floor
 
 from appmode.board.firmware import TICK, Board
 
@@ -159,15 +159,14 @@ def bench_board_cpu(seconds: float) -> list[Row]:
 
     try:
         time.sleep(1.0)
-        cpu = share_and_floor(proc.pid, seconds / 3, read)
+        cpu = share_and_floor(proc.pid, seconds, read)
     finally:
         os.close(fd)
         stop(proc)
     return [
         (
             "appmode board streaming telemetry (paced)",
-            f"{cpu.share:.2f} % of a core ({cpu.received:.0f} bytes/s out); "
-            f"{cpu.share - cpu.floor:+.2f} % over its floor",
+            f"{cpu.share:.2f} % of a core ({cpu.received:.0f} bytes/s out); {over_floor(cpu)}",
             "< 1 %; within 0.3 % of its floor",
         ),
         floor_row(cpu),

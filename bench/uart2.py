@@ -21,7 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 import serial
-from common import fitted_slope, floor_row, percentile, share_and_floor
+from common import fitted_slope, floor_row, over_floor, percentile, share_and_floor
 
 from appmode.protocol import control, control_decoders, settings
 from appmode.protocol.params import DriveType
@@ -171,7 +171,7 @@ def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
         time.sleep(0.5)
         cpu = share_and_floor(
             proc.pid,
-            seconds / 3,
+            seconds,
             lambda: len(port.read(port.in_waiting)) + len(app_port.read(app_port.in_waiting)),
         )
         port.write(control.STOP)
@@ -179,7 +179,7 @@ def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
         (
             "board serving both ports, encoder report on (mecanum, driving)",
             f"{cpu.share:.2f} % of a core ({cpu.received:,.0f} bytes/s read from both ports); "
-            f"{cpu.share - cpu.floor:+.2f} % over its floor",
+            f"{over_floor(cpu)}",
             "< 2 % of a core; within 0.3 % of its floor",
         ),
         floor_row(cpu),
