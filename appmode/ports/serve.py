@@ -30,7 +30,7 @@ from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
 from appmode.ports.endpoints import Endpoint, Log, MakeEndpoint
 from appmode.ports.schedule import INPUT_BACKLOG, Served
 from appmode.ports.urls import BAUD
-from appmode.ports.wakeups import exact_wakeups
+from appmode.ports.wakeups import exact_wakeups, select_exactly
 from appmode.protocol import app
 from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder
@@ -195,7 +195,7 @@ class BoardServer:
             with self.lock:
                 wake = self._step()
             timeout = max(0.0, wake - self.now())
-            for key, _ in self._sel.select(timeout):
+            for key, _ in select_exactly(self._sel, timeout):
                 endpoint: Endpoint | None = key.data
                 if endpoint is None:
                     self._woken()

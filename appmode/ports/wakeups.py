@@ -2,6 +2,9 @@
 
 - Timer slack: Linux wakes a sleeping thread up to 50 µs after its timeout, so that
   wake-ups can be batched; a thread that keeps deadlines asks for 1 µs.
+- Timeouts to the microsecond: epoll counts its timeout in whole milliseconds, rounded
+  up, so a wait of 3.2 ms lasts 4; `select_exactly` waits on the epoll descriptor itself
+  with select(2), whose timeout is in microseconds.
 - A short slice: on a busy machine a woken thread waits until the scheduler lets it run.
   Since Linux 6.12 a thread may ask for a shorter slice (`sched_setattr`'s
   `sched_runtime`, no privilege needed); its deadlines come sooner, so it runs at once
@@ -13,6 +16,8 @@ from __future__ import annotations
 
 import ctypes
 import platform
+import select
+import selectors
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -81,6 +86,21 @@ def exact_wakeups() -> Iterator[None]:
         return
     with _slack(libc), _short_slice(libc):
         yield
+
+
+def select_exactly(
+    sel: selectors.BaseSelector, timeout: float
+) -> list[tuple[selectors.SelectorKey, int]]:
+    """`sel.select(timeout)`, ending within a microsecond of `timeout`, not at the next
+    whole millisecond as an epoll selector's wait does: the wait is on the epoll
+    descriptor, readable once an event is pending, with select(2)."""
+    if timeout <= 0 or sys.platform != "linux" or not isinstance(sel, selectors.EpollSelector):
+        return sel.select(timeout)
+    try:
+        ready, _, _ = select.select([sel.fileno()], [], [], timeout)
+    except (ValueError, OverflowError):  # beyond what select(2) takes: FD_SETSIZE, time_t
+        return sel.select(timeout)
+    return sel.select(0) if ready else []
 
 
 @contextmanager

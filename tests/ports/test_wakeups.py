@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import ctypes
 import platform
+import selectors
+import socket
 import subprocess
 import sys
 import time
@@ -20,6 +22,7 @@ from appmode.ports.wakeups import (
     SchedAttr,
     exact_wakeups,
     sched_attr,
+    select_exactly,
     syscall_numbers,
 )
 from appmode.transcript.replay import play
@@ -141,3 +144,38 @@ def test_a_board_server_runs_with_exact_wakeups(monkeypatch: pytest.MonkeyPatch)
         server.close()
     assert seen == [SLACK_NS] * 3
     assert slack() == before
+
+
+def test_an_exact_select_gives_what_is_ready() -> None:
+    sel = selectors.DefaultSelector()
+    here, there = socket.socketpair()
+    try:
+        sel.register(here, selectors.EVENT_READ, "mine")
+        assert select_exactly(sel, 0.002) == []
+        there.send(b"x")
+        assert [(key.data, events) for key, events in select_exactly(sel, 5.0)] == [
+            ("mine", selectors.EVENT_READ)
+        ]
+        assert [key.data for key, _ in select_exactly(sel, 0)] == ["mine"]
+    finally:
+        sel.close()
+        here.close()
+        there.close()
+
+
+@linux
+def test_an_exact_select_ends_within_the_millisecond_epoll_would_round_up_to() -> None:
+    """A wait of 0.3 ms is never shorter, and not the whole millisecond an epoll
+    selector's own wait takes (most of the time: the machine may be busy)."""
+    sel = selectors.DefaultSelector()
+    waits = []
+    try:
+        with exact_wakeups():
+            for _ in range(40):
+                start = time.monotonic()
+                assert select_exactly(sel, 0.0003) == []
+                waits.append(time.monotonic() - start)
+    finally:
+        sel.close()
+    assert min(waits) >= 0.0003
+    assert sorted(waits)[len(waits) // 2] < 0.0009, waits
