@@ -36,6 +36,10 @@ from appmode.protocol.params import SYSTEM_MODE, DriveType
 from appmode.protocol.transcript import Recorder
 
 T = TypeVar("T")
+GATHER = 0.0002
+"""The server wakes at whole multiples of this many seconds: boards due in the same slot
+run in one wake-up (a wake-up each cost 200 boards twice the CPU), none over 0.2 ms late
+for it."""
 
 
 class BoardServer:
@@ -194,6 +198,8 @@ class BoardServer:
         while not self._stopped:
             with self.lock:
                 wake = self._step()
+            if wake < math.inf:  # never before it: the slot's time is rounded
+                wake = max(wake, math.ceil(wake / GATHER) * GATHER)
             timeout = max(0.0, wake - self.now())
             for key, _ in select_exactly(self._sel, timeout):
                 endpoint: Endpoint | None = key.data

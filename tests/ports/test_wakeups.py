@@ -4,6 +4,7 @@ old ones after."""
 from __future__ import annotations
 
 import ctypes
+import math
 import platform
 import selectors
 import socket
@@ -14,7 +15,8 @@ import time
 import pytest
 
 from appmode.board.firmware import Board
-from appmode.ports.serve import BoardServer
+from appmode.ports import serve
+from appmode.ports.serve import GATHER, BoardServer
 from appmode.ports.wakeups import (
     PR_GET_TIMERSLACK,
     SLACK_NS,
@@ -179,3 +181,35 @@ def test_an_exact_select_ends_within_the_millisecond_epoll_would_round_up_to() -
         sel.close()
     assert min(waits) >= 0.0003
     assert sorted(waits)[len(waits) // 2] < 0.0009, waits
+
+
+def test_a_server_wakes_once_for_the_boards_due_in_one_slot(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Boards at their own phases of the grid are run in wake-ups at whole GATHER slots:
+    fewer wake-ups than boards due, none early, none over a slot late."""
+    clock = [0.0]
+    wakes: list[float] = []
+
+    def waited(sel: object, timeout: float) -> list[object]:
+        clock[0] = max(clock[0] + timeout, math.nextafter(clock[0], math.inf))  # it goes on
+        wakes.append(clock[0])
+        if clock[0] > 1.0:
+            server.stop()
+        return []
+
+    monkeypatch.setattr(serve, "select_exactly", waited)
+    boards = [Board() for _ in range(100)]  # a grid point every 40 µs: 5 in a slot
+    server = BoardServer([Quiet] * 100, boards, pace=True, log=lambda text: None)
+    server.now = lambda: clock[0]  # type: ignore[method-assign]
+    server.lateness = []
+    try:
+        server.run()
+    finally:
+        server.close()
+    late = server.lateness
+    assert min(late) >= 0
+    assert max(late) <= GATHER + 1e-9
+    slots = [round(w / GATHER) for w in wakes]
+    assert all(abs(w - s * GATHER) < 1e-9 for w, s in zip(wakes, slots, strict=True))
+    assert len(wakes) < 0.8 * len(late)  # boards due in one slot shared a wake-up
