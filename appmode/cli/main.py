@@ -8,6 +8,7 @@ import errno
 import importlib
 import os
 import sys
+import traceback
 from collections.abc import Callable, Sequence
 from types import ModuleType
 
@@ -21,6 +22,10 @@ OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
 
 Handler = Callable[[argparse.Namespace], int]
+BUG_STATUS = 70
+"""The exit status of a bug in appmode (BSD's EX_SOFTWARE)."""
+SHOW_TRACEBACK = "APPMODE_TRACEBACK"
+"""Set in the environment, a bug prints its traceback (for a report), not one line."""
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
@@ -89,8 +94,32 @@ def main(argv: Sequence[str] | None = None) -> int:
         with contextlib.suppress(OSError):
             print(f"appmode: error: {what}: {exc.strerror or exc}", file=sys.stderr)
         return 2
+    except Exception as exc:  # a bug: one line that says so, the traceback on request
+        report_bug(exc)
+        return BUG_STATUS
     finally:
         signals.finish()
+
+
+def report_bug(exc: Exception) -> None:
+    """Say on stderr, in a line, that appmode failed (what, where in its code) and how to
+    get the traceback for a report; with SHOW_TRACEBACK set, print the traceback."""
+    if os.environ.get(SHOW_TRACEBACK):
+        traceback.print_exception(exc)
+        return
+    frames = traceback.extract_tb(exc.__traceback__)
+    where = ""
+    if frames:
+        path = frames[-1].filename.replace("\\", "/")
+        path = "appmode/" + path.rsplit("/appmode/", 1)[1] if "/appmode/" in path else path
+        where = f" at {path}:{frames[-1].lineno}"
+    what = " ".join(f"{type(exc).__name__}: {exc}".split())[:200]
+    with contextlib.suppress(OSError):
+        print(
+            f"appmode: internal error: {what}{where}: a bug in appmode; run it again with "
+            f"{SHOW_TRACEBACK}=1 for the traceback, and report it",
+            file=sys.stderr,
+        )
 
 
 if __name__ == "__main__":

@@ -65,25 +65,65 @@ def test_demo_prints_the_route_and_records() -> None:
     assert text.count("< {A") > 20 and text.count("< {B") > 20
 
 
-def test_only_our_own_errors_become_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Issue 22.14: a ValueError from a bug is not dressed up as a user's mistake; a value
-    out of range (InvalidValue, a ValueError too) is one line, as before."""
+def test_only_our_own_errors_become_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 22.14: a ValueError from a bug is not dressed up as a user's mistake: it is
+    named a bug (exit 70, where in appmode it happened); a value out of range
+    (InvalidValue, a ValueError too) is one line, as before."""
     from appmode.cli import main as cli_main
     from appmode.cli import ports
     from appmode.errors import InvalidValue
 
     def buggy(args: object) -> int:
-        raise ValueError("a bug")
+        raise ValueError("a bug\nin two lines")
 
     monkeypatch.setattr(ports, "run", buggy)
-    with pytest.raises(ValueError, match="a bug"):
-        cli_main.main(["ports"])
+    monkeypatch.delenv("APPMODE_TRACEBACK", raising=False)
+    assert cli_main.main(["ports"]) == 70
+    err = capsys.readouterr().err
+    line = err.rstrip("\n")
+    assert "\n" not in line, "one line"
+    assert line.startswith("appmode: internal error: ValueError: a bug in two lines at ")
+    assert "tests/cli/test_cli_core.py:" in line and "a bug in appmode" in line
+    assert "APPMODE_TRACEBACK=1" in line and "Traceback" not in line
+
+    monkeypatch.setenv("APPMODE_TRACEBACK", "1")
+    assert cli_main.main(["ports"]) == 70
+    err = capsys.readouterr().err
+    assert err.startswith("Traceback (most recent call last):")
+    assert "ValueError: a bug" in err and "in buggy" in err
 
     def refused(args: object) -> int:
         raise InvalidValue("max_speed (parameter 0) must be in 0–65535, not 70000")
 
     monkeypatch.setattr(ports, "run", refused)
     assert cli_main.main(["ports"]) == 2
+    assert capsys.readouterr().err == (
+        "appmode: error: max_speed (parameter 0) must be in 0–65535, not 70000\n"
+    )
+
+
+def test_a_bug_in_a_served_board_ends_it_in_one_line(tmp_path: Path) -> None:
+    """A board whose model fails (here made to, in a subprocess) says so in a line and
+    exits 70, after closing its ports, not with a traceback."""
+    code = (
+        "import sys\n"
+        "from appmode.board import vehicle\n"
+        "def broken(self, *args, **kwargs):\n"
+        "    raise ZeroDivisionError('division by zero')\n"
+        "vehicle.Vehicle.step = broken\n"
+        "from appmode.cli.main import main\n"
+        "sys.exit(main(['board', '--pty', '--quiet']))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, timeout=60, check=False
+    )
+    assert done.returncode == 70, done.stderr
+    err = done.stderr.decode()
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("appmode: internal error: ZeroDivisionError: division by zero at ")
+    assert "a bug in appmode" in err
 
 
 def test_the_errors_the_docs_name_are_importable_from_appmode() -> None:
