@@ -397,17 +397,20 @@ def bench_trickle(seconds: float) -> list[Row]:
         while time.monotonic() < end:
             os.write(fd, b"{Q:P}")  # a C record: 31 bytes, 32 ms of wire
             first = None
+            seen = b""  # what came since the "{C" (or the last byte before one)
             until = time.monotonic() + 0.3
             while time.monotonic() < until:
                 ready, _, _ = select.select([fd], [], [], 0.05)
                 if ready:
                     chunk = os.read(fd, 4096)
                     sizes.append(len(chunk))
-                    if b"{C" in chunk:
+                    seen = seen[-1:] + chunk if first is None else seen + chunk
+                    if first is None and b"{C" in seen:  # its start, split or not
                         first = time.monotonic()
-                    if first is not None and b"}$" in chunk and b"{C" not in chunk:
+                        seen = seen[seen.index(b"{C") :]
+                    if first is not None and b"}$" in seen:  # its end, split or not
                         spans.append(time.monotonic() - first)
-                        first = None
+                        first, seen = None, b""
     finally:
         os.close(fd)
         stop(proc)
