@@ -21,8 +21,32 @@ TMUX = ["tmux", "-L", f"appmode-tests-{os.getpid()}"]
 another test run's, stay apart."""
 
 
+WATCHDOG = """\
+import os, subprocess, sys, time
+while os.getppid() == int(sys.argv[1]):
+    time.sleep(0.5)
+subprocess.run(sys.argv[2:] + ["kill-server"], capture_output=True)
+"""
+"""`WATCHDOG PID TMUX…` ends the tmux server once its parent, process PID (the test
+process), has ended: then it is another's child (PID is given, as the test may end
+before the watchdog has started)."""
+_watchdogs: list[subprocess.Popen[bytes]] = []
+
+
 def tmux(*args: str) -> str:
     assert shutil.which("tmux"), "these tests drive the console in tmux: apt-get install tmux"
+    if not _watchdogs:
+        # a run killed mid-test (SIGKILL: a timeout, a benchmark's load) runs no cleanup;
+        # its consoles would run on, retrying their port (a path the next pty reuses)
+        _watchdogs.append(
+            subprocess.Popen(
+                [sys.executable, "-c", WATCHDOG, str(os.getpid()), *TMUX],
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                start_new_session=True,  # outlives a kill of this test's process group
+            )
+        )
     return subprocess.run([*TMUX, *args], capture_output=True, text=True, check=True).stdout
 
 
@@ -245,3 +269,30 @@ def test_messages_wrap_between_words() -> None:
         wait_screen(r"error: max_speed \(parameter 0\) must be in 0–65535, not\n  70000000")
     finally:
         tmux("kill-session", "-t", SESSION)
+
+
+def test_a_test_process_killed_outright_leaves_no_console_behind() -> None:
+    """A test process that is SIGKILLed (no cleanup runs) has its tmux server, and the
+    consoles in it, ended by the watchdog within a second or so."""
+    code = (
+        "import sys, time\n"
+        "from tests.console import test_console_tmux as t\n"
+        "t.tmux('new-session', '-d', '-s', 'orphan', 'sleep 60')\n"
+        "print(t.TMUX[2], flush=True)\n"
+        "time.sleep(60)\n"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert child.stdout is not None
+        server = ["tmux", "-L", child.stdout.readline().strip()]
+        alive = [*server, "has-session", "-t", "orphan"]
+        assert subprocess.run(alive, capture_output=True, check=False).returncode == 0
+    finally:
+        child.kill()
+        child.wait()
+    end = time.monotonic() + 10
+    while subprocess.run(alive, capture_output=True, check=False).returncode == 0:
+        assert time.monotonic() < end, "the killed test's tmux session still runs"
+        time.sleep(0.1)
