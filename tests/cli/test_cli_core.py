@@ -104,9 +104,9 @@ def test_only_our_own_errors_become_one_line(
     )
 
 
-def test_a_bug_in_a_served_board_ends_it_in_one_line(tmp_path: Path) -> None:
+def test_a_bug_in_a_served_board_ends_it_in_one_line() -> None:
     """A board whose model fails (here made to, in a subprocess) says so in a line and
-    exits 70, after closing its ports, not with a traceback."""
+    exits 70, not with a traceback."""
     code = (
         "import sys\n"
         "from appmode.board import vehicle\n"
