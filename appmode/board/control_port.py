@@ -15,6 +15,8 @@ from appmode.protocol.params import DriveType
 
 REPORT_MS = 50
 """The encoder report's period on UART2 (§12)."""
+APP_MODE, ENCODER_REPORT = params.MODE_BIT["app_mode"], params.MODE_BIT["encoder_report"]
+"""system_mode's bits that say where records go and whether UART2 reports (§12)."""
 
 
 class ControlPort:
@@ -28,6 +30,9 @@ class ControlPort:
         self._frames = control_decoders.FrameDecoder(core.drive_type)
         self._intake = ControlIntake()
         self._last_frame: bytes | None = None  # the last frame, not yet taken (§13.1)
+        self._reports = core.profile.answers_reads
+        self._report_for: tuple[object, ...] | None = None  # what _report_is was made of
+        self._report_is = b""
 
     def receive(self, data: bytes, now: float) -> None:
         """Apply bytes that arrived on the control port at `now` (§8)."""
@@ -85,14 +90,21 @@ class ControlPort:
                 value = self._read_value(read)
                 core.out2 += control.encode(control.Reply(read.reply_id, value))
             core.reads.clear()
-        if (
-            core.tick_ms % REPORT_MS == 0
-            and core.mode("encoder_report")
-            and not core.mode("app_mode")
-            and core.profile.answers_reads
-        ):
+        if core.tick_ms % REPORT_MS == 0 and self._reports:
+            mode = int(core.params[params.SYSTEM_MODE])
+            if mode & ENCODER_REPORT and not mode & APP_MODE:
+                core.out2 += self._report(mode)
+
+    def _report(self, mode: int) -> bytes:
+        """The encoder report's bytes; made again only when what it shows changed (a car
+        driving steadily reports the same wheels 20 times a second)."""
+        core, v = self.core, self.core.vehicle
+        key = (mode, core.target_velocity, v.vx, v.vy, v.vz, core.command, core.uart2_control)
+        if key != self._report_for:
+            self._report_for = key
             targets = self._encoders(self._wheel_targets())
-            core.out2 += control.encode_report(targets, self._encoders(self._wheels()))
+            self._report_is = control.encode_report(targets, self._encoders(self._wheels()))
+        return self._report_is
 
     def angle_mode(self, frame: control.VelocityFrame) -> bool:
         return frame.angle and self.core.drive_type is not DriveType.DIFF_GYRO

@@ -22,7 +22,14 @@ from collections import deque
 from appmode.board import kinematics
 from appmode.board.app_port import AppPort
 from appmode.board.chip import float32
-from appmode.board.control_port import REPORT_MS, ControlPort, clamp, motor_speeds
+from appmode.board.control_port import (
+    APP_MODE,
+    ENCODER_REPORT,
+    REPORT_MS,
+    ControlPort,
+    clamp,
+    motor_speeds,
+)
 from appmode.board.core import UART3, Core, Note
 from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
@@ -36,7 +43,6 @@ TICK = 0.01
 TICK_MS = 10
 SLOT = 0.05
 """The sheet profile's time between records."""
-_APP_MODE, _ENCODER_REPORT = params.MODE_BIT["app_mode"], params.MODE_BIT["encoder_report"]
 MAX_CATCH_UP = 200
 """Ticks run one by one when the board falls behind; beyond that it skips ahead."""
 MAX_RAMP = 2000
@@ -157,11 +163,11 @@ class Board:
         core, telemetry = self.core, self.telemetry
         uart3, uart2 = float(telemetry.record_ms), telemetry.burst_ms
         mode = int(core.params[params.SYSTEM_MODE])
-        if mode & _APP_MODE:
+        if mode & APP_MODE:
             uart3, uart2 = uart2, uart3
         if core.reads:
             uart2 = min(uart2, core.tick_ms)
-        elif mode & _ENCODER_REPORT and not mode & _APP_MODE:
+        elif mode & ENCODER_REPORT and not mode & APP_MODE:
             uart2 = min(uart2, -(-core.tick_ms // REPORT_MS) * REPORT_MS)
         return core.boot + uart3 / 1000, core.boot + uart2 / 1000
 

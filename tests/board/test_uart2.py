@@ -256,6 +256,34 @@ def test_s12_encoder_report_every_50_ms_while_bit_6_is_set() -> None:
     assert board.poll_uart2(3.0) == b""
 
 
+def test_s12_each_report_shows_the_wheels_as_they_are_then() -> None:
+    """A car driving steadily reports the same wheels; what changes them (the velocity,
+    encoder_reverse, the drive type, a motor frame) is in the next report."""
+    board = Board(drive=DriveType.MECANUM)
+    report = params.MODE_BIT["encoder_report"]
+
+    def last(now: float, wheels: int = 4) -> control.EncoderReport:
+        events = control_decoders.ReplyDecoder(wheels).feed(board.poll_uart2(now))
+        return [e for e in events if isinstance(e, control.EncoderReport)][-1]
+
+    set_setting(board, "system_mode", DriveType.MECANUM | report, 0.0)
+    board.receive_uart2(encode(control.velocity(DriveType.MECANUM, y=200)), 0.0)
+    assert last(2.0).actuals == (200, 200, 200, 200)
+    assert last(2.5).actuals == (200, 200, 200, 200), "steady: the same report"
+    reverse = params.MODE_BIT["encoder_reverse"]
+    set_setting(board, "system_mode", DriveType.MECANUM | report | reverse, 2.5)
+    assert last(2.56).actuals == (-200, -200, -200, -200) == last(2.56 + 0.05).targets
+    board.receive_uart2(encode(control.velocity(DriveType.MECANUM, x=100, y=200)), 2.61)
+    assert last(2.66).targets == (-300, -100, -300, -100)
+    assert last(4.0).actuals == (-300, -100, -300, -100)
+    board.receive_uart2(encode(control.MotorFrame((10, 20, 30, 40))), 4.0)
+    assert last(6.0).targets == (-10, -20, -30, -40)
+    board.receive_uart2(encode(control.MotorFrame((11, 21, 29, 39))), 6.0)  # the same body
+    assert last(6.06).targets == (-11, -21, -29, -39)
+    set_setting(board, "system_mode", DriveType.OMNI | report, 6.06)
+    assert last(6.11, wheels=3).targets == (11, 21, 29)
+
+
 def test_s12_app_mode_moves_the_app_protocol_to_uart2() -> None:
     board = Board()
     set_setting(board, "system_mode", params.MODE_BIT["app_mode"], 0.01)
