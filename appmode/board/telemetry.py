@@ -32,6 +32,7 @@ class Telemetry:
         self._c_pending = False
         self.c_on_wire_until = -math.inf
         """Until when a C record is going out (a read then is lost on some boards)."""
+        self._made: dict[bytes, tuple[tuple[int, ...], bytes]] = {}  # by letter: the last
 
     def request_c(self, now: float, shown: str, port: str) -> None:
         """`{Q:P}`: a C record in the next slot, in place of A or B (§5.1)."""
@@ -56,7 +57,7 @@ class Telemetry:
         if self._c_pending:
             self._c_pending = False
             values = tuple(c_int(v) if profile.c_saturates else int(v) for v in core.params)
-            data = app.record_bytes(b"C", values)
+            data = self._bytes(b"C", values)
             self.c_on_wire_until = core.boot + at / 1000 + len(data) * APP_BYTE
         else:
             data = self._a_record(at) if self._show_a else self._b_record(at)
@@ -75,6 +76,14 @@ class Telemetry:
         rate = self.core.vehicle.vz * YAW_GAIN * GYRO_PER_DEGREE
         self.core.out2 += control.HEADER + bytes([(int(rate) + 0x8000) & 0xFF])
         self.burst_ms = math.inf
+
+    def _bytes(self, letter: bytes, values: tuple[int, ...]) -> bytes:
+        """A record's bytes; formatted again only when its values changed (a car driving
+        steadily sends the same records)."""
+        made = self._made.get(letter)
+        if made is None or made[0] != values:
+            made = self._made[letter] = (values, app.record_bytes(letter, values))
+        return made[1]
 
     def _whole(self, value: float) -> int:
         return math.trunc(value) if self.core.profile.truncate else round(value)
@@ -98,7 +107,7 @@ class Telemetry:
             fields[i] = shown if layout.signed else abs(shown) % 256
         if layout.battery is not None:
             fields[layout.battery] = self._battery(ms)
-        return app.record_bytes(b"A", fields)
+        return self._bytes(b"A", tuple(fields))
 
     def _b_record(self, ms: int) -> bytes:
         core = self.core
@@ -106,4 +115,4 @@ class Telemetry:
         yaw = -v.heading if core.mode("gyro_reverse") else v.heading
         pitch, roll = self._whole(v.pitch), self._whole(v.roll)
         yaw_shown = wrap_degrees(yaw, profile.yaw_low, profile.truncate)
-        return app.record_bytes(b"B", (pitch, roll, yaw_shown, self._battery(ms)))
+        return self._bytes(b"B", (pitch, roll, yaw_shown, self._battery(ms)))
