@@ -32,7 +32,7 @@ class Telemetry:
         self._c_pending = False
         self.c_on_wire_until = -math.inf
         """Until when a C record is going out (a read then is lost on some boards)."""
-        self._made: dict[bytes, tuple[tuple[int, ...], bytes]] = {}  # by letter: the last
+        self._made: dict[bytes, tuple[tuple[int, ...], bytes]] = {}  # letter: last values, bytes
 
     def request_c(self, now: float, shown: str, port: str) -> None:
         """`{Q:P}`: a C record in the next slot, in place of A or B (§5.1)."""
