@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, add_profile, file_name
+from appmode.cli.options import Subparsers, add_profile, board_url, file_name, profile_for
 from appmode.errors import AppmodeError
 
 
@@ -39,7 +39,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_profile(
         conform,
         "run the transcripts written for this board profile (@board profile=…); "
-        "without --board, on a simulated board of that profile",
+        "without --board or with a sim:// one, on a simulated board of that profile",
+        default=None,
+        unset="a sim:// --board's profile, else sheet",
     )
     conform.add_argument(
         "--junit", type=file_name, metavar="FILE", help="also write a JUnit XML report"
@@ -64,6 +66,9 @@ def run(args: argparse.Namespace) -> int:
     from appmode.ports.urls import is_simulated
     from appmode.transcript.runner import run_conform
 
+    if args.board:
+        args.board = board_url(args.board, profile=args.profile)
+    profile = profile_for(args.board, args.profile).name
     if args.board and not is_simulated(args.board) and not args.yes:
         warning = WARNING.format(url=args.board)
         if not sys.stdin.isatty():
@@ -74,6 +79,4 @@ def run(args: argparse.Namespace) -> int:
             return 1
     if args.board2 and not args.board:
         raise AppmodeError("--board2 names the control port of the --board: give --board too")
-    return run_conform(
-        args.paths, args.board, args.junit, sys.stdout, args.profile, board2=args.board2
-    )
+    return run_conform(args.paths, args.board, args.junit, sys.stdout, profile, board2=args.board2)

@@ -16,6 +16,7 @@ from appmode.cli.options import (
     add_profile,
     add_record,
     add_uart2,
+    board_url,
     layout_for,
     number_type,
     profile_for,
@@ -132,7 +133,7 @@ def make_session(
     from appmode.session.app_session import Session
     from appmode.session.control_session import ControlSession
 
-    url = _with_options(args.url, profile=args.profile, drive=args.drive_type)
+    url = board_url(args.url, profile=args.profile, drive=args.drive_type)
     layout = layout_for(url, args.profile)
     uart2_url = args.uart2_url or args.url2
     if args.url2 and args.uart2_url:
@@ -154,7 +155,7 @@ def make_session(
         )
     app_url = None
     if uart2_url is not None:
-        app_url, url = url, _with_options(uart2_url, profile=args.profile, drive=args.drive_type)
+        app_url, url = url, board_url(uart2_url, profile=args.profile, drive=args.drive_type)
         if is_simulated(app_url) and is_simulated(url):
             app_url, url = _one_board(app_url, url)
     profile = profile_for(url, args.profile)
@@ -169,16 +170,6 @@ def make_session(
         takeover_byte=profile.takeover_byte,
         reads=profile.answers_reads,
     )
-
-
-def _with_options(url: str, **options: str | None) -> str:
-    """A sim:// URL with `--profile` and `--drive` as its options, where it has none."""
-    if not url.lower().startswith("sim://"):
-        return url
-    for name, value in options.items():
-        if value and f"{name}=" not in url:
-            url += f"{'&' if '?' in url else '?'}{name}={value}"
-    return url
 
 
 def _one_board(app_url: str, uart2_url: str) -> tuple[str, str]:

@@ -10,11 +10,13 @@ from typing import TYPE_CHECKING, TextIO
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     DAY,
+    ON_A_BOARD,
     Subparsers,
     add_profile,
     add_record,
     add_uart2,
     add_url,
+    board_url,
     layout_for,
     number_type,
     profile_for,
@@ -38,7 +40,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_url(mon)
     mon.add_argument("--json", action="store_true", help="print JSON Lines")
-    add_profile(mon, default=None)
+    add_profile(mon, ON_A_BOARD, default=None)
     add_limits(mon, "show and count only these")
     mon.add_argument(
         "--stop-on-exit",
@@ -73,6 +75,7 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    args.url = board_url(args.url, profile=args.profile)
     if args.uart2:
         from appmode.cli import uart2  # here: start-up stays short
 

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 from serial import SerialException
 
 from appmode.board.names import PROFILE_NAMES
+from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
     from _typeshed import SupportsWrite
@@ -57,10 +58,13 @@ def add_record(parser: argparse.ArgumentParser) -> None:
     )
 
 
-A_RECORD = (
-    "the board's profile, for what its A record holds: sheet (x, y, z) or minibalance "
-    "(|0.7x|, |0.7y|, battery; docs/protocol.md §13)"
+HOLDS = (
+    "for what its A record holds: sheet (x, y, z) or minibalance (|0.7x|, |0.7y|, battery; "
+    "docs/protocol.md §13)"
 )
+A_RECORD = f"the board's profile, {HOLDS}"
+ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {HOLDS}"
+"""--profile of a command that opens a board (`board_url`)."""
 FROM_URL = "a sim:// URL's profile, else sheet"
 
 
@@ -97,6 +101,31 @@ def stop_again_for(url: str | None, name: str | None) -> bytes:
     from appmode.protocol.session_end import stop_again
 
     return stop_again(frames_take_letters=not profile_for(url, name).steer_in_frames)
+
+
+def board_url(url: str, **options: str | None) -> str:
+    """The URL a command opens: a sim:// URL takes the command's `--profile` and `--drive`
+    as its options where it has none (the simulated board is what they describe), and one
+    it sets otherwise is an error; other URLs as they are."""
+    if not url.lower().startswith("sim://"):
+        return url
+    from appmode.ports.sim import parse_sim_url
+
+    try:
+        given = parse_sim_url(url)
+    except SerialException:
+        return url  # opening it says what is wrong
+    for name, value in options.items():
+        if not value:
+            continue
+        if name not in given:
+            url += f"{'&' if '?' in url else '?'}{name}={value}"
+        elif given[name] != value:
+            raise AppmodeError(
+                f"{url} sets {name}={given[name]}, and --{name} {value} another: give "
+                f"the {name} once"
+            )
+    return url
 
 
 def layout_for(url: str | None, name: str | None) -> ALayout:

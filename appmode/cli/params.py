@@ -14,6 +14,7 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
+    board_url,
     profile_for,
 )
 from appmode.errors import AppmodeError
@@ -72,8 +73,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_profile(
         prm,
-        "the board's profile, for the defaults shown: sheet or minibalance (the reference "
-        "firmware, docs/protocol.md §13)",
+        "the board's profile (with a sim:// URL, the simulated board's), for the defaults "
+        "shown: sheet or minibalance (the reference firmware, docs/protocol.md §13)",
         default=None,
     )
     add_record(prm)
@@ -81,6 +82,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    args.url = board_url(args.url, profile=args.profile)
     if args.uart2:
         if args.verify_saved:
             raise AppmodeError(

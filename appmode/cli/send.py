@@ -10,11 +10,13 @@ from typing import TYPE_CHECKING, TextIO
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     DAY,
+    ON_A_BOARD,
     Subparsers,
     add_profile,
     add_record,
     add_uart2,
     add_url,
+    board_url,
     layout_for,
     number_type,
     profile_for,
@@ -52,12 +54,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="with --uart2: leave the encoder report as it is (it is on for the session)",
     )
-    add_profile(send, default=None)
+    add_profile(send, ON_A_BOARD, default=None)
     add_record(send)
     return send
 
 
 def run(args: argparse.Namespace) -> int:
+    args.url = board_url(args.url, profile=args.profile)
     if args.uart2:
         from appmode.cli import uart2  # here: start-up stays short
 

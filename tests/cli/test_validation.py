@@ -15,6 +15,7 @@ import pytest
 from appmode.protocol.transcript import parse_transcript
 from tests.support.processes import ROOT, appmode_cmd, run
 
+MINIBALANCE = ROOT / "transcripts" / "suite" / "minibalance"
 REFUSED = [
     ("send", "sim://", "Z", "--listen", "inf"),
     ("send", "sim://", "Z", "--listen", "nan"),
@@ -144,4 +145,52 @@ def test_started_as_the_program_a_ctrl_c_ends_it_quietly_from_the_first_import(
     )
     assert (imported.returncode, imported.stdout.strip()) == (0, "default_int_handler"), (
         imported.stderr
+    )
+
+
+@pytest.mark.parametrize(
+    "args, shown",
+    [
+        (("params", "sim://", "--json"), '"max_speed": 30,'),
+        (("send", "sim://", "{Q:P}", "wait:1.5"), "< {C30:3000:40:"),
+        (("monitor", "sim://", "--filter", "A", "--count", "1"), "battery=-740%"),
+        (("drive", "sim://"), "max_speed 30 · max_position 3000"),
+        (
+            ("conform", "--board", "sim://", str(MINIBALANCE / "s13_power_up.transcript")),
+            "1 passed, 0 failed against sim://?profile=minibalance",
+        ),
+    ],
+    ids=["params", "send", "monitor", "drive", "conform"],
+)
+def test_a_profile_given_with_a_sim_url_is_the_simulated_boards(
+    args: tuple[str, ...], shown: str
+) -> None:
+    """`--profile minibalance` on sim:// serves the reference firmware's board (its own
+    parameters; its battery reads −740 % for 1.9 s, §13), not the sheet's board decoded
+    as if it were that one."""
+    done = run(*args, "--profile", "minibalance", timeout=30, stdin=b"params\nstatus\n")
+    assert done.returncode == 0, done.stderr
+    assert shown in done.stdout, done.stdout
+
+
+@pytest.mark.parametrize(
+    "args, url, name, value",
+    [
+        (("params", "URL"), "sim://?profile=sheet", "profile", "minibalance"),
+        (("send", "URL", "A"), "sim://?profile=minibalance", "profile", "sheet"),
+        (("monitor", "URL", "--count", "1"), "sim://?profile=sheet", "profile", "minibalance"),
+        (("drive", "URL"), "sim://?drive=omni", "drive", "mecanum"),
+        (("conform", "--board", "URL"), "sim://?profile=sheet", "profile", "minibalance"),
+    ],
+    ids=["params", "send", "monitor", "drive", "conform"],
+)
+def test_a_profile_or_drive_that_the_sim_url_contradicts_is_refused(
+    args: tuple[str, ...], url: str, name: str, value: str
+) -> None:
+    command = [url if arg == "URL" else arg for arg in args]
+    done = run(*command, f"--{name}", value, timeout=20)
+    assert done.returncode == 2
+    assert done.stderr == (
+        f"appmode: error: {url} sets {url.split('?')[1]}, and --{name} {value} another: give "
+        f"the {name} once\n"
     )
