@@ -76,8 +76,8 @@ def _add_where(board: argparse.ArgumentParser) -> None:
     where.add_argument(
         "--listen",
         metavar="HOST:PORT",
-        help="serve on TCP, one client at a time (host 127.0.0.1 by default; "
-        "port 0 picks a free one)",
+        help="serve on TCP, one client at a time (host 127.0.0.1 by default, [::1] for "
+        "IPv6; port 0 picks a free one)",
     )
     where.add_argument(
         "--port",

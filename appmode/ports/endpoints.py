@@ -174,8 +174,9 @@ class TcpEndpoint:
         self._log = log
         self.baud = baud
         """The line rate it is paced at; None: the port's own."""
+        family = socket.AF_INET6 if ":" in host else socket.AF_INET  # [::1]: IPv6
         try:
-            self._listener = socket.create_server((host, port))
+            self._listener = socket.create_server((host, port), family=family)
         except OSError as exc:
             if exc.errno == errno.EADDRINUSE:
                 raise AppmodeError(
@@ -185,7 +186,8 @@ class TcpEndpoint:
             raise AppmodeError(f"cannot listen on {host}:{port}: {exc.strerror}") from None
         self._listener.setblocking(False)
         bound_host, bound_port = self._listener.getsockname()[:2]
-        self.url = f"socket://{bound_host}:{bound_port}"
+        shown = f"[{bound_host}]" if family == socket.AF_INET6 else bound_host
+        self.url = f"socket://{shown}:{bound_port}"
         self._client: socket.socket | None = None
         self._out = Overrun(log, "the TCP client")
         self._paused = False

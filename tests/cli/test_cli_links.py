@@ -8,6 +8,7 @@ import pty
 import re
 import select
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -119,6 +120,24 @@ def test_monitor_over_tcp_for_a_duration() -> None:
     assert all("its start missed" in text for text in lines if text not in records)
     # joining a stream mid-record costs at most the first partial record
     assert len(done.stdout.splitlines()) - len(records) <= 1
+
+
+def test_a_board_listens_on_an_ipv6_address() -> None:
+    """`--listen [::1]:0`: the URL it prints brackets the address, and a host opens it (on
+    a machine without IPv6, one line says it cannot listen there)."""
+    try:
+        socket.create_server(("::1", 0), family=socket.AF_INET6).close()
+    except OSError:
+        done = run("board", "--listen", "[::1]:0")
+        assert done.returncode == 2
+        assert done.stderr.startswith("appmode: error: cannot listen on ::1:0: ")
+        assert done.stderr.count("\n") == 1
+        return
+    with board_process("--listen", "[::1]:0", "--quiet") as board:
+        assert board.url.startswith("socket://[::1]:"), board.url
+        done = run("params", board.url, "--json")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["max_speed"] == 500
 
 
 @pytest.mark.parametrize(
