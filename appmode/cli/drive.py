@@ -115,13 +115,16 @@ def add_board(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from appmode.console.driving import run_drive  # here: start-up stays short
+    from appmode.console.script import command_lines
+    from appmode.session.base import MAX_COMMAND
     from appmode.session.hold import HoldToDrive
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
     on_message = None if interactive else _print_message
     session = make_session(args, driving, on_message)
-    return run_drive(session, interactive, sys.stdin, sys.stdout, keep_going=args.keep_going)
+    script = command_lines(sys.stdin, MAX_COMMAND)
+    return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
 
 
 def make_session(

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from typing import TextIO
 
 from appmode.console.panel import status_text
@@ -14,6 +14,17 @@ from appmode.session.base import BaseSession, Quit, ShowHelp, ShowStatus, Step
 
 REFRESH = 0.02
 """Seconds between reads of the link while time passes."""
+
+
+def command_lines(stream: TextIO, limit: int) -> Iterator[str]:
+    """`stream`'s lines, never more than `limit` + 1 characters of one held: a longer
+    line (a file piped in by mistake) is given as its first `limit` + 1 characters, its
+    rest read and let go."""
+    while line := stream.readline(limit + 1):
+        if len(line) > limit and not line.endswith("\n"):
+            while (rest := stream.readline(limit + 1)) and not rest.endswith("\n"):
+                pass
+        yield line
 
 
 def run_script(

@@ -8,8 +8,12 @@ import os
 import time
 from pathlib import Path
 
+import pytest
+
+from appmode.console.script import command_lines
 from appmode.protocol.transcript import Recorder
 from appmode.session.app_session import Session
+from appmode.session.base import MAX_COMMAND
 from appmode.session.hold import HoldToDrive
 from tests.support.processes import BoardProcess, run, sent_lines
 
@@ -26,6 +30,28 @@ def test_script_mode_reads_commands_from_stdin(tmp_path: Path) -> None:
     assert "appmode: error: unknown command 'fly': type help for the list" in done.stderr
     sent = [line for line in record.read_text().splitlines() if " > " in line]
     assert sent[-1].endswith(" > Z"), sent[-3:]
+
+
+def test_a_huge_command_line_is_refused_at_once() -> None:
+    """5 MB on one line (a file piped in by mistake): one error, in time linear in it
+    (splitting it into words would take hours), and the next line runs."""
+    done = run("drive", "--keep-going", stdin=b"x" * 5_000_000 + b"\nstatus\n", timeout=30)
+    assert done.returncode == 1
+    assert done.stderr.startswith(
+        "appmode: error: a command line of over 1,000 characters: a command is shorter "
+        "(was a file given by mistake?)\n"
+    )
+    assert "SIMULATED BOARD" in done.stdout
+
+
+@pytest.mark.parametrize("size", [999, 1000, 1001, 2002, 5000])
+def test_a_script_line_is_never_held_whole(size: int) -> None:
+    """command_lines holds at most MAX_COMMAND + 1 characters of a line: a line up to the
+    limit comes whole, a longer one as its first MAX_COMMAND + 1 characters (refused
+    then), and the line after it comes as it is."""
+    lines = list(command_lines(io.StringIO("y" * size + "\nstatus\n"), MAX_COMMAND))
+    assert lines[1:] == ["status\n"]
+    assert lines[0].rstrip("\n") == "y" * min(size, MAX_COMMAND + 1)
 
 
 def test_script_mode_against_a_board_process_over_tcp(tmp_path: Path) -> None:
