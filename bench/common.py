@@ -160,7 +160,7 @@ def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> f
     all (the machine's cost, not appmode's)."""
     master, slave = os.openpty()
     tty.setraw(slave)
-    idle, _ = os.pipe()
+    idle, never = os.pipe()  # a descriptor nothing is written to: select only times out
     sel = selectors.DefaultSelector()
     sel.register(idle, selectors.EVENT_READ)
     per_wakeup = writes / max(rate, 1e-9)
@@ -179,6 +179,6 @@ def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> f
                 os.read(slave, 65536)
     share = (time.process_time() - start_cpu) / (time.monotonic() - start) * 100
     sel.close()
-    for fd in (master, slave, idle):
+    for fd in (master, slave, idle, never):
         os.close(fd)
     return share
