@@ -18,13 +18,14 @@ REFRESH = 0.02
 
 def command_lines(stream: TextIO, limit: int) -> Iterator[str]:
     """`stream`'s lines, never more than `limit` + 1 characters of one held: a longer
-    line (a file piped in by mistake) is given as its first `limit` + 1 characters, its
-    rest read and let go."""
+    line (a file piped in by mistake) is given at once as its first `limit` + 1
+    characters, and its rest is read and let go only when the next line is asked for
+    (a script that ends at the error does not read on: /dev/zero has no line end)."""
     while line := stream.readline(limit + 1):
+        yield line
         if len(line) > limit and not line.endswith("\n"):
             while (rest := stream.readline(limit + 1)) and not rest.endswith("\n"):
                 pass
-        yield line
 
 
 def run_script(
@@ -37,18 +38,18 @@ def run_script(
     """
     settle(session, 0.0)
     for raw in lines:
-        if session.failures and not keep_going:
-            print(
-                "appmode: the script stopped at its first error (--keep-going runs on)",
-                file=sys.stderr,
-            )
-            break
         try:
             step = session.run(raw)
         except Quit:
             break  # run_drive names what was not saved
         show(session, step)
         settle(session, step.seconds if isinstance(step, Wait) else 0.0)
+        if session.failures and not keep_going:  # before the next line is read
+            print(
+                "appmode: the script stopped at its first error (--keep-going runs on)",
+                file=sys.stderr,
+            )
+            break
     out.flush()
 
 

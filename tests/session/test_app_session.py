@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import io
 import os
+import subprocess
 import time
 from pathlib import Path
 
@@ -15,7 +16,7 @@ from appmode.protocol.transcript import Recorder
 from appmode.session.app_session import Session
 from appmode.session.base import MAX_COMMAND
 from appmode.session.hold import HoldToDrive
-from tests.support.processes import BoardProcess, run, sent_lines
+from tests.support.processes import BoardProcess, appmode_cmd, run, sent_lines
 
 
 def test_script_mode_reads_commands_from_stdin(tmp_path: Path) -> None:
@@ -42,6 +43,21 @@ def test_a_huge_command_line_is_refused_at_once() -> None:
         "(was a file given by mistake?)\n"
     )
     assert "SIMULATED BOARD" in done.stdout
+
+
+def test_a_script_with_no_line_end_ends_at_its_first_line() -> None:
+    """/dev/zero given as the script: its first 1,001 characters are refused at once, and
+    the script ends there (it does not read on for the line's end, which never comes)."""
+    with open("/dev/zero", "rb") as zero:
+        done = subprocess.run(
+            appmode_cmd("drive"), stdin=zero, capture_output=True, text=True, timeout=30
+        )
+    assert done.returncode == 1
+    assert done.stderr.splitlines() == [
+        "appmode: error: a command line of over 1,000 characters: a command is shorter "
+        "(was a file given by mistake?)",
+        "appmode: the script stopped at its first error (--keep-going runs on)",
+    ]
 
 
 @pytest.mark.parametrize("size", [999, 1000, 1001, 2002, 5000])
