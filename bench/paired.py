@@ -15,38 +15,16 @@ every round. The same folder twice shows the noise.
 from __future__ import annotations
 
 import argparse
-import os
 import statistics
-import subprocess
-import sys
 import time
+from contextlib import ExitStack
 from pathlib import Path
 
 import serial
 from common import cpu_seconds
-
-from appmode.protocol import control, settings
-from appmode.protocol.params import DriveType
+from uart2 import drive_reporting, served
 
 Ports = tuple[serial.Serial, serial.Serial]
-
-
-def start(root: Path) -> tuple[subprocess.Popen[str], Ports]:
-    """`appmode board` from the package in `root`, its car driving, its two ports open."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "appmode", "board", "--pty", "--quiet", "--drive", "mecanum"],
-        stdout=subprocess.PIPE,
-        text=True,
-        env={**os.environ, "PYTHONPATH": str(root)},
-        cwd=root,
-    )
-    assert proc.stdout is not None
-    app = proc.stdout.readline().split(" ", 1)[1].strip()
-    uart2 = proc.stdout.readline().split(" ", 1)[1].strip()
-    app_port, uart2_port = serial.Serial(app, 9600, timeout=0.1), serial.Serial(uart2, 115200)
-    uart2_port.write(control.encode(control.SetSetting(settings.BY_NAME["system_mode"], 0x41)))
-    uart2_port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
-    return proc, (app_port, uart2_port)
 
 
 def drained(ports: Ports) -> int:
@@ -55,9 +33,15 @@ def drained(ports: Ports) -> int:
 
 def rounds(roots: tuple[Path, Path], count: int, seconds: float) -> list[tuple[float, float]]:
     """(A's share, B's share) in % of a core, for `count` rounds of `seconds`, the two
-    started in the order given."""
-    started = [start(root) for root in roots]
-    try:
+    started in the order given (both stopped at the end, or when one fails to start)."""
+    with ExitStack() as stack:
+        started = []
+        for root in roots:
+            proc, app, uart2 = stack.enter_context(served("--drive", "mecanum", root=root))
+            app_port = stack.enter_context(serial.Serial(app, 9600, timeout=0.1))
+            uart2_port = stack.enter_context(serial.Serial(uart2, 115200, timeout=0.1))
+            drive_reporting(uart2_port)
+            started.append((proc, (app_port, uart2_port)))
         time.sleep(1.0)  # the cars at speed
         shares = []
         for _ in range(count):
@@ -75,12 +59,6 @@ def rounds(roots: tuple[Path, Path], count: int, seconds: float) -> list[tuple[f
             )
             shares.append((a, b))
         return shares
-    finally:
-        for proc, ports in started:
-            for port in ports:
-                port.close()
-            proc.terminate()
-            proc.wait(10)
 
 
 def main() -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import os
 import random
 import subprocess
 import sys
@@ -19,6 +20,7 @@ import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 
 import serial
 from common import fitted_slope, floor_row, over_floor, percentile, share_and_floor
@@ -32,18 +34,24 @@ READ = control.encode(control.read("max_speed"))
 
 
 @contextmanager
-def served(*args: str) -> Iterator[tuple[subprocess.Popen[str], str, str]]:
-    """`appmode board --pty ARGS`: the process, its APP port and its UART2."""
+def served(
+    *args: str, root: Path | None = None
+) -> Iterator[tuple[subprocess.Popen[str], str, str]]:
+    """`appmode board --pty ARGS` (from the appmode package in folder `root`, if given):
+    the process, its APP port and its UART2."""
     proc = subprocess.Popen(
         [sys.executable, "-m", "appmode", "board", "--pty", "--quiet", *args],
         stdout=subprocess.PIPE,
         text=True,
+        env=None if root is None else {**os.environ, "PYTHONPATH": str(root)},
+        cwd=root,
     )
     try:
         assert proc.stdout is not None
-        app = proc.stdout.readline().split(" ", 1)[1].strip()
-        uart2 = proc.stdout.readline().split(" ", 1)[1].strip()
-        yield proc, app, uart2
+        app, uart2 = (proc.stdout.readline() for _ in range(2))
+        if not (app.startswith("port: ") and uart2.startswith("uart2: ")):
+            raise SystemExit(f"appmode board {' '.join(args)} did not start (from {root or '.'})")
+        yield proc, app.split(" ", 1)[1].strip(), uart2.split(" ", 1)[1].strip()
     finally:
         proc.terminate()
         proc.wait(10)
@@ -159,15 +167,19 @@ def throughput_rows(frames: int) -> list[tuple[str, str, str]]:
     ]
 
 
+def drive_reporting(port: serial.Serial) -> None:
+    """Over a mecanum board's UART2: the encoder report on, the car driving forward."""
+    port.write(control.encode(control.SetSetting(settings.BY_NAME["system_mode"], 0x41)))
+    port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
+
+
 def cpu_rows(seconds: float) -> list[tuple[str, str, str]]:
     with (
         served("--drive", "mecanum") as (proc, app, uart2),
         serial.Serial(uart2, 115200, timeout=0.1) as port,
         serial.Serial(app, 9600, timeout=0.1) as app_port,
     ):
-        report = control.SetSetting(settings.BY_NAME["system_mode"], 0x41)
-        port.write(control.encode(report))
-        port.write(control.encode(control.velocity(DriveType.MECANUM, y=200)))
+        drive_reporting(port)
         time.sleep(0.5)
         cpu = share_and_floor(
             proc.pid,

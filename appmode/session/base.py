@@ -38,7 +38,6 @@ QUIT_WORDS = ("quit", "exit", "q")
 MAX_COMMAND = 1000
 """Characters a command line may have (splitting one into words takes time that grows
 as the square of its length: a megabyte pasted or piped in would hang the session)."""
-TOO_LONG = f"a command line of over {MAX_COMMAND:,} characters: a command is shorter"
 ON_OFF = {"on": None, "off": None}
 
 
@@ -313,7 +312,10 @@ class BaseSession(ABC):
         Mistakes are reported as messages, never raised.
         """
         if len(line.rstrip("\r\n")) > MAX_COMMAND:  # a script's line ends with its newline
-            self.fail(f"{TOO_LONG} (was a file given by mistake?)")
+            self.fail(
+                f"a command line of over {MAX_COMMAND:,} characters: a command is shorter "
+                "(was a file given by mistake?)"
+            )
             return None
         try:
             words = shlex.split(line, comments=True)
