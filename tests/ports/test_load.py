@@ -1,4 +1,4 @@
-"""Load: a host flooding the board (short versions; bench/load.py runs 60 s)."""
+"""Load: a host flooding the board (short versions; bench/run_all.py runs 60 s)."""
 
 from __future__ import annotations
 
