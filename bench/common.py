@@ -14,6 +14,9 @@ import tty
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import NamedTuple
+
+from appmode.ports.wakeups import exact_wakeups, select_exactly
 
 
 @contextmanager
@@ -107,13 +110,18 @@ class Share:
     """Its write calls a second (median)."""
     received: float
     """Bytes a second the reader got (median)."""
+    floor_wakeups: float
+    """The floor's own wake-ups a second, as counted (median)."""
+    floor_writes: float
+    """The floor's write calls a second (median)."""
 
 
 def share_and_floor(pid: int, seconds: float, read: Callable[[], int], rounds: int = 10) -> Share:
     """Process `pid`'s CPU share (%) while `read()` is called every 50 ms, and its floor
     (`wakeup_floor` with the same wake-ups, write calls and bytes a second), measured in
     turn for `rounds` rounds, `seconds` of each in all."""
-    shares, floors, rates, calls, volumes = [], [], [], [], []
+    shares, rates, calls, volumes = [], [], [], []
+    floors: list[Floor] = []
     for _ in range(rounds):
         read()  # what came while the floor ran
         start_cpu, start, woken, got = cpu_seconds(pid), time.monotonic(), wakeups(pid), 0
@@ -131,9 +139,16 @@ def share_and_floor(pid: int, seconds: float, read: Callable[[], int], rounds: i
             wakeup_floor(seconds / rounds, rates[-1], calls[-1], (now_wrote - wrote) / elapsed)
         )
     median = statistics.median
-    over = sorted(s - f for s, f in zip(shares, floors, strict=True))
+    over = sorted(s - f.share for s, f in zip(shares, floors, strict=True))
     return Share(
-        median(shares), median(floors), over, median(rates), median(calls), median(volumes)
+        median(shares),
+        median(f.share for f in floors),
+        over,
+        median(rates),
+        median(calls),
+        median(volumes),
+        median(f.wakeups for f in floors),
+        median(f.writes for f in floors),
     )
 
 
@@ -149,15 +164,29 @@ def floor_row(cpu: Share) -> tuple[str, str, str]:
     """The benchmark table's row for `cpu`'s floor."""
     return (
         "its floor: a bare loop, same wake-ups and pty writes",
-        f"{cpu.floor:.2f} % of a core ({cpu.wakeups:.0f} wake-ups/s, {cpu.writes:.0f} writes/s)",
+        f"{cpu.floor:.2f} % of a core ({cpu.floor_wakeups:.0f} wake-ups/s, "
+        f"{cpu.floor_writes:.0f} writes/s; the board {cpu.wakeups:.0f}, {cpu.writes:.0f})",
         "",
     )
 
 
-def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> float:
+class Floor(NamedTuple):
+    """What a floor cost and did."""
+
+    share: float
+    """% of a core."""
+    wakeups: float
+    """Its wake-ups a second, as counted (voluntary context switches)."""
+    writes: float
+    """Its write calls a second."""
+
+
+def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> Floor:
     """CPU of a loop doing nothing but what trickled output needs: `rate` timed wake-ups
     a second, and `writes` write calls a second into a pty, `volume` bytes a second in
-    all (the machine's cost, not appmode's)."""
+    all (the machine's cost, not appmode's). It waits as a served board does (exact
+    wake-ups, on a grid from one start): with an epoll wait's timeout of 1 / `rate`,
+    rounded up to whole milliseconds, it woke 99 times a second for 110."""
     master, slave = os.openpty()
     tty.setraw(slave)
     idle, never = os.pipe()  # a descriptor nothing is written to: select only times out
@@ -165,20 +194,28 @@ def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> f
     sel.register(idle, selectors.EVENT_READ)
     per_wakeup = writes / max(rate, 1e-9)
     chunk = b"x" * max(1, round(volume / max(writes, 1e-9)))
-    start_cpu, start = time.process_time(), time.monotonic()
-    owed = 0.0
-    count = 0
-    while time.monotonic() - start < seconds:
-        sel.select(1 / rate)
-        owed += per_wakeup
-        while owed >= 1:
-            os.write(master, chunk)
-            owed -= 1
-            count += 1
-            if count % 64 == 0:
-                os.read(slave, 65536)
-    share = (time.process_time() - start_cpu) / (time.monotonic() - start) * 100
+    period = 1 / max(rate, 1e-9)
+    with exact_wakeups():
+        start_cpu, start, woken = time.process_time(), time.monotonic(), wakeups(os.getpid())
+        owed = 0.0
+        count = wakes = 0
+        while (now := time.monotonic()) - start < seconds:
+            wakes = max(wakes + 1, math.ceil((now - start) / period))  # late: the next one
+            select_exactly(sel, start + wakes * period - now)
+            owed += per_wakeup
+            while owed >= 1:
+                os.write(master, chunk)
+                owed -= 1
+                count += 1
+                if count % 64 == 0:
+                    os.read(slave, 65536)
+        elapsed = time.monotonic() - start
+        floor = Floor(
+            (time.process_time() - start_cpu) / elapsed * 100,
+            (wakeups(os.getpid()) - woken) / elapsed,
+            count / elapsed,
+        )
     sel.close()
     for fd in (master, slave, idle, never):
         os.close(fd)
-    return share
+    return floor
