@@ -201,7 +201,7 @@ def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> F
         count = wakes = 0
         while (now := time.monotonic()) - start < seconds:
             wakes = max(wakes + 1, math.ceil((now - start) / period))  # late: the next one
-            select_exactly(sel, start + wakes * period - now)
+            select_exactly(sel, start + min(wakes * period, seconds) - now)
             owed += per_wakeup
             while owed >= 1:
                 os.write(master, chunk)
