@@ -185,8 +185,8 @@ def wakeup_floor(seconds: float, rate: float, writes: float, volume: float) -> F
     """CPU of a loop doing nothing but what trickled output needs: `rate` timed wake-ups
     a second, and `writes` write calls a second into a pty, `volume` bytes a second in
     all (the machine's cost, not appmode's). It waits as a served board does (exact
-    wake-ups, on a grid from one start): with an epoll wait's timeout of 1 / `rate`,
-    rounded up to whole milliseconds, it woke 99 times a second for 110."""
+    wake-ups, on a grid from one start): an epoll wait's timeout is whole milliseconds,
+    rounded up, and one of 1/110 s woke it 99 times a second."""
     master, slave = os.openpty()
     tty.setraw(slave)
     idle, never = os.pipe()  # a descriptor nothing is written to: select only times out

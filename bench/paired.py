@@ -27,8 +27,9 @@ from uart2 import drive_reporting, served
 Ports = tuple[serial.Serial, serial.Serial]
 
 
-def drained(ports: Ports) -> int:
-    return sum(len(port.read(port.in_waiting)) for port in ports)
+def drain(ports: Ports) -> None:
+    for port in ports:
+        port.read(port.in_waiting)
 
 
 def rounds(roots: tuple[Path, Path], count: int, seconds: float) -> list[tuple[float, float]]:
@@ -46,12 +47,12 @@ def rounds(roots: tuple[Path, Path], count: int, seconds: float) -> list[tuple[f
         shares = []
         for _ in range(count):
             for _, ports in started:
-                drained(ports)
+                drain(ports)
             before, begun = [cpu_seconds(proc.pid) for proc, _ in started], time.monotonic()
             while time.monotonic() - begun < seconds:
                 time.sleep(0.05)
                 for _, ports in started:
-                    drained(ports)
+                    drain(ports)
             elapsed = time.monotonic() - begun
             a, b = (
                 (cpu_seconds(proc.pid) - cpu) / elapsed * 100
