@@ -2,8 +2,8 @@
 
 Side by side in one run: appmode's BoardDecoder, and a straightforward byte-at-a-time
 decoder written the way the firmware's interrupt handler reads bytes (a handler called
-per byte, a state machine, a buffer of digits). Both build every record, fully decoded
-to integers.
+per byte, a state machine, a buffer of digits), each the best of three runs taken in
+turn. Both build every record, fully decoded to integers.
 Target: at least 8 MB/s, and at least 2x the byte-at-a-time decoder.
 """
 
@@ -176,14 +176,24 @@ class SameEventsByteLoop:
         self.events.append(app_decoders._parse_record(raw, raw[1 : raw.index(b"}")], terminated))
 
 
-def timed(run: object) -> tuple[float, int]:
+def timed(run: Callable[[], int]) -> tuple[float, int]:
     start = time.perf_counter()
-    count = run()  # type: ignore[operator]
+    count = run()
     return time.perf_counter() - start, count
 
 
-def compare(megabytes: float, noise: float, chunk: int) -> dict[str, float]:
-    """Both decoders on the same stream: MB/s and records/s of each."""
+def best_of(runs: int, *decoders: Callable[[], int]) -> list[tuple[float, int]]:
+    """Each decoder's best (seconds, count) of `runs` runs, taken in turn: a moment of the
+    machine's load falls on one run, not on one decoder."""
+    best = [(math.inf, 0)] * len(decoders)
+    for _ in range(runs):
+        best = [min(b, timed(run)) for b, run in zip(best, decoders, strict=True)]
+    return best
+
+
+def compare(megabytes: float, noise: float, chunk: int, runs: int = 3) -> dict[str, float]:
+    """Both decoders on the same stream, the best of `runs` runs each: MB/s and records/s
+    of each."""
     stream, _ = make_stream(int(megabytes * 1e6), noise)
     chunks = [stream[i : i + chunk] for i in range(0, len(stream), chunk)]
 
@@ -197,8 +207,7 @@ def compare(megabytes: float, noise: float, chunk: int) -> dict[str, float]:
             decoder.feed(piece)
         return len(decoder.records)
 
-    fast, fast_count = timed(ours)
-    slow, slow_count = timed(naive)
+    (fast, fast_count), (slow, slow_count) = best_of(runs, ours, naive)
     return {
         "mb": len(stream) / 1e6,
         "ours_mbs": len(stream) / fast / 1e6,

@@ -142,9 +142,8 @@ class HostDecoder:
         pos = 0
         # split scans in C: [gap, frame, gap, frame, …, gap]; a gap of single bytes is
         # read here, others go the general way, the last one held where it may continue
-        parts = _FRAMES.split(buf)
-        for i in range(0, len(parts) - 1, 2):
-            gap, frame = parts[i], parts[i + 1]
+        parts = iter(_FRAMES.split(buf))
+        for gap, frame in zip(parts, parts, strict=False):  # pairs; the last gap left out
             if gap:
                 if self._skip_len or LBRACE in gap:
                     pos = general(buf, pos, pos + len(gap), out)
@@ -305,9 +304,8 @@ class BoardDecoder:
         pos = 0
         # split scans in C: [gap, record, x, y, z, w, gap, record, …, gap]; each gap
         # goes the general way, the last one held if it may continue
-        parts = _FAST.split(buf)
-        for i in range(0, len(parts) - 1, 6):
-            gap, raw, x, y, z, w = parts[i : i + 6]
+        parts = iter(_FAST.split(buf))
+        for gap, raw, x, y, z, w in zip(*[parts] * 6, strict=False):  # the last gap left out
             if gap:
                 general(buf, pos, pos + len(gap), out, False)
                 pos += len(gap)
