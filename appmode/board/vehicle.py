@@ -132,13 +132,15 @@ class Vehicle:
         heading, east, north = self.heading, self.east, self.north
         travel_x, travel_y, travel_z = self.travel_x, self.travel_y, self.travel_z
         centivolts = self.centivolts
-        for _ in range(ticks):
-            heading = (heading + turn) % 360.0
+        cos = sin = 0.0
+        for tick in range(ticks):
+            if turn or not tick:  # else the heading, and so its cosine and sine, are as they were
+                heading = (heading + turn) % 360.0
+                rad = math.radians(heading)
+                cos, sin = math.cos(rad), math.sin(rad)
             travel_x += vx * dt
             travel_y += vy * dt
             travel_z += vz * dt
-            rad = math.radians(heading)
-            cos, sin = math.cos(rad), math.sin(rad)
             east += (vx * cos + vy * sin) * dt
             north += (vy * cos - vx * sin) * dt
             centivolts = max(0.0, centivolts - drain)
