@@ -9,7 +9,9 @@ on, as the both-ports row does, and one client reads all four ports every 50 ms.
 pair is started in both orders, each start measured in rounds: the board started second
 has cost less (0.09–0.20 % of a core, in three pairs of runs), so each order's median of
 B's share less A's is printed, and their mean is the estimate, with the quartiles of
-every round. The same folder twice shows the noise.
+every round. The same folder twice shows the noise, and a comparison run again may not
+agree: one change measured -0.155 % in one run and +0.136 % in another (both start
+orders agreeing each time), so a change smaller than about 0.3 % needs many runs.
 """
 
 from __future__ import annotations
