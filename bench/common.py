@@ -56,6 +56,24 @@ def fitted_slope(xs: Sequence[float], ys: Sequence[float]) -> tuple[float, float
     return fit.slope, math.sqrt(residuals / (len(xs) - 2) / spread)
 
 
+def build() -> str:
+    """Which appmode the benchmarks measure: the compiled build (README, "The compiled
+    build") or pure Python, as a process they start imports it (and this one, if not the
+    same)."""
+    probe = "import appmode.board.firmware as m; print(m.__file__)"
+    probed = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    here = (
+        sys.modules["appmode.board.firmware"].__file__
+        if "appmode.board.firmware" in sys.modules
+        else None
+    )
+    name = {True: "pure Python", False: "compiled (mypyc)"}
+    theirs = name[probed.stdout.strip().endswith(".py")]
+    if here is None or name[here.endswith(".py")] == theirs:
+        return theirs
+    return f"{theirs} (in its own processes; {name[here.endswith('.py')]} in run_all's)"
+
+
 def percentile(values: list[float], q: float) -> float:
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, int(q / 100 * len(ordered)))]

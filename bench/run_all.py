@@ -38,7 +38,7 @@ import serial
 import startup
 import uart2
 import web
-from common import board, cpu_seconds, floor_row, over_floor, percentile, share_and_floor
+from common import board, build, cpu_seconds, floor_row, over_floor, percentile, share_and_floor
 
 from appmode.board.firmware import TICK, Board
 
@@ -486,7 +486,10 @@ def main() -> None:
         f"{platform.python_version()}, {platform.system()} {platform.release()}"
     )
     beside = "beside a busy process" if args.busy else "idle"
-    print(f"appmode benchmarks — {time.strftime('%Y-%m-%d')} — {machine} — {beside}")
+    print(
+        f"appmode benchmarks — {time.strftime('%Y-%m-%d')} — {machine} — {beside} — "
+        f"appmode {build()}"
+    )
     width = max(len(r[0]) for r in rows)
     print(f"| {'benchmark'.ljust(width)} | result | target |")
     print(f"|{'-' * (width + 2)}|---|---|")

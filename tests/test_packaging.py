@@ -70,3 +70,31 @@ def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_pa
     sheet = len(list((ROOT / "transcripts" / "suite").glob("*.transcript")))
     sheet += len(list((ROOT / "transcripts" / "suite" / "uart2").glob("*.transcript")))
     assert f"{sheet} passed, 0 failed" in done.stdout
+
+
+def test_the_default_wheel_is_pure_python(wheel: Path) -> None:
+    """The compiled build is asked for (HATCH_BUILD_HOOKS_ENABLE=1): `pip install .`
+    needs no C compiler, on any system."""
+    assert wheel.name.endswith("-py3-none-any.whl")
+    names = zipfile.ZipFile(wheel).namelist()
+    assert not [n for n in names if n.endswith((".so", ".pyd"))]
+
+
+def test_compiled_modules_beside_the_sources_are_as_new_as_them() -> None:
+    """The compiled build leaves its modules beside their sources, where Python imports
+    them first: one older than its source (edited since) would be run in its place."""
+    stale = [
+        compiled.relative_to(ROOT).as_posix()
+        for pattern in ("*.so", "*.pyd")
+        for compiled in (ROOT / "appmode").rglob(pattern)
+        if compiled.stat().st_mtime < source_of(compiled).stat().st_mtime
+    ]
+    assert not stale, (
+        f"{', '.join(stale)}: older than their sources; build again "
+        "(HATCH_BUILD_HOOKS_ENABLE=1 pip install .) or remove them (rm appmode/*/*.so *__mypyc*.so)"
+    )
+
+
+def source_of(compiled: Path) -> Path:
+    """The source a compiled module was built from: firmware.cpython-311-….so, firmware.py."""
+    return compiled.with_name(compiled.name.split(".")[0] + ".py")

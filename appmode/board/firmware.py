@@ -306,7 +306,7 @@ class Board:
         profile, vehicle = core.profile, core.vehicle
         speed = core.params[params.MAX_SPEED]
         if 0 < speed < profile.stall_speed:
-            core.params[params.MAX_SPEED] = speed = profile.stall_speed
+            core.params[params.MAX_SPEED] = speed = float(profile.stall_speed)
         if core.uart2_control and profile.firmware_uart2:
             self._drive_firmware_uart2(ticks)
             return

@@ -67,7 +67,7 @@ class Telemetry:
         else:
             core.out3 += data
         if profile.firmware_uart2:  # written once the record has gone out
-            self.burst_ms = at + math.ceil(len(data) * profile.byte_ms)
+            self.burst_ms = float(at + math.ceil(len(data) * profile.byte_ms))
         self.record_ms = at + profile.record_period_ms(len(data))
 
     def send_burst(self) -> None:
