@@ -58,20 +58,22 @@ def fitted_slope(xs: Sequence[float], ys: Sequence[float]) -> tuple[float, float
 
 def build() -> str:
     """Which appmode the benchmarks measure: the compiled build (README, "The compiled
-    build") or pure Python, as a process they start imports it (and this one, if not the
-    same)."""
+    build") or pure Python, as a process they start imports it (and this one's, if not
+    the same)."""
     probe = "import appmode.board.firmware as m; print(m.__file__)"
-    probed = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
-    here = (
-        sys.modules["appmode.board.firmware"].__file__
-        if "appmode.board.firmware" in sys.modules
-        else None
+    theirs = _build(
+        subprocess.run(
+            [sys.executable, "-c", probe], capture_output=True, text=True, check=True
+        ).stdout.strip()
     )
-    name = {True: "pure Python", False: "compiled (mypyc)"}
-    theirs = name[probed.stdout.strip().endswith(".py")]
-    if here is None or name[here.endswith(".py")] == theirs:
-        return theirs
-    return f"{theirs} (in its own processes; {name[here.endswith('.py')]} in run_all's)"
+    module = sys.modules.get("appmode.board.firmware")
+    mine = _build(module.__file__ or "") if module is not None else theirs
+    return theirs if mine == theirs else f"{theirs} (in its own processes; {mine} in run_all's)"
+
+
+def _build(path: str) -> str:
+    """The build a module at `path` belongs to."""
+    return "pure Python" if path.endswith(".py") else "compiled (mypyc)"
 
 
 def percentile(values: list[float], q: float) -> float:

@@ -73,8 +73,8 @@ def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_pa
 
 
 def test_the_default_wheel_is_pure_python(wheel: Path) -> None:
-    """The compiled build is asked for (HATCH_BUILD_HOOKS_ENABLE=1): `pip install .`
-    needs no C compiler, on any system."""
+    """The compiled build is made only when asked for (HATCH_BUILD_HOOKS_ENABLE=1):
+    `pip install .` needs no C compiler, on any system."""
     assert wheel.name.endswith("-py3-none-any.whl")
     names = zipfile.ZipFile(wheel).namelist()
     assert not [n for n in names if n.endswith((".so", ".pyd"))]
