@@ -453,7 +453,7 @@ def main() -> None:
         ("key latency", lambda: bench_key_latency(100 if quick else 300)),
         ("decode command", lambda: bench_decode_command(quick)),
         ("start-up", lambda: bench_startup(5 if quick else 15)),
-        ("board CPU", lambda: bench_board_cpu(10 if quick else 30)),
+        ("board CPU", lambda: bench_board_cpu(12 if quick else 120)),
         ("drive CPU", lambda: bench_drive_cpu(10 if quick else 30)),
         ("boards per core", lambda: bench_many_boards([200, 500, 1000], 5 if quick else 15)),
         ("trickle", lambda: bench_trickle(3 if quick else 10)),

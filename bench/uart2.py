@@ -203,7 +203,7 @@ def rows(quick: bool) -> list[tuple[str, str, str]]:
         *decoder_rows(1_000_000 if quick else 4_000_000),
         *round_trip_rows(200 if quick else 1000),
         *throughput_rows(2000 if quick else 10_000),
-        *cpu_rows(10 if quick else 30),
+        *cpu_rows(12 if quick else 120),
     ]
 
 
