@@ -477,10 +477,16 @@ def main() -> None:
             parser.error(f"no part {', '.join(sorted(unknown))}; parts: {[n for n, _ in plan]}")
         plan = [(name, run) for name, run in plan if name in args.only]
     rows: list[Row] = []
+    failed: list[str] = []
     with replay_timing.load("busy1" if args.busy else "idle"):
         for name, run in plan:
             print(f"running: {name} …", file=sys.stderr, flush=True)
-            rows += run()
+            try:
+                rows += run()
+            except (Exception, SystemExit) as error:  # the other parts' rows are kept
+                print(f"{name}: failed: {error}", file=sys.stderr, flush=True)
+                rows.append((name, f"failed: {error}", ""))
+                failed.append(name)
     machine = (
         f"{platform.machine()}, {os.cpu_count()} cores, Python "
         f"{platform.python_version()}, {platform.system()} {platform.release()}"
@@ -495,6 +501,8 @@ def main() -> None:
     print(f"|{'-' * (width + 2)}|---|---|")
     for label, result, target in rows:
         print(f"| {label.ljust(width)} | {result} | {target} |")
+    if failed:
+        raise SystemExit(f"run_all: failed: {', '.join(failed)} (the table has the rest)")
 
 
 if __name__ == "__main__":
