@@ -15,6 +15,7 @@ import re
 import secrets
 import stat
 import sys
+import time
 from pathlib import Path
 
 from appmode.errors import AppmodeError
@@ -58,6 +59,32 @@ def data_folder() -> Path:
     else:
         base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
     return base / "appmode"
+
+
+def recordings_folder() -> Path:
+    """Where recordings started from the web page go (`data_folder()`/recordings)."""
+    return data_folder() / "recordings"
+
+
+def new_recording() -> Path:
+    """A new file in `recordings_folder()` (made if need be, for the user alone), named
+    by the time: the page asks for a recording, never names a file."""
+    folder = recordings_folder()
+    try:
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    except OSError as exc:
+        raise AppmodeError(f"cannot make the folder {folder}: {exc.strerror}") from None
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for n in range(1000):
+        path = folder / f"web-{stamp}{f'-{n}' if n else ''}.transcript"
+        try:
+            os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _CLOEXEC, 0o600))
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            raise AppmodeError(f"cannot write transcript {path}: {exc.strerror}") from None
+        return path
+    raise AppmodeError(f"cannot find a new name in {folder}: remove old recordings")
 
 
 def check_writable(path: str | os.PathLike[str], what: str) -> None:

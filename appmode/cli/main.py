@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 from types import ModuleType
 
 from appmode import __version__
+from appmode.cli import outlet
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
@@ -21,6 +22,9 @@ from appmode.host import signals
 OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
 
+DRIVES = frozenset({"drive", "web", "demo", "send", "params", "replay", "conform", "tap"})
+"""The commands that can move a car: their output goes through bounded writers
+(`outlet`), so that no reader of it can hold up the stop."""
 Handler = Callable[[argparse.Namespace], int]
 BUG_STATUS = 70
 """The exit status of a bug in appmode (BSD's EX_SOFTWARE)."""
@@ -67,8 +71,24 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         return 2
     words = sys.argv[1:] if argv is None else argv
-    parser = build_parser(command_in(words))
+    command = command_in(words)
+    parser = build_parser(command)
     signals.install()
+    outlets = outlet.install() if command in DRIVES else None
+    try:
+        status = _run(parser, words)
+    finally:
+        lost = outlet.finish(outlets) if outlets is not None else None
+        signals.finish()
+    if lost is not None:
+        with contextlib.suppress(OSError):
+            print(f"appmode: error: {lost}", file=sys.stderr)
+        return status or 2
+    return status
+
+
+def _run(parser: argparse.ArgumentParser, words: Sequence[str]) -> int:
+    """Parse and run the command, every mistake as one line on stderr; its exit status."""
     try:
         try:
             args = parser.parse_args(words)
@@ -97,8 +117,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # a bug: one line that says so, the traceback on request
         report_bug(exc)
         return BUG_STATUS
-    finally:
-        signals.finish()
 
 
 def report_bug(exc: Exception) -> None:

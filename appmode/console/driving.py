@@ -27,7 +27,8 @@ def run_drive(
 ) -> int:
     """Start the session, run the console (or script mode), and always close it: the
     stop last. Values set and not saved are named at the end. Script mode ends at the
-    first error (every line with `keep_going`); its exit status is 1 if any line failed."""
+    first error (every line with `keep_going`); its exit status is 1 if any line failed,
+    or (in either mode) if the recording stopped on its own."""
     try:
         session.start()
         if interactive:
@@ -49,4 +50,10 @@ def run_drive(
                     else "the board keeps it until it is switched off"
                 )
                 print(f"appmode: {warning}: {lasts}", file=sys.stderr)
-    return 1 if session.failures and not interactive else 0
+            if session.recording_failure is not None and interactive:
+                print(
+                    f"appmode: error: {session.recording_failure}; the recording stopped there",
+                    file=sys.stderr,
+                )
+    failed = session.failures and not interactive
+    return 1 if failed or session.recording_failure is not None else 0

@@ -8,6 +8,7 @@ ControlHost` on UART2) build on it and decode what `_read_once` brings.
 from __future__ import annotations
 
 import contextlib
+import threading
 import time
 from collections.abc import Callable, Iterator
 from types import TracebackType
@@ -58,6 +59,7 @@ class Link(Generic[E]):
         self.tap = tap
         self._opener = opener
         self._port: serial.SerialBase | None = opener(url)
+        self._writing = threading.Lock()  # the stop guard may write from its thread
         # after opening: an in-process sim:// board booted just now, and its clock is ours
         board_origin = getattr(self._port, "clock_origin", None)
         self._origin = time.monotonic() if board_origin is None else float(board_origin)
@@ -134,25 +136,28 @@ class Link(Generic[E]):
         """Write bytes to the board, CHUNK at a time, each tapped and followed (`_sent`)
         as it leaves; LinkLost if the link is down. An ending signal waits for the chunk
         under way: what the session end knows is what really left."""
-        if self._port is None:
-            self._reconnect()
-        if self._port is None:
-            raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
-        for start in range(0, len(data), CHUNK):
-            chunk = data[start : start + CHUNK]
-            self._pace(len(chunk))
-            with signals.atomic():
-                port = self._port
-                if port is None:  # lost at the last chunk
-                    raise LinkLost(f"link to {self.url} lost while sending")
-                try:
-                    port.write(chunk)
-                except (serial.SerialException, OSError) as exc:
-                    self._lost(exc)
-                    raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
-                if self.tap is not None:
-                    self.tap(self.sent, self._written_at(port), chunk)
-                self._sent(chunk)
+        with self._writing:
+            if self._port is None:
+                self._reconnect()
+            if self._port is None:
+                raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
+            for start in range(0, len(data), CHUNK):
+                self._write_chunk(data[start : start + CHUNK])
+
+    def _write_chunk(self, chunk: bytes) -> None:
+        self._pace(len(chunk))
+        with signals.atomic():
+            port = self._port
+            if port is None:  # lost at the last chunk
+                raise LinkLost(f"link to {self.url} lost while sending")
+            try:
+                port.write(chunk)
+            except (serial.SerialException, OSError) as exc:
+                self._lost(exc)
+                raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
+            if self.tap is not None:
+                self.tap(self.sent, self._written_at(port), chunk)
+            self._sent(chunk)
 
     def _written_at(self, port: serial.SerialBase) -> float:
         """When the bytes just written left: the time the board took them for a port that

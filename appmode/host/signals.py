@@ -14,6 +14,8 @@ is Ctrl-C. `install()` gives all three one handler, which:
 from __future__ import annotations
 
 import signal
+import threading
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -26,6 +28,7 @@ ENDING_SIGNALS: tuple[signal.Signals, ...] = tuple(
 class _Ending:
     def __init__(self) -> None:
         self.ended = False  # an ending signal has been acted on
+        self.since: float | None = None  # when the first ending signal came (monotonic)
         self.depth = 0  # atomic steps under way
         self.pending = False  # a signal came during one
         self.action: Callable[[], None] | None = None
@@ -39,6 +42,7 @@ def install() -> None:
     """Handle SIGINT, SIGTERM and SIGHUP as above (in the main thread), from now: an
     ending acted on before is forgotten."""
     _ending.ended = _ending.pending = False
+    _ending.since = None
     for signum in (signal.SIGINT, *ENDING_SIGNALS):
         _ending.before[signum] = signal.signal(signum, _handle)
 
@@ -52,7 +56,16 @@ def finish() -> None:
     _ending.before.clear()
 
 
+def ending_since() -> float | None:
+    """When (time.monotonic) the first ending signal of this command came, or None:
+    the stop guard (`session.authority`) acts when the session has not ended soon
+    after."""
+    return _ending.since
+
+
 def _handle(signum: int, frame: object) -> None:
+    if _ending.since is None:
+        _ending.since = time.monotonic()
     if _ending.ended:
         return
     if _ending.depth:
@@ -68,7 +81,11 @@ def _handle(signum: int, frame: object) -> None:
 @contextmanager
 def atomic() -> Iterator[None]:
     """A step that an ending signal must not cut in two: the signal takes effect when
-    the step is done."""
+    the step is done. Signals reach the main thread only: another thread's step (the
+    stop guard's) needs no such care."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
     _ending.depth += 1
     try:
         yield

@@ -11,15 +11,21 @@ import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from typing import BinaryIO, TextIO
 
 from appmode.errors import AppmodeError
 from appmode.files import is_fifo, open_fifo
 from appmode.protocol.escaping import escape, unescape
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2, Event, PortsReader
+from appmode.writer import BoundedWriter
 
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
 HEADER = "# appmode transcript v1"
 SUFFIX = ".transcript"
+HEADER_WAIT = 0.1
+"""Seconds `Recorder.create` waits to see a file take its header (a file or device
+takes it at once; a full one fails then, and the caller is told)."""
 MAX_TIME = 86400.0
 """The latest time a line may have: a day. Later is surely a mistake, and a run to it
 could not finish."""
@@ -116,15 +122,17 @@ class Recorder:
 
     def __init__(
         self,
-        out: TextIO,
+        out: TextIO | BoundedWriter,
         origin: float = 0.0,
         directives: tuple[str, ...] = (),
         name: str | None = None,
     ) -> None:
         self._out = out
-        self._owned = False  # a stream given by the caller stays open
+        """A stream given by the caller (written at once, and left open), or the bounded
+        writer of a file `create` opened (written off the caller's thread)."""
         self.name = name or str(getattr(out, "name", "the transcript"))
         self._failed = False
+        self._closed = False
         self._origin = origin
         self._reader = PortsReader()
         self._held = {direction: _Held() for direction in DIRECTIONS}
@@ -136,26 +144,27 @@ class Recorder:
     def create(
         cls, path: str | os.PathLike[str], origin: float = 0.0, directives: tuple[str, ...] = ()
     ) -> Recorder:
+        """A recorder of the file `path`, written by a `BoundedWriter`: a full disk, a
+        FIFO nobody reads or a stalled reader never holds up the caller (the recording
+        stops, and the next call or `close` says why)."""
+        shown = os.fspath(path)
+        if is_fifo(path):  # its open waits for a reader: in the writer's thread
+            opener = partial(open_fifo, path, "transcript")
+            return cls(BoundedWriter(opener, shown), origin, directives)
         new = not os.path.lexists(path)
         try:
-            if is_fifo(path):  # written as it is read: opened without waiting for a reader
-                out = os.fdopen(open_fifo(path, "transcript"), "w", encoding="utf-8")
-            else:
-                out = open(path, "w", encoding="utf-8")  # noqa: SIM115 - the recorder's
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | _CLOEXEC, 0o666)
         except OSError as exc:
-            raise AppmodeError(
-                f"cannot write transcript {os.fspath(path)}: {exc.strerror}"
-            ) from None
-        try:
-            recorder = cls(out, origin, directives, os.fspath(path))
-        except AppmodeError:  # not even the header fits (a full disk): leave nothing
-            with contextlib.suppress(OSError):
-                out.close()
-            if new:
+            raise AppmodeError(f"cannot write transcript {shown}: {exc.strerror}") from None
+        recorder = cls(BoundedWriter(lambda: fd, shown), origin, directives)
+        writer = recorder._out
+        assert isinstance(writer, BoundedWriter)
+        if not writer.drained(HEADER_WAIT):  # not even the header fits (a full disk)
+            writer.close(0.0)
+            if new:  # leave nothing
                 with contextlib.suppress(OSError):
                     os.unlink(path)
-            raise
-        recorder._owned = True
+            raise AppmodeError(f"cannot write transcript {shown}: {writer.failure}")
         return recorder
 
     def __call__(self, direction: str, time: float, data: bytes) -> None:
@@ -200,6 +209,11 @@ class Recorder:
         self._write(f"{max(0.0, time - self._origin):.{TIME_DIGITS}f} {direction} {payload}\n")
 
     def _write(self, text: str) -> None:
+        if isinstance(self._out, BoundedWriter):
+            if self._failed or not self._out.write(text.encode("utf-8")):
+                self._failed = True
+                raise AppmodeError(f"cannot write transcript {self.name}: {self._out.failure}")
+            return
         try:
             self._out.write(text)
             self._out.flush()
@@ -208,24 +222,28 @@ class Recorder:
             reason = "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror
             raise AppmodeError(f"cannot write transcript {self.name}: {reason}") from None
 
-    def close(self) -> None:
-        """Write what the decoders still hold, and close the file (if it opened it).
+    @property
+    def failure(self) -> str | None:
+        """Why the recording stopped, if it did (a file's writer fails on its own)."""
+        if isinstance(self._out, BoundedWriter) and self._out.failure is not None:
+            return f"cannot write transcript {self.name}: {self._out.failure}"
+        return f"cannot write transcript {self.name}" if self._failed else None
 
-        After a failed write it only closes the file: that failure was reported."""
-        if self._out.closed:
+    def close(self) -> None:
+        """Write what the decoders still hold, and close the file (if it opened it),
+        waiting at most CLOSE_WAIT for its writer; AppmodeError if the recording is not
+        whole. After a failed write it only closes the file: that failure was reported."""
+        if self._closed:
             return
-        if self._failed:
-            if self._owned:
-                with contextlib.suppress(OSError):
-                    self._out.close()
-            return
-        self._units(self._reader.flush())
-        self._release(math.inf)
-        if self._owned:
-            try:
-                self._out.close()
-            except OSError as exc:
-                raise AppmodeError(f"cannot write transcript {self.name}: {exc.strerror}") from None
+        self._closed = True
+        if not self._failed:
+            with contextlib.suppress(AppmodeError):  # the writer's failure is said below
+                self._units(self._reader.flush())
+                self._release(math.inf)
+        if isinstance(self._out, BoundedWriter):
+            whole = self._out.close() and not self._failed
+            if not whole and not self._failed:
+                raise AppmodeError(f"cannot write transcript {self.name}: {self._out.failure}")
 
 
 # ---------------------------------------------------------------- reading

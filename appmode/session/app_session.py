@@ -89,13 +89,16 @@ class Session(BaseSession):
     # ------------------------------------------------------------ life cycle
 
     def start(self) -> None:
-        """Put the board on the direction page (stopped) and read its parameters."""
+        """Put the board on the direction page (stopped) and read its parameters; the
+        stop guard starts watching."""
+        self.guard.start()
         self.switch_page("J")
         self.host.start_query(ParamQuery(where=self.url))
 
     def close(self) -> None:
         """Stop the car — `Z` is the last byte sent, and with `stop_again` confirmed on
         the board's A records — and close everything."""
+        self.guard.close()
         try:
             self.host.close()
         finally:
@@ -126,7 +129,7 @@ class Session(BaseSession):
         if self.driving.release_due(self.host.now()):
             self._send_letter(STOP_LETTER)
             return True
-        return bool(events)
+        return self.watch() or bool(events)
 
     # ------------------------------------------------------------ driving
 
@@ -144,6 +147,17 @@ class Session(BaseSession):
     def stop(self) -> None:
         self.driving.stop()
         self._send_letter(STOP_LETTER)
+
+    @property
+    def moving(self) -> bool:
+        return self.in_force != STOP_LETTER
+
+    def _guard_stop(self) -> None:
+        self.host.send(self.host.state.end.stop)
+
+    def _forget_motion(self) -> None:
+        self.driving.stop()
+        self.in_force = STOP_LETTER
 
     def switch_page(self, letter: str) -> None:
         self.driving.stop()

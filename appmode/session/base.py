@@ -6,7 +6,6 @@ the control port.
 
 from __future__ import annotations
 
-import contextlib
 import shlex
 from abc import ABC, abstractmethod
 from collections import deque
@@ -15,10 +14,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 from appmode.errors import AppmodeError
+from appmode.files import new_recording, recordings_folder
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.sim import sim_directives
 from appmode.ports.urls import is_simulated
 from appmode.protocol.transcript import Recorder
+from appmode.session.authority import STALL, StopGuard
 from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped
 
@@ -83,9 +84,19 @@ def _latch(session: BaseSession, args: list[str]) -> None:
 
 
 def _record(session: BaseSession, args: list[str]) -> None:
-    if len(args) != 1:
-        raise AppmodeError("usage: record FILE, or record stop")
-    session.stop_recording() if args[0] == "stop" else session.start_recording(args[0])
+    if args == ["stop"]:
+        session.stop_recording()
+    elif session.names_files:
+        if len(args) != 1:
+            raise AppmodeError("usage: record FILE, or record stop")
+        session.start_recording(args[0])
+    elif args in ([], ["start"]):
+        session.start_recording(str(new_recording()))
+    else:
+        raise AppmodeError(
+            f"the page names no file: 'record' starts a recording in {recordings_folder()} "
+            "under a new name, 'record stop' ends it"
+        )
 
 
 def _wait(session: BaseSession, args: list[str]) -> Wait:
@@ -140,12 +151,24 @@ class BaseSession(ABC):
         """Commands and queries that failed (`fail`)."""
         self.on_message = on_message
         self.recorder: Recorder | None = None
+        self.names_files = True
+        """The command line may name files (`record FILE`); a page's may not: its
+        recordings go to `recordings_folder()` under names appmode makes."""
+        self.recording_failure: str | None = None
+        """Why a recording stopped on its own (the command then exits non-zero)."""
         specs: tuple[CommandSpec[Any], ...] = (*self.commands, *COMMON)
         self._specs = {spec.name: spec for spec in specs}
         self.completions: dict[str, object] = {spec.name: spec.completes for spec in specs}
         """Every command's name, and what the command line completes after it."""
         self.closing_notes: list[str] = []
         """What closing had to do beyond its stop, for people (shown after the console)."""
+        self.lease: float | None = None
+        """Seconds any motion lasts without `keepalive` (a page's heartbeats); None: the
+        view's own ticks prove it alive (the console, a script)."""
+        self._alive_at = 0.0
+        self._quiet_said = False
+        self.guard = StopGuard(lambda: self.moving, self._guard_stop)
+        """The stop authority's thread: stops the car when the ticks stall."""
 
     # ------------------------------------------------------------ what a session is
 
@@ -184,6 +207,45 @@ class BaseSession(ABC):
     @abstractmethod
     def stop(self) -> None:
         """Stop the car now."""
+
+    @property
+    @abstractmethod
+    def moving(self) -> bool:
+        """Whether motion is in force, whatever started it (a key, a command, a stick,
+        raw bytes, a turn)."""
+
+    @abstractmethod
+    def _guard_stop(self) -> None:
+        """Send the port's stop and nothing else (from the stop guard's thread)."""
+
+    @abstractmethod
+    def _forget_motion(self) -> None:
+        """The car was stopped another way: nothing is in force any more."""
+
+    # ------------------------------------------------------------ the stop authority
+
+    def keepalive(self) -> None:
+        """The motion's source proves it is alive (a page's heartbeat)."""
+        self._alive_at = self.now()
+        self._quiet_said = False
+
+    def watch(self) -> bool:
+        """At each tick: end motion whose source has gone quiet (`lease`), and take note
+        of a stop the guard sent while the ticks stalled; whether the car was stopped."""
+        if self.guard.beat():
+            self._forget_motion()
+            self.say(f"stopped: the session stalled for over {STALL:g} s (its view was blocked)")
+            return True
+        if self.lease is None or not self.moving:
+            return False
+        quiet = self.now() - self._alive_at
+        if quiet <= self.lease:
+            return False
+        self.stop()
+        if not self._quiet_said:
+            self._quiet_said = True
+            self.say(f"stopped: no heartbeat from the page for {quiet:.2f} s")
+        return True
 
     def steer(self, x: float, y: float) -> None:
         """An analog stick (x right, y forward, each −1…1), where the port takes one."""
@@ -275,13 +337,23 @@ class BaseSession(ABC):
             self.recorder(direction, time, data)
         except AppmodeError as exc:
             self._drop_recorder()
-            self.say(f"{exc}; recording stopped")
+            self._recording_failed(str(exc))
+
+    def _recording_failed(self, text: str) -> None:
+        """A recording stopped on its own: said as an error, and remembered for the exit
+        status; the session and its stop go on."""
+        self.recording_failure = text
+        self.say(f"error: {text}; recording stopped")
 
     def _drop_recorder(self) -> None:
+        """Stop recording: what it still holds is written (never waiting long)."""
         recorder, self.recorder = self.recorder, None
-        if recorder is not None:
-            with contextlib.suppress(AppmodeError):
-                recorder.close()
+        if recorder is None:
+            return
+        try:
+            recorder.close()
+        except AppmodeError as exc:
+            self._recording_failed(str(exc))
 
     def start_recording(self, path: str, origin: float | None = None) -> None:
         """Record from now on, times counted from `origin` (default: now)."""

@@ -125,7 +125,9 @@ class ControlSession(BaseSession):
 
     def start(self) -> None:
         """Take the motion over with the zero velocity frame, then read the settings
-        (the encoder report is turned on for the session once system_mode is known)."""
+        (the encoder report is turned on for the session once system_mode is known); the
+        stop guard starts watching."""
+        self.guard.start()
         self._send(lambda: self.host.stop())
         if self.reads:
             self.query(SETTING_NAMES)
@@ -135,6 +137,7 @@ class ControlSession(BaseSession):
     def close(self) -> None:
         """`Z` on the APP port, then on UART2 the encoder report as it was and the zero
         velocity frame last; then the recording."""
+        self.guard.close()
         try:
             if self.app is not None:
                 self.app.close()
@@ -170,7 +173,7 @@ class ControlSession(BaseSession):
         if self.driving.release_due(self.now()):
             self.stop()
             return True
-        return bool(events)
+        return self.watch() or bool(events)
 
     def _done(self, outcome: ReadDone) -> None:
         values = outcome.values
@@ -276,6 +279,14 @@ class ControlSession(BaseSession):
         self.driving.stop()
         self._send(lambda: self.host.stop())
         self._forget_motion()
+
+    @property
+    def moving(self) -> bool:
+        frame = self.host.state.in_force
+        return self.in_force != STOP or self.rotation is not None or frame is not None
+
+    def _guard_stop(self) -> None:
+        self.host.stop()
 
     def _forget_motion(self) -> None:
         self.driving.stop()

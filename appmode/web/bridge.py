@@ -1,10 +1,12 @@
 """A driving session and the pages that show it: one page drives, the others watch.
 
 What a page sends is checked here and goes through the session's own code — a touch on
-the pad is the session's `press`, as a key in the terminal is. A held direction stays
-only while the page's heartbeats come: the session's hold-to-drive runs with HEARTBEAT
-as both its timeouts, so a page that goes quiet (a dropped network, a frozen or crashed
-browser) stops the car within that time.
+the pad is the session's `press`, as a key in the terminal is. Any motion lasts only
+while the driving page proves it is alive: it sends a heartbeat (`alive`) every 100 ms,
+and the session's lease (`BaseSession.lease`) is HEARTBEAT, whatever started the motion
+(the pad, a latch, the command line, the stick, a turn); a held direction also needs
+its repeats (hold-to-drive with HEARTBEAT as both timeouts). A page that goes quiet (a
+dropped network, a frozen renderer or browser) stops the car within that time.
 """
 
 from __future__ import annotations
@@ -59,6 +61,8 @@ class Bridge:
 
     def __init__(self, session: BaseSession) -> None:
         self.session = session
+        session.lease = HEARTBEAT
+        session.names_files = False  # a page names no file on this machine
         self.driver: object | None = None
         self.pages: dict[object, Bucket] = {}
         self.waves: set[object] = set()
@@ -69,6 +73,7 @@ class Bridge:
         self.pages[page] = Bucket()
         if self.driver is None:
             self.driver = page
+            self.session.keepalive()
 
     def leave(self, page: object) -> None:
         """A page closed (or lost its connection): if it drove, the car stops."""
@@ -90,6 +95,8 @@ class Bridge:
             if page is self.driver and self.session.driving.current is not None:
                 self.session.stop()  # a page that floods loses the car: stopped, once
             return {"t": "error", "text": "too many messages: slow down (the car is stopped)"}
+        if page is self.driver:
+            self.session.keepalive()  # any message proves the driving page alive
         if len(text) > MAX_MESSAGE:
             return {"t": "error", "text": f"message over {MAX_MESSAGE} bytes: ignored"}
         try:
@@ -97,6 +104,8 @@ class Bridge:
         except (ValueError, UnicodeDecodeError):
             return {"t": "error", "text": "not JSON: ignored"}
         kind = message.get("t") if isinstance(message, dict) else None
+        if kind == "alive":
+            return None
         if kind == "take":
             return self._take(page)
         if kind == "waves":
@@ -147,6 +156,7 @@ class Bridge:
         if page is not self.driver:
             self.session.stop()
             self.driver = page
+            self.session.keepalive()
             self.session.say("another page took over driving")
         return None
 

@@ -1,6 +1,7 @@
 // appmode web: the pad, tilt, gamepad, parameters, waveforms and the command line over
-// one websocket. A held direction is sent again every HEARTBEAT_MS; the server stops
-// the car when they stop coming (a dropped network, a frozen page), and on every release.
+// one websocket. The page says it is alive every HEARTBEAT_MS, and a held direction is
+// sent again as often; the server stops the car when either stops coming (a dropped
+// network, a frozen page), however the motion began, and on every release.
 "use strict";
 
 const HEARTBEAT_MS = 100;
@@ -430,3 +431,4 @@ function connect() {
 }
 
 connect();
+setInterval(() => send({ t: "alive" }), HEARTBEAT_MS);

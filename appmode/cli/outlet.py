@@ -1,0 +1,91 @@
+"""Standard output and error through bounded writers, for the commands that drive a car:
+a pipe nobody reads, a FIFO whose reader stalls or a paused terminal never holds up the
+session, its stop or a signal (`writer.BoundedWriter`).
+
+A write never waits. A reader that left, or a full disk, is reported as a plain stream
+would report it, at the next write (BrokenPipeError, OSError); a reader that takes
+nothing for the writer's whole bound loses the output from there on, and the command
+says so and exits non-zero (`finish`).
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import sys
+from typing import TextIO, cast
+
+from appmode.host import signals
+from appmode.writer import CLOSE_WAIT, BoundedWriter
+
+STEP = 0.1
+"""Seconds between looks at a draining writer (a signal is acted on between them)."""
+
+
+class Outlet:
+    """A text stream (as much of one as print and prompt_toolkit use) over a
+    BoundedWriter on a copy of `stream`'s file descriptor."""
+
+    def __init__(self, stream: TextIO, name: str) -> None:
+        fd = os.dup(stream.fileno())
+        self._stream = stream
+        self.name = name
+        self.encoding = getattr(stream, "encoding", None) or "utf-8"
+        self.errors = "replace"
+        self.writer = BoundedWriter(lambda: fd, name)
+
+    def fileno(self) -> int:
+        return self._stream.fileno()
+
+    def isatty(self) -> bool:
+        return self._stream.isatty()
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, text: str) -> int:
+        error = self.writer.error
+        if error is not None:
+            raise error
+        self.writer.write(text.encode(self.encoding, self.errors))
+        return len(text)
+
+    def flush(self) -> None:
+        """Nothing to wait for: the writer writes as soon as it can."""
+
+
+def install() -> tuple[Outlet, Outlet] | None:
+    """Put Outlets in place of sys.stdout and sys.stderr, unless they are not the
+    process's own (a test's capture): then None."""
+    out, err = sys.stdout, sys.stderr
+    if out is not sys.__stdout__ or err is not sys.__stderr__ or out is None or err is None:
+        return None
+    try:
+        outlets = Outlet(out, "standard output"), Outlet(err, "standard error")
+    except (OSError, ValueError, AttributeError):
+        return None
+    sys.stdout, sys.stderr = (cast(TextIO, outlet) for outlet in outlets)
+    return outlets
+
+
+def finish(outlets: tuple[Outlet, Outlet]) -> str | None:
+    """Let the outlets write what they hold and put the streams back: waiting as a
+    plain stream would (a signal ends the wait), or at most CLOSE_WAIT after an ending
+    signal; why output was lost, if it was (a reader that left, as `cat`, loses
+    nothing worth saying)."""
+    out, err = outlets
+    lost = None
+    for outlet in (out, err):
+        while outlet.writer.pending and outlet.writer.failure is None:
+            since = signals.ending_since()
+            if since is not None:
+                outlet.writer.close(CLOSE_WAIT)
+                break
+            outlet.writer.drained(STEP)
+        outlet.writer.close(0.0 if outlet.writer.failure else CLOSE_WAIT)
+        error = outlet.writer.error
+        quiet = error is not None and error.errno == errno.EPIPE  # `| head`: as cat does
+        if outlet is out and outlet.writer.failure is not None and not quiet:
+            lost = f"cannot write the output: {outlet.writer.failure}"
+    sys.stdout, sys.stderr = sys.__stdout__, sys.__stderr__
+    return lost

@@ -1,0 +1,147 @@
+"""A bounded writer: bytes handed over at once, written by a thread of their own.
+
+Whoever drives the car must never wait for a disk, a pipe nobody reads, a FIFO whose
+reader stalls or a terminal that is paused: a recording or an output line written on
+that path would hold up the stop and the signals. `BoundedWriter.write` only queues;
+its thread opens the file (a FIFO's open waits for a reader there, not here) and writes.
+It holds at most `limit` bytes; when its reader cannot keep up, or a write fails (a full
+disk, a file size limit, a reader that left), it stops writing for good and keeps why
+in `failure`, which the caller reports (stderr, a non-zero exit) while the session and
+its stop go on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import threading
+from collections import deque
+from collections.abc import Callable
+
+LIMIT = 1 << 20
+"""Bytes a writer holds for a slow reader before it gives up: minutes of a recording."""
+CLOSE_WAIT = 0.5
+"""Seconds `close` waits for the writer to drain: a signal ends a session within 1 s."""
+
+
+class BoundedWriter:
+    """Writes to the file descriptor that `opener` gives (called in the writer's thread),
+    in order, from a queue of at most `limit` bytes."""
+
+    def __init__(
+        self,
+        opener: Callable[[], int],
+        name: str,
+        limit: int = LIMIT,
+        close_fd: bool = True,
+    ) -> None:
+        self.name = name
+        self.limit = limit
+        self.failure: str | None = None
+        """Why writing stopped (None while it goes on)."""
+        self.error: OSError | None = None
+        """The error that stopped it, where one did (not a reader too slow)."""
+        self._opener = opener
+        self._close_fd = close_fd
+        self._queue: deque[bytes] = deque()
+        self._held = 0  # bytes queued and not yet written
+        self._closing = False
+        self._done = threading.Event()  # the thread has ended
+        self._lock = threading.Condition()
+        self._thread = threading.Thread(target=self._run, name=f"writer {name}", daemon=True)
+        self._thread.start()
+
+    def write(self, data: bytes) -> bool:
+        """Queue `data`; never waits. False once writing has stopped (see `failure`)."""
+        with self._lock:
+            if self.failure is not None or self._closing:
+                return False
+            if self._held + len(data) > self.limit:
+                self._fail(f"its reader took nothing for {self._held:,} bytes")
+                return False
+            self._queue.append(data)
+            self._held += len(data)
+            self._lock.notify()
+        return True
+
+    @property
+    def pending(self) -> int:
+        """Bytes queued and not yet written."""
+        return self._held
+
+    def drained(self, wait: float = CLOSE_WAIT) -> bool:
+        """Wait at most `wait` seconds for what is queued to be written; whether it was
+        (False also once writing has stopped)."""
+        with self._lock:
+            self._lock.wait_for(lambda: not self._held or self.failure is not None, wait)
+            return not self._held and self.failure is None
+
+    def close(self, wait: float = CLOSE_WAIT) -> bool:
+        """Let the writer finish what it holds, for at most `wait` seconds, and end it;
+        whether everything was written (else `failure` says why)."""
+        with self._lock:
+            self._closing = True
+            self._lock.notify()
+        if not self._done.wait(wait):
+            with self._lock:
+                if self.failure is None:
+                    self._fail(f"{self._held:,} bytes were still unwritten after {wait:g} s")
+            return False
+        return self.failure is None
+
+    def _fail(self, why: str) -> None:
+        """Stop writing (the lock held): what is queued is dropped."""
+        if self.failure is None:
+            self.failure = why
+        self._queue.clear()
+        self._held = 0
+        self._lock.notify_all()
+
+    def _run(self) -> None:
+        try:
+            fd = self._opener()
+        except OSError as exc:
+            with self._lock:
+                self.error = exc
+                self._fail(_reason(exc))
+            self._done.set()
+            return
+        try:
+            self._drain(fd)
+        finally:
+            if self._close_fd:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+            self._done.set()
+
+    def _drain(self, fd: int) -> None:
+        while True:
+            with self._lock:
+                while not self._queue and not self._closing and self.failure is None:
+                    self._lock.wait()
+                if self.failure is not None or not self._queue:
+                    return
+                data = self._queue[0]
+            try:  # outside the lock: `write` never waits for this
+                view = memoryview(data)
+                while view:
+                    view = view[os.write(fd, view) :]
+            except OSError as exc:
+                with self._lock:
+                    self.error = exc
+                    self._fail(_reason(exc))
+                return
+            with self._lock:
+                if self._queue and self._queue[0] is data:
+                    self._queue.popleft()
+                    self._held -= len(data)
+                    self._lock.notify_all()
+
+
+def _reason(exc: OSError) -> str:
+    if exc.errno == errno.EPIPE:
+        return "its reader left"
+    if exc.errno == errno.EFBIG:
+        return "the file size limit was reached"
+    return exc.strerror or str(exc)
