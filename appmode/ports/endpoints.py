@@ -5,6 +5,7 @@ UART does, what nobody reads."""
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import selectors
@@ -302,12 +303,18 @@ Endpoint = PtyEndpoint | TcpEndpoint | SerialEndpoint
 
 
 def parse_listen(text: str, option: str = "--listen") -> tuple[str, int]:
-    """`PORT` or `HOST:PORT` (host 127.0.0.1 by default)."""
+    """`PORT` or `HOST:PORT` (host 127.0.0.1 by default). An IPv4 address in a short or
+    numeric form the system also takes (`127.1`, `0x7f000001`, `0`) is written out as the
+    address it binds, so that what is loopback or every address is seen as such."""
     host, _, port = text.rpartition(":")
     number = params.whole(port)
     if number is None or number > 65535:
         raise AppmodeError(f"{option} {text!r}: expected HOST:PORT or PORT, e.g. 127.0.0.1:5000")
-    return host.strip("[]") or "127.0.0.1", number
+    host = host.strip("[]") or "127.0.0.1"
+    if host.isascii() and not host.isalpha():  # a name is kept as it is
+        with contextlib.suppress(OSError):
+            host = socket.inet_ntoa(socket.inet_aton(host))
+    return host, number
 
 
 MakeEndpoint = Callable[[selectors.BaseSelector, Log], Endpoint]

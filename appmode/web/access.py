@@ -18,8 +18,11 @@ def new_token() -> str:
 
 
 def token_matches(token: str, given: str | None) -> bool:
-    """Whether `given` is the token, compared in constant time."""
-    return given is not None and secrets.compare_digest(token.encode(), given.encode())
+    """Whether `given` is the token, compared in constant time (a header's bytes that are
+    no UTF-8 are simply not the token)."""
+    if given is None:
+        return False
+    return secrets.compare_digest(token.encode(), given.encode("utf-8", "surrogatepass"))
 
 
 def is_loopback(host: str) -> bool:

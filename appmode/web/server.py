@@ -13,8 +13,10 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import math
 import ssl
 import sys
+import time
 from collections.abc import Awaitable, Callable
 from contextlib import suppress
 from importlib import resources
@@ -35,6 +37,14 @@ from appmode.web.access import (
 )
 from appmode.web.bridge import MAX_MESSAGE, Bridge
 
+HEADER_TIMEOUT = 10.0
+"""Seconds a connection may take to send a whole request (aiohttp's keep-alive timeout
+also closes a connection whose first request never completes)."""
+MAX_CONNECTIONS = 64
+"""Connections served at once: more are closed as they come (a flood of half-sent
+requests would otherwise use up the server's open files and lock its owner out)."""
+LOG_EVERY = 10.0
+"""Seconds between two log lines of one kind (a flood of bad requests logs one)."""
 REFRESH = 0.02
 """Seconds between reads of the link (and checks of the heartbeat)."""
 SEND = 0.1
@@ -87,7 +97,9 @@ class WebServer:
 
     async def start(self) -> None:
         """Listen (port 0 picks a free one: `port` then says which)."""
-        self._runner = web.AppRunner(self.app, access_log=None, handle_signals=False)
+        self._runner = _CappedRunner(
+            self.app, access_log=None, handle_signals=False, keepalive_timeout=HEADER_TIMEOUT
+        )
         await self._runner.setup()
         site = web.TCPSite(
             self._runner, self.host, self.port, shutdown_timeout=0.5, ssl_context=self.tls
@@ -122,7 +134,13 @@ class WebServer:
                 return _refused("wrong token: open the address appmode web printed")
             found = web.HTTPSeeOther("/")  # the token leaves the address bar
             found.set_cookie(
-                COOKIE, self.token, httponly=True, samesite="Strict", path="/", max_age=None
+                COOKIE,
+                self.token,
+                httponly=True,
+                samesite="Strict",
+                path="/",
+                max_age=None,
+                secure=self.tls is not None,  # never sent to a plain-HTTP server
             )
             return found
         if not token_matches(self.token, request.cookies.get(COOKIE)):
@@ -198,26 +216,71 @@ class WebServer:
                 await self.stop()
 
 
+class _CappedRunner(web.AppRunner):
+    """An AppRunner whose server closes connections past MAX_CONNECTIONS at once."""
+
+    async def _make_server(self) -> web.Server:
+        server = await super()._make_server()
+        made = server.connection_made
+
+        def connection_made(handler: Any, transport: asyncio.Transport) -> None:
+            made(handler, transport)
+            if len(server.connections) > MAX_CONNECTIONS:
+                transport.close()
+
+        server.connection_made = connection_made  # type: ignore[method-assign]
+        return server
+
+
+class Throttle:
+    """One log line of a kind every LOG_EVERY seconds; how many were left out between."""
+
+    def __init__(self, every: float = LOG_EVERY) -> None:
+        self.every = every
+        self._last: dict[str, float] = {}
+        self._left_out: dict[str, int] = {}
+
+    def allow(self, kind: str) -> int | None:
+        """None to leave this line out; else how many of its kind were left out."""
+        now = time.monotonic()
+        if now - self._last.get(kind, -math.inf) < self.every:
+            self._left_out[kind] = self._left_out.get(kind, 0) + 1
+            return None
+        self._last[kind] = now
+        return self._left_out.pop(kind, 0)
+
+
+_throttle = Throttle()
+
+
+def _say_throttled(kind: str, text: str) -> None:
+    left_out = _throttle.allow(kind)
+    if left_out is not None:
+        more = f" ({left_out:,} more like it left out)" if left_out else ""
+        print(f"appmode web: {text}{more}", file=sys.stderr)
+
+
 def _one_line(loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
-    """What the event loop would print with a traceback, in a line."""
+    """What the event loop would print with a traceback, in a line (a flood, once per
+    LOG_EVERY seconds: accept errors while open files run out)."""
     error = context.get("exception")
-    print(
-        f"appmode web: {context.get('message')}{f': {error!r}' if error else ''}", file=sys.stderr
-    )
+    message = str(context.get("message"))
+    _say_throttled(message, f"{message}{f': {error!r}' if error else ''}")
 
 
 def _refused(text: str) -> web.Response:
     return web.Response(status=403, text=f"403: {text}\n", headers=HEADERS)
 
 
-class _OneLine(logging.Formatter):
-    """The server's own complaints (a handler that failed), one line each."""
+class _OneLine(logging.Handler):
+    """The server's own complaints (a handler that failed, a malformed request), one line
+    each, and one of a kind every LOG_EVERY seconds."""
 
-    def format(self, record: logging.LogRecord) -> str:
+    def emit(self, record: logging.LogRecord) -> None:
         text = record.getMessage()
         if record.exc_info and record.exc_info[1] is not None:
             text += f": {record.exc_info[1]!r}"
-        return f"appmode web: {text}"
+        _say_throttled(f"{record.name} {record.msg}", text)
 
 
 def serve_web(
@@ -231,11 +294,10 @@ def serve_web(
     """Start the session, serve the page until ended, and always close the session: its
     stop is the last thing sent. `names` are other addresses the page is reached at; a
     self-signed certificate's `fingerprint` is printed for the owner to check."""
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(_OneLine())
-    server_log = logging.getLogger("aiohttp")
-    server_log.addHandler(handler)
-    server_log.propagate = False
+    for name in ("aiohttp", "asyncio"):
+        server_log = logging.getLogger(name)
+        server_log.addHandler(_OneLine())
+        server_log.propagate = False
 
     def announce(server: WebServer) -> None:
         first = names[0] if names else None
