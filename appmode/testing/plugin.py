@@ -12,7 +12,11 @@ Fixtures:
 `--appmode-board URL` (and `--appmode-board2 URL` for its control port) runs the same
 tests against a real car: the fixtures give its URLs, and a test that needs what only
 the simulated board has (its state, its recording, a restart, faults) is skipped saying
-so. Nothing heavy is imported until a fixture is used.
+so. The URLs are checked once, before any test (one line if one does not open), and at
+every such test's teardown, passed or failed, the plugin sends the car its stop
+(`stop_again` of the marker's profile on the APP port: an open frame closed, a rotation
+ended, `Z`; the zero velocity frame on the control port). Nothing heavy is imported
+until a fixture is used.
 """
 
 from __future__ import annotations
@@ -57,6 +61,51 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", MARKER)
+    for option in ("--appmode-board", "--appmode-board2"):
+        url = config.getoption(option)
+        if url is not None:
+            _check_url(option, url)
+
+
+def _check_url(option: str, url: str) -> None:
+    """A real board's URL opens (else one line, and no test runs)."""
+    if not url.strip():
+        raise pytest.UsageError(f"{option} is empty: give the board's device or URL")
+    from appmode.errors import AppmodeError
+    from appmode.ports.urls import open_link
+
+    try:
+        open_link(url).close()
+    except AppmodeError as exc:
+        raise pytest.UsageError(f"{option} {url}: {exc}") from None
+
+
+def _stop_real(board: RealBoard, profile: str | None) -> None:
+    """Send a real car its stop, whatever the test left (it may have failed mid-drive)."""
+    from appmode.board.profiles import profile_named
+    from appmode.errors import AppmodeError
+    from appmode.line.wire import UART2_BAUD
+    from appmode.ports.urls import BAUD, open_link
+    from appmode.protocol import control
+    from appmode.protocol.session_end import stop_again
+
+    try:
+        steer_in_frames = profile_named(profile or "sheet").steer_in_frames
+    except AppmodeError:
+        steer_in_frames = False  # the marker's mistake is said where it is used
+    stops = [(board.port, stop_again(frames_take_letters=not steer_in_frames), BAUD)]
+    if board.uart2_url is not None:  # twice: the second is whole whatever half-frame was left
+        stops.append((board.uart2_url, control.STOP * 2, UART2_BAUD))
+    for url, stop, baud in stops:
+        try:
+            link = open_link(url, baud=baud)
+            try:
+                link.write(stop)
+                link.flush()
+            finally:
+                link.close()
+        except (AppmodeError, OSError) as exc:
+            pytest.fail(f"appmode_board: could not stop the car at {url}: {exc}", pytrace=False)
 
 
 def _options(request: pytest.FixtureRequest) -> dict[str, Any]:
@@ -85,13 +134,13 @@ class RealBoard:
 
     def __init__(self, port: str, uart2: str | None) -> None:
         self.port = port
-        self._uart2 = uart2
+        self.uart2_url = uart2
 
     @property
     def uart2(self) -> str:
-        if self._uart2 is None:
+        if self.uart2_url is None:
             pytest.skip("the test uses the control port (UART2): give --appmode-board2 URL")
-        return self._uart2
+        return self.uart2_url
 
     @staticmethod
     def _only_simulated(what: str) -> Any:
@@ -131,25 +180,32 @@ def appmode_board_factory(
     """`make(profile=…, drive=…, faults=…, pace=…, flash=…)`: a new simulated board on two
     ptys, stopped when the test ends."""
     boards: list[ServedBoard] = []
+    real_boards: list[tuple[RealBoard, str | None]] = []
     home = Path(request.path).parent
 
     def make(**options: Any) -> ServedBoard | RealBoard:
         _check_options(options)
         real = _real(request.config, options)
         if real is not None:
+            real_boards.append((real, options.get("profile")))
             return real
         from appmode.errors import AppmodeError
         from appmode.testing.served import ServedBoard
 
         folder = tmp_path_factory.mktemp("appmode_board")
+        failed = None
         try:
             board = ServedBoard(folder, home=home, **options)
         except AppmodeError as exc:
-            pytest.fail(f"appmode_board: {exc}", pytrace=False)
+            failed = str(exc).removeprefix("appmode_board: ")
+        if failed is not None:  # outside the except: one line, not two exceptions
+            pytest.fail(f"appmode_board: {failed}", pytrace=False)
         boards.append(board)
         return board
 
     yield make
+    for real_board, profile in real_boards:
+        _stop_real(real_board, profile)
     failures = []
     for board in boards:
         try:
@@ -171,19 +227,22 @@ def appmode_board(
 
 
 @pytest.fixture
-def appmode_sim_url(request: pytest.FixtureRequest) -> str:
+def appmode_sim_url(request: pytest.FixtureRequest) -> Iterator[str]:
     """`sim://?…&share=NAME`: the simulated board in-process, for code that opens a pyserial
     URL (`serial.serial_for_url`); add `&port=uart2` for the same board's control port.
-    Options by `@pytest.mark.appmode_board`; with --appmode-board, that board's URL."""
+    Options by `@pytest.mark.appmode_board`; with --appmode-board, that board's URL (and
+    the car's stop at the teardown)."""
     options = _options(request)
     _check_options(options)
     real = _real(request.config, options)
     if real is not None:
-        return real.port
+        yield real.port
+        _stop_real(real, options.get("profile"))
+        return
     import appmode.ports.urls  # noqa: F401 - registers sim:// with pyserial
 
     query = {k: v for k, v in options.items() if v not in (None, "")}
     if "pace" in query:
         query["pace"] = int(bool(query["pace"]))
     query["share"] = f"pytest-{next(_SHARES)}"
-    return f"sim://?{urlencode(query)}"
+    yield f"sim://?{urlencode(query)}"

@@ -188,3 +188,52 @@ def test_the_readme_example_passes(tmp_path: Path) -> None:
     done = pytest_in(tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
     assert "1 passed" in done.stdout
+
+
+def test_a_real_board_is_stopped_at_every_teardown_even_after_a_failure(
+    tmp_path: Path,
+) -> None:
+    """Issue 49.4: a test that wrote `JA` and failed left the car at `{A0:500:0:0}$`."""
+    (tmp_path / "pytest.ini").write_text("[pytest]\n")
+    (tmp_path / "test_car.py").write_text(
+        "import serial\n\n"
+        "def test_drives_then_fails(appmode_board):\n"
+        "    with serial.serial_for_url(appmode_board.port, 9600, timeout=1) as port:\n"
+        "        port.write(b'JA')\n"
+        "        port.flush()\n"
+        "    assert False, 'the test failed mid-drive'\n"
+    )
+    with ServedBoard(tmp_path / "car") as car:  # the "real" car, served on a pty
+        done = pytest_in(tmp_path, "--appmode-board", car.port)
+        car.wait_until(lambda state: state.velocity == (0, 0, 0), timeout=5)
+        sent = [e.data for e in car.recording().entries if e.direction == ">"]
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "the test failed mid-drive" in done.stdout
+    assert b"".join(sent).endswith(b"A{}KJZ"), sent
+
+
+@pytest.mark.parametrize("url", ["", "/dev/appmode-no-such-device"])
+def test_a_board_url_that_does_not_open_is_one_line_before_any_test(
+    tmp_path: Path, url: str
+) -> None:
+    (tmp_path / "pytest.ini").write_text("[pytest]\n")
+    (tmp_path / "test_car.py").write_text("def test_it(appmode_board):\n    pass\n")
+    done = pytest_in(tmp_path, "--appmode-board", url)
+    assert done.returncode == 4, done.stdout + done.stderr
+    [line] = [x for x in done.stderr.splitlines() if x.strip()]
+    assert line.startswith("ERROR: --appmode-board "), line
+    assert "Traceback" not in done.stdout + done.stderr
+
+
+def test_a_bad_marker_fails_in_one_line(tmp_path: Path) -> None:
+    (tmp_path / "pytest.ini").write_text("[pytest]\n")
+    (tmp_path / "test_car.py").write_text(
+        "import pytest\n\n"
+        "@pytest.mark.appmode_board(profile='nosuch')\n"
+        "def test_it(appmode_board):\n    pass\n"
+    )
+    done = pytest_in(tmp_path)
+    assert done.returncode == 1, done.stdout
+    assert "appmode_board: appmode_board:" not in done.stdout
+    assert "During handling of the above exception" not in done.stdout
+    assert "appmode_board: " in done.stdout
