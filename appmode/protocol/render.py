@@ -171,19 +171,27 @@ def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
     return f"{counted(len(event.raw), 'undecodable byte')}"
 
 
+MAX_RUN = 4096
+"""Bytes one merged Noise or Garbage event holds at most: a longer run (a megabyte of
+zeros) is several events, so memory stays bounded on any input."""
+
+
 def coalesce(events: Iterable[p.Event]) -> Iterator[p.Event]:
-    """Merge adjacent Noise or Garbage events into one event per run of bytes (in time
-    linear in the run: the pieces are joined once, when the run ends)."""
+    """Merge adjacent Noise or Garbage events into one event per run of bytes, of at
+    most MAX_RUN bytes (in time linear in the run: the pieces are joined once)."""
     run: list[p.Noise | p.Garbage] = []
+    size = 0
     for event in events:
-        if run and type(event) is type(run[0]):
+        if run and type(event) is type(run[0]) and size + len(event.raw) <= MAX_RUN:
             run.append(event)
+            size += len(event.raw)
             continue
         if run:
             yield _joined(run)
             run = []
         if isinstance(event, (p.Noise, p.Garbage)):
             run.append(event)
+            size = len(event.raw)
         else:
             yield event
     if run:

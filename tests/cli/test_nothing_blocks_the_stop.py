@@ -129,3 +129,20 @@ def test_a_recording_lost_to_a_file_size_limit_is_an_error(tmp_path: Path) -> No
     assert f"appmode: error: cannot write transcript {record}: " in done.stderr
     assert "recording stopped" in done.stderr
     assert "recording stopped" not in done.stdout
+
+
+def test_decode_is_bounded_on_a_stream_of_zeros(tmp_path: Path) -> None:
+    """Issue 49.9: 100 MB of zeros grew decode to 1.7 GB (one 500 MB JSON line)."""
+    zeros = tmp_path / "zeros"
+    with zeros.open("wb") as f:
+        f.truncate(20_000_000)
+    out = tmp_path / "out.jsonl"
+    with out.open("w") as sink:
+        proc = subprocess.Popen(
+            [*appmode_cmd("decode", str(zeros))], stdout=sink, stderr=subprocess.PIPE, cwd=ROOT
+        )
+        _, usage = os.wait4(proc.pid, 0)[1:]
+        proc.returncode = 0
+    assert usage.ru_maxrss < 200_000, f"{usage.ru_maxrss} KiB"  # Linux: KiB
+    longest = max(len(line) for line in out.open("rb"))
+    assert longest < 64_000, longest
