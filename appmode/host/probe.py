@@ -47,6 +47,10 @@ PERIOD_FIT = 0.1
 """How far (as a fraction) a measured record period may be from a firmware's."""
 READ_TRIES = 2
 """Rounds of `{Q:P}` for the parameters (each asks for two agreeing C records)."""
+STATUS_RATE = 40
+"""Status bursts a second at most from a control port that sends only those: the
+reference firmware sends one after each record (about 17 a second); a device that
+streams `00 FF` without pause makes thousands."""
 SAMPLE = 48
 """Bytes of text kept to show what a port that is not a board sent."""
 
@@ -83,7 +87,11 @@ class Heard:
 
     @property
     def carries_uart2(self) -> bool:
-        return self.uart2_bursts >= ENOUGH and 10 * self.uart2_bytes >= 8 * self.size
+        """Control-port traffic: encoder reports, or status bursts in a firmware's rhythm
+        (a few a second, not a stream of them), making up most of the bytes."""
+        if self.uart2_bursts < ENOUGH or 10 * self.uart2_bytes < 8 * self.size:
+            return False
+        return self.reports > 0 or self.uart2_bursts <= STATUS_RATE * max(self.seconds, 0.1)
 
     @property
     def text(self) -> bool:
@@ -244,6 +252,8 @@ def _probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
         close_quietly(port)
         if one.carries_uart2 and (baud == UART2_BAUD or fixed):
             return _control_port(path, one, heard, fixed)
+        if one.text and not one.records:
+            break  # text that reads as text: the rate is right, and no board talks so
         if len(heard) == 2 and not any(h.size for h in heard):
             break  # silent at the APP port's rate and at the control port's
     uart2 = next((h for h in heard if h.carries_uart2), None)  # at a rate of its own

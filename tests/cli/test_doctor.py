@@ -250,3 +250,42 @@ def test_a_port_that_goes_away_while_listened_to_is_said_so() -> None:
     assert found.kind == "lost" and not found.is_car
     assert found.verdict.startswith("it opened, then failed while listening")
     assert "the device went away" in found.fix
+
+
+@contextmanager
+def spewing_pty(code: str) -> Iterator[str]:
+    """A pseudo-terminal that a process writes to (`code`, with `master` its end)."""
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    spew = subprocess.Popen(
+        [sys.executable, "-c", f"import os,sys,time\nmaster = {master}\n{code}"],
+        pass_fds=(master,),
+    )
+    try:
+        yield os.ttyname(slave)
+    finally:
+        spew.kill()
+        spew.wait()
+        os.close(master)
+        os.close(slave)
+
+
+def test_a_device_streaming_00_ff_is_not_a_car_s_control_port() -> None:
+    """Issue 49.11: it was 'a car's control port … drive it with: appmode drive … --uart2'."""
+    with spewing_pty("while True:\n os.write(master, b'\\x00\\xff' * 256); time.sleep(0.01)") as p:
+        status, (found,), _ = doctor(p)
+    assert status == 1, found
+    assert found["kind"] != "uart2" and not found["car"], found
+    assert "--uart2" not in found["fix"]
+
+
+def test_text_is_told_as_quickly_as_silence() -> None:
+    """Issue 49.11: a port sending plain text took 20 s (2.5 s at each of eight rates)."""
+    code = "while True:\n os.write(master, b'Debian GNU/Linux 12 login: '); time.sleep(0.2)"
+    with spewing_pty(code) as path:
+        started = time.monotonic()
+        status, (found,), _ = doctor(path)
+        took = time.monotonic() - started
+    assert status == 1 and found["kind"] == "text"
+    assert len(found["heard"]) == 1, found["heard"]
+    assert took < 8, took
