@@ -408,11 +408,14 @@ class Board:
 
     def _pushes(self) -> tuple[int | None, ...]:
         """Which way a ramping board pushes x, y, z this tick (vehicle.ramp): with no
-        direction x and y coast, and z too on the button page; on the direction page a
-        rotation that ended stops at once (§13.1)."""
+        direction x and y coast, and z too on the sheet's button page; a rotation that
+        ended stops at once on the direction page (§13.1) and, where rotations are held
+        apart (sticky_rotation), on the button page too: there every byte but C and G
+        clears the rotation and z is 0 at the next tick (§13.2)."""
         core = self.core
         motion = motion_for(core.page, core.direction, core.profile.buttons)
-        z: int | None = core.turn or (0 if core.page is Page.DIRECTION else None)
+        stops_at_once = core.page is Page.DIRECTION or core.profile.sticky_rotation
+        z: int | None = core.turn or (0 if stops_at_once else None)
         if motion is None:
             return (None, None, z)
         x, y, turn = (int(math.copysign(1, f)) if f else 0 for f in motion.holonomic)

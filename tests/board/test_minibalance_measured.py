@@ -67,13 +67,32 @@ def test_the_a_record_scales_in_float32() -> None:
     assert a_after(records, ON + 3.0)[0].y == 63, "90 · 0.7f is 63 in float32, 62.999… in double"
 
 
-def test_a_rotation_that_ended_stops_at_once_on_the_direction_page() -> None:
-    script = [(ON, APP, b"KC"), (ON + 1.0, APP, b"B"), (ON + 1.1, APP, b"J")]
-    board, _, _ = play(script, ON + 1.09)
-    coasting = board.vehicle.vz
-    assert 0 < coasting < 30, "on the button page z coasts"
-    board, _, _ = play(script, ON + 1.13)
+def test_a_rotation_that_ended_stops_at_once_on_either_page() -> None:
+    """§13.1 on the direction page; §13.2 on the button page (where §13.1 had it coast)."""
+    script = [(ON, APP, b"KC"), (ON + 1.0, APP, b"B")]
+    board, _, _ = play(script, ON + 0.999)
+    assert board.vehicle.vz == 30
+    board, _, _ = play(script, ON + 1.011)
+    assert board.vehicle.vz == 0, "on the button page z is 0 at the next tick"
+    script = [(ON, APP, b"KC"), (ON + 1.0, APP, b"JA"), (ON + 1.1, APP, b"Z")]
+    board, _, _ = play(script, ON + 1.111)
     assert board.vehicle.vz == 0
+
+
+def test_s13_2_a_frame_on_the_button_page_ends_the_rotation_and_g_starts_it_from_0() -> None:
+    """§13.2's minimal case: KG, `{3:{}` at 0.560, G at 0.717, Z at 1.561 (the commanded
+    z, tick by tick: the frame's first byte zeroes it, G ramps it from 0, Z zeroes it)."""
+    script = [(ON, APP, b"KG"), (ON + 0.56, APP, b"{3:{}"), (ON + 0.717, APP, b"G")]
+    script.append((ON + 1.561, APP, b"Z"))
+    board, _, _ = play(script, ON + 0.559)
+    assert board.vehicle.vz < 0, "rotating left"
+    board, _, _ = play(script, ON + 0.571)
+    assert board.vehicle.vz == 0, "the frame's first byte cleared the rotation"
+    assert board.params[3] == 75, "`{3:{}` sets position_ki to 0x7B − 0x30"
+    board, _, _ = play(script, ON + 0.731)
+    assert -2 < board.vehicle.vz < 0, "G ramps z from 0, one step a tick"
+    board, _, _ = play(script, ON + 1.571)
+    assert board.vehicle.vz == 0, "Z stops it within one tick"
 
 
 def test_a_uart2_velocity_is_taken_unclamped_and_without_a_ramp() -> None:
