@@ -275,8 +275,12 @@ def run_conform(
     live = board is not None and not is_simulated(board)  # sim:// is a new board each time
     found = _read_params(board) if live and board is not None else None
     results: list[Result] = []
+    between = None
+    if board is not None and found is not None:
+        url, values = board, found
+        between = lambda: put_back(url, values)  # noqa: E731 - the run's own undo
     try:
-        _run_all(transcripts, board, progress, interactive, results, out, board2)
+        _run_all(transcripts, board, progress, interactive, results, out, board2, between)
     finally:
         if board is not None and found is not None:
             out.write(restore_params(board, found) + "\n")
@@ -316,7 +320,10 @@ def _run_all(
     results: list[Result],
     out: TextIO,
     board2: str | None = None,
+    between: Callable[[], str | None] | None = None,
 ) -> None:
+    """Run each transcript and write its line; `between` (a real board) puts back what a
+    transcript changed before the next runs, so that none relies on the ones before."""
     for transcript in transcripts:
         needs = Check(transcript).needs
         if board is None:
@@ -340,6 +347,9 @@ def _run_all(
             out.write(f"{verdict}  {result.path}  ({timing})\n")
         if result.failure is not None:
             out.write(f"      {result.failure}\n")
+        failed = between() if between is not None and not result.skipped else None
+        if failed is not None:
+            out.write(f"      {failed}\n")
         out.flush()
 
 
@@ -366,15 +376,32 @@ def _read_params(url: str) -> tuple[int, ...]:
             raise AppmodeError(f"before running: {exc}") from None
 
 
+def _set_back(host: Host, values: tuple[int, ...]) -> list[int]:
+    """Set the parameters that differ from `values` back (verified); which did."""
+    now = host.read_params()
+    changed = [i for i, (a, b) in enumerate(zip(now, values, strict=True)) if a != b]
+    for index in changed:
+        host.set_param(index, values[index])
+    return changed
+
+
+def put_back(url: str, values: tuple[int, ...]) -> str | None:
+    """Between two transcripts on a real board: its parameters back to `values`
+    (verified, not saved); what went wrong, in a line, or None."""
+    try:
+        with Host(url) as host:
+            _set_back(host, values)
+    except AppmodeError as exc:
+        return f"could not put the parameters back before the next transcript: {exc}"
+    return None
+
+
 def restore_params(url: str, values: tuple[int, ...]) -> str:
     """Set the board's parameters back to `values` (verified) and send `{Q:W}`: what a
     run against a real board changed is undone. Returns what was done, in a line."""
     try:
         with Host(url) as host:
-            now = host.read_params()
-            changed = [i for i, (a, b) in enumerate(zip(now, values, strict=True)) if a != b]
-            for index in changed:
-                host.set_param(index, values[index])
+            changed = _set_back(host, values)
             host.save()
     except AppmodeError as exc:
         shown = ", ".join(f"{p.name}={v}" for p, v in zip(params.PARAMS, values, strict=True))
