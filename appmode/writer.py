@@ -27,7 +27,8 @@ CLOSE_WAIT = 0.5
 
 class BoundedWriter:
     """Writes to the file descriptor that `opener` gives (called in the writer's thread),
-    in order, from a queue of at most `limit` bytes."""
+    in order, from a queue of at most `limit` bytes; a write may name another descriptor
+    (standard error beside standard output), kept in the same order."""
 
     def __init__(
         self,
@@ -42,25 +43,29 @@ class BoundedWriter:
         """Why writing stopped (None while it goes on)."""
         self.error: OSError | None = None
         """The error that stopped it, where one did (not a reader too slow)."""
+        self.side_errors: dict[int, OSError] = {}
+        """Errors writing another descriptor (its bytes are dropped from then on)."""
         self._opener = opener
         self._close_fd = close_fd
-        self._queue: deque[bytes] = deque()
+        self._queue: deque[tuple[int | None, bytes]] = deque()
         self._held = 0  # bytes queued and not yet written
         self._closing = False
+        self._opened = False  # the opener has returned
         self._done = threading.Event()  # the thread has ended
         self._lock = threading.Condition()
         self._thread = threading.Thread(target=self._run, name=f"writer {name}", daemon=True)
         self._thread.start()
 
-    def write(self, data: bytes) -> bool:
-        """Queue `data`; never waits. False once writing has stopped (see `failure`)."""
+    def write(self, data: bytes, fd: int | None = None) -> bool:
+        """Queue `data` (for `fd`, by default the opened one); never waits. False once
+        writing has stopped (see `failure`)."""
         with self._lock:
             if self.failure is not None or self._closing:
                 return False
             if self._held + len(data) > self.limit:
                 self._fail(f"its reader took nothing for {self._held:,} bytes")
                 return False
-            self._queue.append(data)
+            self._queue.append((fd, data))
             self._held += len(data)
             self._lock.notify()
         return True
@@ -85,7 +90,9 @@ class BoundedWriter:
             self._lock.notify()
         if not self._done.wait(wait):
             with self._lock:
-                if self.failure is None:
+                if self.failure is None and not self._opened:
+                    self._fail(f"no program opened it to read within {wait:g} s of the end")
+                elif self.failure is None:
                     self._fail(f"{self._held:,} bytes were still unwritten after {wait:g} s")
             return False
         return self.failure is None
@@ -101,6 +108,7 @@ class BoundedWriter:
     def _run(self) -> None:
         try:
             fd = self._opener()
+            self._opened = True
         except OSError as exc:
             with self._lock:
                 self.error = exc
@@ -122,18 +130,22 @@ class BoundedWriter:
                     self._lock.wait()
                 if self.failure is not None or not self._queue:
                     return
-                data = self._queue[0]
+                item = self._queue[0]
+            target, data = item
             try:  # outside the lock: `write` never waits for this
-                view = memoryview(data)
-                while view:
-                    view = view[os.write(fd, view) :]
+                if target not in self.side_errors:
+                    view = memoryview(data)
+                    while view:
+                        view = view[os.write(fd if target is None else target, view) :]
             except OSError as exc:
                 with self._lock:
-                    self.error = exc
-                    self._fail(_reason(exc))
-                return
+                    if target is None:
+                        self.error = exc
+                        self._fail(_reason(exc))
+                        return
+                    self.side_errors[target] = exc
             with self._lock:
-                if self._queue and self._queue[0] is data:
+                if self._queue and self._queue[0] is item:
                     self._queue.popleft()
                     self._held -= len(data)
                     self._lock.notify_all()

@@ -24,15 +24,18 @@ STEP = 0.1
 
 class Outlet:
     """A text stream (as much of one as print and prompt_toolkit use) over a
-    BoundedWriter on a copy of `stream`'s file descriptor."""
+    BoundedWriter on a copy of `stream`'s file descriptor; given the `writer` of
+    another Outlet, it shares it (standard output and error keep their order)."""
 
-    def __init__(self, stream: TextIO, name: str) -> None:
+    def __init__(self, stream: TextIO, name: str, writer: BoundedWriter | None = None) -> None:
         fd = os.dup(stream.fileno())
         self._stream = stream
         self.name = name
         self.encoding = getattr(stream, "encoding", None) or "utf-8"
         self.errors = "replace"
-        self.writer = BoundedWriter(lambda: fd, name)
+        self._fd = None if writer is None else fd
+        """The descriptor this Outlet names in a shared writer (None: the writer's own)."""
+        self.writer = writer or BoundedWriter(lambda: fd, name)
 
     def fileno(self) -> int:
         return self._stream.fileno()
@@ -44,10 +47,11 @@ class Outlet:
         return True
 
     def write(self, text: str) -> int:
-        error = self.writer.error
+        writer = self.writer
+        error = writer.error if self._fd is None else writer.side_errors.get(self._fd)
         if error is not None:
             raise error
-        self.writer.write(text.encode(self.encoding, self.errors))
+        writer.write(text.encode(self.encoding, self.errors), self._fd)
         return len(text)
 
     def flush(self) -> None:
@@ -61,7 +65,8 @@ def install() -> tuple[Outlet, Outlet] | None:
     if out is not sys.__stdout__ or err is not sys.__stderr__ or out is None or err is None:
         return None
     try:
-        outlets = Outlet(out, "standard output"), Outlet(err, "standard error")
+        first = Outlet(out, "standard output")
+        outlets = first, Outlet(err, "standard error", first.writer)
     except (OSError, ValueError, AttributeError):
         return None
     sys.stdout, sys.stderr = (cast(TextIO, outlet) for outlet in outlets)
@@ -73,19 +78,12 @@ def finish(outlets: tuple[Outlet, Outlet]) -> str | None:
     plain stream would (a signal ends the wait), or at most CLOSE_WAIT after an ending
     signal; why output was lost, if it was (a reader that left, as `cat`, loses
     nothing worth saying)."""
-    out, err = outlets
-    lost = None
-    for outlet in (out, err):
-        while outlet.writer.pending and outlet.writer.failure is None:
-            since = signals.ending_since()
-            if since is not None:
-                outlet.writer.close(CLOSE_WAIT)
-                break
-            outlet.writer.drained(STEP)
-        outlet.writer.close(0.0 if outlet.writer.failure else CLOSE_WAIT)
-        error = outlet.writer.error
-        quiet = error is not None and error.errno == errno.EPIPE  # `| head`: as cat does
-        if outlet is out and outlet.writer.failure is not None and not quiet:
-            lost = f"cannot write the output: {outlet.writer.failure}"
+    writer = outlets[0].writer
+    while writer.pending and writer.failure is None and signals.ending_since() is None:
+        writer.drained(STEP)
+    writer.close(CLOSE_WAIT)
     sys.stdout, sys.stderr = sys.__stdout__, sys.__stderr__
-    return lost
+    error = writer.error
+    if writer.failure is None or (error is not None and error.errno == errno.EPIPE):
+        return None  # `| head`: as cat does
+    return f"cannot write the output: {writer.failure}"

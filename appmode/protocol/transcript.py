@@ -222,13 +222,6 @@ class Recorder:
             reason = "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror
             raise AppmodeError(f"cannot write transcript {self.name}: {reason}") from None
 
-    @property
-    def failure(self) -> str | None:
-        """Why the recording stopped, if it did (a file's writer fails on its own)."""
-        if isinstance(self._out, BoundedWriter) and self._out.failure is not None:
-            return f"cannot write transcript {self.name}: {self._out.failure}"
-        return f"cannot write transcript {self.name}" if self._failed else None
-
     def close(self) -> None:
         """Write what the decoders still hold, and close the file (if it opened it),
         waiting at most CLOSE_WAIT for its writer; AppmodeError if the recording is not
