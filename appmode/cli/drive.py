@@ -100,7 +100,9 @@ def add_board(parser: argparse.ArgumentParser) -> None:
         "--drive-type",
         dest="drive_type",
         choices=DRIVE_NAMES,
-        help="the car's drive type: the embedded board's (sim://?drive=; default: omni), "
+        metavar="TYPE",
+        help=f"the car's drive type ({', '.join(DRIVE_NAMES)}): the embedded board's "
+        "(sim://?drive=; default: omni), "
         "or with UART2 a board's that does not answer reads (default: read from "
         "system_mode)",
     )

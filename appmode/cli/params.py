@@ -159,12 +159,18 @@ def run_params(
         if save:
             host.save()
             values = host.read_params()
-            saves.remember(url, values)
             print(
                 f"save requested ({{Q:W}}); the board does not confirm a save: restart it, "
                 f"then run appmode params {url} --verify-saved",
                 file=sys.stderr,
             )
+            try:
+                saves.remember(url, values)
+            except AppmodeError as exc:  # the set and the save went out all the same
+                print(
+                    f"appmode: WARNING: {exc}: --verify-saved will not know this save",
+                    file=sys.stderr,
+                )
     status = 0
     if saved is not None:
         status = _verify(values, *saved)

@@ -33,7 +33,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     replay.add_argument(
         "--speed",
-        type=float,
+        type=number_type(0.001, 1000),
         default=1.0,
         metavar="X",
         help="time factor: 2 plays twice as fast (default 1)",
@@ -67,8 +67,6 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from appmode.transcript.replay import run_replay
 
-    if not (0.001 <= args.speed <= 1000 and args.loop >= 1):
-        raise AppmodeError("--speed must be > 0, in 0.001–1000, and --loop at least 1")
     if args.side == "host" and args.to == "pty":
         raise AppmodeError(
             "replay --to pty plays the board's side to an app: add --side board (to drive "

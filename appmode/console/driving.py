@@ -14,6 +14,7 @@ from prompt_toolkit.output import Output
 from appmode.console.script import run_script
 from appmode.console.terminal import Console, command_history
 from appmode.session.base import BaseSession
+from appmode.text import wrapped
 
 
 def run_drive(
@@ -49,7 +50,7 @@ def run_drive(
                     if session.simulated
                     else "the board keeps it until it is switched off"
                 )
-                print(f"appmode: {warning}: {lasts}", file=sys.stderr)
+                print(wrapped(f"appmode: {warning}: {lasts}"), file=sys.stderr)
             if session.recording_failure is not None and interactive:
                 print(
                     f"appmode: error: {session.recording_failure}; the recording stopped there",

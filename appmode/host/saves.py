@@ -8,6 +8,7 @@ import json
 import time
 from pathlib import Path
 
+from appmode.errors import AppmodeError
 from appmode.files import data_folder, write_whole
 from appmode.protocol import params
 
@@ -25,10 +26,14 @@ def _load() -> dict[str, dict[str, object]]:
 
 
 def remember(url: str, values: tuple[int, ...]) -> None:
-    """Note that `values` were saved on the board at `url`, now."""
+    """Note that `values` were saved on the board at `url`, now; AppmodeError naming the
+    file if it cannot be written."""
     document = _load()
     document[url] = {"values": list(values), "at": time.strftime("%Y-%m-%d %H:%M:%S")}
-    path().parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path().parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise AppmodeError(f"cannot write saved parameters {path()}: {exc.strerror}") from None
     write_whole(path(), (json.dumps(document, indent=2) + "\n").encode(), "saved parameters")
 
 

@@ -19,9 +19,9 @@ class Wait:
 
 
 def parse_wait(token: str) -> Wait:
-    """`wait:SECONDS` (0 to an hour)."""
+    """`wait:SECONDS` (0 to an hour), in ASCII digits (float() also takes others)."""
     try:
-        seconds = float(token[5:])
+        seconds = float(token[5:]) if token.isascii() else -1.0
     except ValueError:
         seconds = -1.0
     if not 0 <= seconds <= 3600:

@@ -14,6 +14,7 @@ like every host session.
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -185,16 +186,19 @@ def _open_for_app(url: str) -> serial.SerialBase | PtyPort:
     return port
 
 
+PROGRESS_WIDTH = 79
+"""Columns the progress line takes at most (an 80-column terminal does not wrap it)."""
+
+
 def _progress(path: str) -> Callable[[float, float], None]:
+    name = os.path.basename(path) or path
+
     def show(done: float, total: float) -> None:
         share = 0.0 if total <= 0 else min(1.0, done / total)
-        bar = "#" * round(share * 30)
-        print(
-            f"\r\033[Kreplay {path} [{bar:<30}] {done:6.1f} / {total:.1f} s  "
-            f"ETA {max(0.0, total - done):5.1f} s",
-            end="",
-            file=sys.stderr,
-            flush=True,
-        )
+        bar = "#" * round(share * 20)
+        tail = f" [{bar:<20}] {done:.1f}/{total:.1f} s, ETA {max(0.0, total - done):.1f} s"
+        room = PROGRESS_WIDTH - len("replay ") - len(tail)
+        shown = name if len(name) <= room else name[: max(0, room - 1)] + "…"
+        print(f"\r\033[Kreplay {shown}{tail}", end="", file=sys.stderr, flush=True)
 
     return show

@@ -14,6 +14,7 @@ import ipaddress
 import os
 import socket
 import ssl
+import sys
 from pathlib import Path
 
 from appmode.errors import AppmodeError
@@ -53,18 +54,25 @@ def _san(names: list[str]) -> list[object]:
     return entries
 
 
-def _covers(cert_path: Path, names: list[str]) -> bool:
-    """Whether the certificate there is valid now and names every one of `names`."""
+def _why_new(cert_path: Path, names: list[str]) -> str | None:
+    """Why the certificate kept there will not do (None: it is valid now and names
+    every one of `names`); "" when none is kept."""
     from cryptography import x509
 
+    if not cert_path.exists():
+        return ""
     try:
+        if not cert_path.is_file():  # a FIFO would hang the read
+            raise ValueError("not a regular file")
         cert = x509.load_pem_x509_certificate(cert_path.read_bytes())
         held = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
-    except (OSError, ValueError, x509.ExtensionNotFound):
-        return False
+    except (OSError, ValueError, x509.ExtensionNotFound) as exc:
+        return f"the one kept in {cert_path} could not be read ({exc})"
     now = datetime.datetime.now(datetime.timezone.utc)
-    fresh = cert.not_valid_before_utc <= now < cert.not_valid_after_utc
-    return fresh and all(entry in held for entry in _san(names))
+    if not cert.not_valid_before_utc <= now < cert.not_valid_after_utc:
+        return f"the one kept in {cert_path} is not valid now"
+    missing = [name for name, entry in zip(names, _san(names), strict=True) if entry not in held]
+    return f"the one kept does not name {', '.join(missing)}" if missing else None
 
 
 def own_certificate(names: list[str], folder: Path | None = None) -> tuple[Path, Path]:
@@ -77,8 +85,15 @@ def own_certificate(names: list[str], folder: Path | None = None) -> tuple[Path,
 
     folder = folder or data_folder()
     cert_path, key_path = folder / CERT, folder / KEY
-    if key_path.exists() and _covers(cert_path, names):
+    why = _why_new(cert_path, names) if key_path.is_file() else ""
+    if why is None:
         return cert_path, key_path
+    if why:
+        print(
+            f"appmode: made a new certificate for the page: {why}; its fingerprint is new, "
+            "so the browser asks again",
+            file=sys.stderr,
+        )
     key = ec.generate_private_key(ec.SECP256R1())
     subject = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "appmode web")])
     now = datetime.datetime.now(datetime.timezone.utc)
@@ -126,6 +141,9 @@ def _write(path: Path, data: bytes, mode: int) -> None:
 def server_context(cert: Path, key: Path) -> ssl.SSLContext:
     """A TLS context serving `cert`; a clear error for files that are not a pair."""
     context = ssl.create_default_context(ssl.Purpose.CLIENT_AUTH)
+    for path in (cert, key):
+        if path.exists() and not path.is_file():  # a FIFO would hang the read
+            raise AppmodeError(f"cannot serve HTTPS with {path}: it is not a file; give a PEM file")
     try:
         context.load_cert_chain(cert, key)
     except (OSError, ssl.SSLError) as exc:

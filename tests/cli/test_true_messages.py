@@ -34,10 +34,10 @@ def test_a_quiet_control_port_says_why() -> None:
 
 def test_quitting_the_embedded_board_unsaved_says_it_ends_with_the_session() -> None:
     done = run("drive", stdin=b"set max_speed 800\nquit\n")
-    assert "not saved: max_speed 500 → 800: the embedded board ends with this session" in (
-        done.stderr
-    )
+    said = " ".join(done.stderr.split())
+    assert "not saved: max_speed 500 → 800: the embedded board ends with this session" in said
     assert "switched off" not in done.stderr
+    assert max(len(line) for line in done.stderr.splitlines()) <= 80, "issue 49.14: 83 columns"
 
 
 def test_the_page_command_pairs_each_page_with_its_letter() -> None:

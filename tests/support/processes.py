@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import selectors
 import signal
 import subprocess
@@ -23,8 +24,10 @@ def run(
     timeout: float = 60,
     stdin: bytes = b"",
     limits: Callable[[], None] | None = None,
+    env: dict[str, str] | None = None,
 ) -> subprocess.CompletedProcess[str]:
-    """`appmode ARGS` run to its end; `limits` runs in the child first (resource limits)."""
+    """`appmode ARGS` run to its end; `limits` runs in the child first (resource limits);
+    `env` is added to the environment."""
     done = subprocess.run(
         appmode_cmd(*args),
         input=stdin.decode(),
@@ -34,6 +37,7 @@ def run(
         cwd=ROOT,
         check=False,
         preexec_fn=limits,
+        env=None if env is None else {**os.environ, **env},
     )
     return done
 
