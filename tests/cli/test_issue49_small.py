@@ -92,3 +92,13 @@ def test_the_replay_progress_line_fits_80_columns() -> None:
         _progress("short.transcript")(1.0, 2.0)
     for line in shown.getvalue().split("\r\033[K")[1:]:
         assert len(line) <= 79, line
+
+
+def test_dump_refuses_the_range_conform_refuses(tmp_path: Path) -> None:
+    """`dump` passed `{A0:5..1:0:0}$`, which `conform` rejected: one check for both now."""
+    bad = tmp_path / "bad.transcript"
+    bad.write_text("# appmode transcript v1\n0.500 < {A0:5..1:0:0}$\n")
+    said = f"appmode: error: {bad}:2: 5..1: a field LO..HI needs LO <= HI\n"
+    for command in ("dump", "conform"):
+        done = run(command, str(bad))
+        assert (done.returncode, done.stderr) == (2, said), command
