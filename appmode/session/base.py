@@ -234,7 +234,10 @@ class BaseSession(ABC):
         of a stop the guard sent while the ticks stalled; whether the car was stopped."""
         if self.guard.beat():
             self._forget_motion()
-            self.say(f"stopped: the session stalled for over {STALL:g} s (its view was blocked)")
+            self.say(
+                f"stopped: over {STALL:g} s without a tick while driving (its view or script "
+                "was blocked or waiting)"
+            )
             return True
         if self.lease is None or not self.moving:
             return False

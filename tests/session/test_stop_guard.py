@@ -1,0 +1,59 @@
+"""The stop authority's guard (issue 49.2): a session whose ticks stall while the car
+moves gets its stop from the guard's thread, on the board's own recording."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from appmode.protocol.transcript import read_transcript
+from appmode.session.app_session import Session
+from appmode.session.authority import STALL, StopGuard
+from appmode.session.hold import HoldToDrive
+
+
+def test_the_guard_stops_a_moving_session_whose_ticks_stall() -> None:
+    stops: list[float] = []
+    guard = StopGuard(lambda: True, lambda: stops.append(time.monotonic()))
+    guard.start()
+    try:
+        started = time.monotonic()
+        for _ in range(10):  # ticks keep it from acting
+            guard.beat()
+            time.sleep(STALL / 5)
+        assert not stops
+        time.sleep(STALL * 6)  # no tick: the view is blocked
+        assert len(stops) == 1, "once, until the session acknowledges it"
+        assert stops[0] - started >= 10 * STALL / 5
+        assert guard.beat() is True and guard.beat() is False
+    finally:
+        guard.close()
+
+
+def test_the_guard_leaves_a_stopped_car_alone() -> None:
+    stops: list[float] = []
+    guard = StopGuard(lambda: False, lambda: stops.append(time.monotonic()))
+    guard.start()
+    time.sleep(STALL * 4)
+    guard.close()
+    assert not stops
+
+
+def test_a_latched_session_that_stops_ticking_is_stopped(tmp_path: Path) -> None:
+    record = tmp_path / "s.transcript"
+    session = Session("sim://", HoldToDrive(latched=True), record=str(record))
+    try:
+        session.start()
+        session.run("drive A")
+        assert session.moving
+        time.sleep(STALL * 6)  # the session's loop is "blocked": no tick
+        session.tick()
+        assert not session.moving
+        assert any("without a tick while driving" in m for m in session.messages)
+    finally:
+        session.close()
+    sent = [e for e in read_transcript(record).entries if e.direction == ">"]
+    drive = next(i for i, e in enumerate(sent) if e.data == b"A")
+    stop = sent[drive + 1]
+    assert stop.data == b"Z"
+    assert STALL <= stop.time - sent[drive].time < STALL * 4
