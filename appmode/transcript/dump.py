@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import sys
+import textwrap
 from collections.abc import Callable, Iterable, Iterator
 from io import BytesIO
 from pathlib import Path
@@ -17,7 +19,7 @@ from appmode.protocol import app, control
 from appmode.protocol.control_view import view
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
-from appmode.protocol.reader import RECEIVED, RECEIVED2, PortsReader
+from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT2, PortsReader
 from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, line
 from appmode.protocol.transcript import (
     DIRECTIONS,
@@ -174,9 +176,10 @@ def run_plot(path: str, output: str) -> int:
     layout = Check(transcript).needs.profile.a_layout
     motion, series, commands = _series(transcript, path)
     if not series["tA"] and not series["tB"]:
-        raise AppmodeError(f"{path} has no A or B records to plot")
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(11, 8), constrained_layout=True)
-    vel, att, bat = axes
+        return _plot_reports(plt, transcript, path, output)
+    fig, (strip, vel, att, bat) = plt.subplots(
+        4, 1, sharex=True, figsize=(11, 8.5), height_ratios=(0.7, 3, 3, 2), layout="constrained"
+    )
     names = VELOCITY_LABELS if layout is VELOCITY else layout.labels
     for i, column in motion.items():
         vel.plot(series["tA"], column, label=names[i], drawstyle="steps-post")
@@ -194,25 +197,76 @@ def run_plot(path: str, output: str) -> int:
         bat.set_ylim(low - pad, high + pad)
         bat.yaxis.set_major_locator(MaxNLocator(integer=True))
     bat.set_xlabel("time (s)")
+    times = series["tA"] + series["tB"] + [t for t, _ in commands]
+    _mark_commands(strip, (vel, att, bat), commands, max(times) - min(times))
+    vel.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    att.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    fig.suptitle(_title(path, transcript), fontsize=11)
+    return _save(plt, fig, output)
+
+
+def _title(path: str, transcript: Transcript) -> str:
+    """The file's name and the transcript's title, whole words in lines that fit."""
+    title = (transcript.title or "telemetry").rstrip(",;: ")
+    return textwrap.fill(f"{Path(path).name} — {title}", 110)
+
+
+def _mark_commands(strip: Any, axes: tuple[Any, ...], commands: list[Any], span: float) -> None:
+    """The commands sent: a dotted line on each plot, their labels in a strip of their
+    own above (never over the data)."""
+    strip.axis("off")
     for ax in axes:
         ax.grid(True, alpha=0.3)
         for t, _ in commands:
             ax.axvline(t, color="grey", linestyle=":", linewidth=0.8)
-    times = series["tA"] + series["tB"] + [t for t, _ in commands]
-    for t, text in command_labels(commands, (max(times) - min(times)) * LABEL_GAP):
-        vel.annotate(
+    for t, text in command_labels(commands, span * LABEL_GAP):
+        strip.annotate(
             text,
-            (t, 1.0),
+            (t, 0.0),
             xycoords=("data", "axes fraction"),
             fontsize=8,
             rotation=90,
-            va="top",
-            ha="right",
+            va="bottom",
+            ha="center",
             color="dimgrey",
         )
-    vel.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
-    att.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
-    fig.suptitle(f"{Path(path).name} — {transcript.title or 'telemetry'}", fontsize=11)
+
+
+def _plot_reports(plt: Any, transcript: Transcript, path: str, output: str) -> int:
+    """A UART2 transcript: each wheel's target (dashed) and actual speed from the encoder
+    reports (§12), the frames sent marked."""
+    reports: list[tuple[float, control.EncoderReport]] = []
+    frames: list[tuple[float, str]] = []
+    for t, direction, event in decoded(transcript.items, Check(transcript).needs.drive, path):
+        if isinstance(event, control.EncoderReport):
+            reports.append((t, event))
+        elif direction == SENT2 and not isinstance(event, control.ERRORS):
+            kind = type(event).__name__.removesuffix("Frame")
+            frames.append((t, re.sub(r"(?<!^)(?=[A-Z])", " ", kind).lower()))
+    if not reports:
+        raise AppmodeError(
+            f"{path} has no A or B records, and no encoder reports (UART2, §12), to plot"
+        )
+    fig, (strip, wheels) = plt.subplots(
+        2, 1, sharex=True, figsize=(11, 6), height_ratios=(0.8, 4), layout="constrained"
+    )
+    times = [t for t, _ in reports]
+    for i in range(len(reports[0][1].actuals)):
+        line = wheels.plot(times, [r.actuals[i] for _, r in reports], label=f"wheel {'ABCD'[i]}")
+        wheels.plot(
+            times, [r.targets[i] for _, r in reports], linestyle="--", color=line[0].get_color()
+        )
+    wheels.set_ylabel("wheel speed (dashed: target)")
+    wheels.set_xlabel("time (s)")
+    wheels.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    span = max(times + [t for t, _ in frames]) - min(times + [t for t, _ in frames])
+    _mark_commands(strip, (wheels,), frames, span)
+    fig.suptitle(_title(path, transcript), fontsize=11)
+    return _save(plt, fig, output)
+
+
+def _save(plt: Any, fig: Any, output: str) -> int:
+    """Write the figure as a PNG, whole or not at all."""
     image = BytesIO()
     try:
         fig.savefig(image, format="png", dpi=110)

@@ -231,7 +231,8 @@ def test_plot_without_records_is_a_clear_error(tmp_path: Path) -> None:
     path = tmp_path / "empty.transcript"
     path.write_text("0.0 > J\n")
     done = run("plot", str(path), "-o", str(tmp_path / "x.png"))
-    assert done.returncode == 2 and "has no A or B records to plot" in done.stderr
+    assert done.returncode == 2
+    assert "has no A or B records, and no encoder reports (UART2, §12), to plot" in done.stderr
     assert not (tmp_path / "x.png").exists()
 
 
@@ -338,3 +339,23 @@ def test_command_labels_close_in_time_share_one_label() -> None:
     assert command_labels(commands, 0.01) == [(0.0, "J {Q:P}"), (0.5, "B C D"), (1.0, "Z")]
     many = [(i * 0.001, "{0:12345}") for i in range(5)]
     assert command_labels(many, 0.01) == [(0.0, "{0:12345} {0:12…")]
+
+
+def test_plot_draws_a_uart2_transcript_s_encoder_reports(tmp_path: Path) -> None:
+    """Issue 49.14: a UART2 transcript 'has no A or B records to plot'."""
+    out = tmp_path / "u.png"
+    done = run(
+        "plot", str(ROOT / "transcripts" / "examples" / "uart2_session.transcript"), "-o", str(out)
+    )
+    assert done.returncode == 0, done.stderr
+    assert out.read_bytes().startswith(b"\x89PNG")
+
+
+def test_plot_s_title_is_whole_and_its_labels_stand_apart() -> None:
+    from appmode.protocol.transcript import read_transcript
+    from appmode.transcript.dump import _title
+
+    path = ROOT / "transcripts" / "suite" / "s4_letters_omni.transcript"
+    title = _title(str(path), read_transcript(path))
+    assert all(len(line) <= 110 for line in title.splitlines())
+    assert not title.endswith(","), "a title cut at a comma reads as clipped"
