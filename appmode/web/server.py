@@ -292,7 +292,7 @@ def serve_web(
     fingerprint: str | None = None,
 ) -> int:
     """Start the session, serve the page until ended, and always close the session: its
-    stop is the last thing sent. `names` are other addresses the page is reached at; a
+    stop is the last thing sent (exit status 1 if the recording stopped on its own). `names` are other addresses the page is reached at; a
     self-signed certificate's `fingerprint` is printed for the owner to check."""
     for name in ("aiohttp", "asyncio"):
         server_log = logging.getLogger(name)
@@ -330,4 +330,6 @@ def serve_web(
         session.close()
         for note in session.closing_notes:
             print(f"appmode: WARNING: {note}", file=sys.stderr)
-    return 0
+        if session.recording_failure is not None:
+            print(f"appmode: error: {session.recording_failure}", file=sys.stderr)
+    return 0 if session.recording_failure is None else 1

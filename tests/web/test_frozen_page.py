@@ -10,6 +10,8 @@ drove on until the server was stopped.
 from __future__ import annotations
 
 import asyncio
+import os
+import signal
 import time
 from pathlib import Path
 
@@ -132,3 +134,27 @@ def test_the_page_names_no_file_and_records_into_appmode_s_folder(tmp_path: Path
     assert any(f"recording to {made}" in m for m in messages)
     assert made.read_text().startswith("# appmode transcript v1")
     assert oct(folder.stat().st_mode & 0o777) == "0o700"
+
+
+def test_a_recording_fifo_nobody_reads_never_holds_the_page_s_stop(tmp_path: Path) -> None:
+    """Issue 49.1: `web --record FIFO` whose reader stalls kept the car moving after the
+    release, and signals did nothing."""
+    fifo = tmp_path / "rec"
+    os.mkfifo(fifo)
+
+    async def scenario(web: WebProcess) -> None:
+        async with aiohttp.ClientSession() as session:
+            socket = await page(session, web)
+            await ready(socket)
+            await socket.send_json({"t": "press", "key": "forward"})
+            wait_sent(web, "A")
+            await socket.send_json({"t": "release"})
+            wait_sent(web, "Z", timeout=2)
+            await socket.close()
+
+    with web_process(tmp_path, "--record", str(fifo)) as web:
+        asyncio.run(scenario(web))
+        signalled = time.monotonic()
+        code, err = web.stop(signal.SIGTERM)
+        assert time.monotonic() - signalled < 2.0
+    assert code != 0 and f"cannot write transcript {fifo}" in err, (code, err)
