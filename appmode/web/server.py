@@ -292,8 +292,9 @@ def serve_web(
     fingerprint: str | None = None,
 ) -> int:
     """Start the session, serve the page until ended, and always close the session: its
-    stop is the last thing sent (exit status 1 if the recording stopped on its own). `names` are other addresses the page is reached at; a
-    self-signed certificate's `fingerprint` is printed for the owner to check."""
+    stop is the last thing sent (exit status 1 if the recording stopped on its own).
+    `names` are other addresses the page is reached at; a self-signed certificate's
+    `fingerprint` is printed for the owner to check."""
     for name in ("aiohttp", "asyncio"):
         server_log = logging.getLogger(name)
         server_log.addHandler(_OneLine())
