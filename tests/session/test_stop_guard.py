@@ -6,6 +6,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import pytest
+
 from appmode.protocol.transcript import read_transcript
 from appmode.session.app_session import Session
 from appmode.session.authority import STALL, StopGuard
@@ -57,3 +59,28 @@ def test_a_latched_session_that_stops_ticking_is_stopped(tmp_path: Path) -> None
     stop = sent[drive + 1]
     assert stop.data == b"Z"
     assert STALL <= stop.time - sent[drive].time < STALL * 4
+
+
+def test_after_a_signal_not_acted_on_the_guard_stops_the_car_and_ends_the_process(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Deliver 2: a signal ends the session within a second, whatever is blocked."""
+    from appmode.session import authority
+
+    signalled = time.monotonic()
+    ended: list[tuple[float, int]] = []
+    stops: list[float] = []
+    monkeypatch.setattr(authority.signals, "ending_since", lambda: signalled)
+    monkeypatch.setattr(
+        authority.os, "_exit", lambda status: ended.append((time.monotonic(), status))
+    )
+    guard = StopGuard(lambda: True, lambda: stops.append(time.monotonic()))
+    guard.start()
+    deadline = time.monotonic() + 5
+    while not ended and time.monotonic() < deadline:
+        guard.beat()  # the ticks go on: only the signal is not acted on
+        time.sleep(0.01)
+    guard.close()
+    assert ended and ended[0][1] == 130
+    assert authority.GRACE <= ended[0][0] - signalled < 1.0 + 0.5  # a loaded machine's margin
+    assert stops and stops[0] <= ended[0][0]
