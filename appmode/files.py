@@ -164,9 +164,10 @@ def _fsync_directory(directory: Path) -> None:
         os.close(fd)
 
 
-def open_fifo(path: str | os.PathLike[str], what: str) -> int:
+def open_fifo(path: str | os.PathLike[str], what: str, meanwhile: str = "Ctrl-C gives up") -> int:
     """The write end of the FIFO `path`. With no program reading it yet the open waits
-    for one, as a FIFO does — saying so on stderr rather than hanging in silence."""
+    for one, as a FIFO does — saying so on stderr (with what happens `meanwhile`) rather
+    than hanging in silence."""
     try:
         fd = os.open(path, os.O_WRONLY | getattr(os, "O_NONBLOCK", 0) | _CLOEXEC)
     except OSError as exc:
@@ -174,7 +175,7 @@ def open_fifo(path: str | os.PathLike[str], what: str) -> int:
             raise
         print(
             f"appmode: waiting for a program to read the FIFO {os.fspath(path)} before "
-            f"writing the {what} (Ctrl-C gives up)",
+            f"writing the {what} ({meanwhile})",
             file=sys.stderr,
             flush=True,
         )

@@ -149,7 +149,7 @@ class Recorder:
         stops, and the next call or `close` says why)."""
         shown = os.fspath(path)
         if is_fifo(path):  # its open waits for a reader: in the writer's thread
-            opener = partial(open_fifo, path, "transcript")
+            opener = partial(open_fifo, path, "transcript", "the session goes on meanwhile")
             return cls(BoundedWriter(opener, shown), origin, directives)
         new = not os.path.lexists(path)
         try:
