@@ -39,8 +39,8 @@ if TYPE_CHECKING:
     from appmode.ports.urls import open_link
     from appmode.protocol.app import encode
     from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
+    from appmode.protocol.recorder import Recorder
     from appmode.protocol.transcript import (
-        Recorder,
         TranscriptError,
         parse_transcript,
         read_transcript,
@@ -56,7 +56,7 @@ _WHERE = {
     "BoardDecoder": "appmode.protocol.app_decoders",
     "HostDecoder": "appmode.protocol.app_decoders",
     "encode": "appmode.protocol.app",
-    "Recorder": "appmode.protocol.transcript",
+    "Recorder": "appmode.protocol.recorder",
     "TranscriptError": "appmode.protocol.transcript",
     "parse_transcript": "appmode.protocol.transcript",
     "read_transcript": "appmode.protocol.transcript",

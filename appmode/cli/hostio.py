@@ -15,8 +15,8 @@ from appmode.host.query import QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
 from appmode.ports.sim import sim_directives
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.recorder import Recorder
 from appmode.protocol.render import describe, line, to_json
-from appmode.protocol.transcript import Recorder
 
 H = TypeVar("H", Host, ControlHost)
 E = TypeVar("E")

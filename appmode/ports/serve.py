@@ -33,7 +33,7 @@ from appmode.ports.urls import BAUD
 from appmode.ports.wakeups import exact_wakeups, select_exactly
 from appmode.protocol import app
 from appmode.protocol.params import SYSTEM_MODE, DriveType
-from appmode.protocol.transcript import Recorder
+from appmode.protocol.recorder import Recorder
 
 T = TypeVar("T")
 GATHER = 0.0002
@@ -103,7 +103,9 @@ class BoardServer:
                 pair[UART2] = make_uart2[i](self._sel, self.log)
                 self._endpoints.append(pair[UART2])
             pairs.append(pair)
-        self._recorder = Recorder.create(record, 0.0, directives) if record else None
+        self._recorder = (
+            Recorder.create(record, 0.0, directives, background=False) if record else None
+        )
         for pair, board in zip(pairs, boards, strict=True):
             if self._recorder is not None:
                 self._recorder.follow(int(board.params[SYSTEM_MODE]), 0.0)

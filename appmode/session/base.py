@@ -18,7 +18,7 @@ from appmode.files import new_recording, recordings_folder
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.sim import sim_directives
 from appmode.ports.urls import is_simulated
-from appmode.protocol.transcript import Recorder
+from appmode.protocol.recorder import Recorder
 from appmode.session.authority import STALL, StopGuard
 from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped

@@ -17,8 +17,8 @@ import serial
 
 from appmode.line.pacing import Ahead
 from appmode.ports.urls import new_pty, open_link
+from appmode.protocol.recorder import Recorder
 from appmode.protocol.session_end import SessionEnd
-from appmode.protocol.transcript import Recorder
 
 READ_TIMEOUT = 0.05
 CHUNK = 64

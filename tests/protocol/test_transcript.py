@@ -10,11 +10,11 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from appmode.errors import AppmodeError
+from appmode.protocol.recorder import Recorder
 from appmode.protocol.transcript import (
     HEADER,
     MAX_LINE,
     Directive,
-    Recorder,
     TranscriptError,
     parse_transcript,
     read_transcript,

@@ -10,8 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from appmode.protocol import control
+from appmode.protocol.recorder import Recorder
 from appmode.protocol.transcript import (
-    Recorder,
     TranscriptError,
     parse_transcript,
     uart2_bytes,

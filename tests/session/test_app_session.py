@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from appmode.console.script import command_lines
-from appmode.protocol.transcript import Recorder
+from appmode.protocol.recorder import Recorder
 from appmode.session.app_session import Session
 from appmode.session.base import MAX_COMMAND
 from appmode.session.hold import HoldToDrive

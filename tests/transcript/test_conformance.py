@@ -13,7 +13,8 @@ import pytest
 from appmode.host.client import Host
 from appmode.ports.sim import SimSerial
 from appmode.protocol import params
-from appmode.protocol.transcript import Recorder, parse_transcript, read_transcript
+from appmode.protocol.recorder import Recorder
+from appmode.protocol.transcript import parse_transcript, read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, board_process, board_state, run
 

@@ -1,0 +1,235 @@
+"""Recording a session as a transcript (format v1, `protocol.transcript`) while it
+happens: `Recorder`, a tap on both ports that writes one protocol unit a line."""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import math
+import os
+from collections import deque
+from functools import partial
+from typing import TextIO
+
+from appmode.errors import AppmodeError
+from appmode.files import is_fifo, open_fifo
+from appmode.protocol.escaping import escape
+from appmode.protocol.reader import Event, PortsReader
+from appmode.protocol.transcript import (
+    DIRECTIONS,
+    HEADER,
+    TIME_DIGITS,
+    UART2_DIRECTIONS,
+    uart2_payload,
+)
+from appmode.writer import BoundedWriter
+
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
+HEADER_WAIT = 0.1
+"""Seconds `Recorder.create` waits to see a file take its header (a file or device
+takes it at once; a full one fails then, and the caller is told)."""
+HOLD = 0.5
+"""Seconds a recorder waits for a unit to end before writing it as far as it goes (the
+lines after it wait too: the file stays in time order)."""
+
+
+class _Held:
+    """One direction's bytes fed to its decoder and not yet in a unit, with the time each
+    arrived, and how many of them a line already shows (a unit cut by other lines)."""
+
+    def __init__(self) -> None:
+        self.data = bytearray()
+        self.times: deque[list[float | int]] = deque()  # [time, count] runs of `data`
+        self.written = 0
+
+    def add(self, data: bytes, time: float) -> None:
+        self.data += data
+        self.times.append([time, len(data)])
+
+    def time_at(self, offset: int) -> float:
+        """When the held byte at `offset` arrived."""
+        for when, count in self.times:
+            if offset < count:
+                return float(when)
+            offset -= int(count)
+        return float(self.times[-1][0]) if self.times else 0.0
+
+    def take(self, count: int) -> tuple[float, bytes]:
+        """A unit of `count` bytes leaves: (the time of its first byte no line shows, those
+        bytes)."""
+        shown = min(self.written, count)
+        rest = (self.time_at(shown), bytes(self.data[shown:count]))
+        del self.data[:count]
+        self.written -= shown
+        while count and self.times:
+            run = self.times[0]
+            used = min(count, int(run[1]))
+            run[1] = int(run[1]) - used
+            count -= used
+            if not run[1]:
+                self.times.popleft()
+        return rest
+
+    def unshown(self) -> tuple[float, bytes]:
+        """The bytes no line shows yet, from the time of the first; they are shown now."""
+        rest = (self.time_at(self.written), bytes(self.data[self.written :]))
+        self.written = len(self.data)
+        return rest
+
+
+class Recorder:
+    """Writes a session as it happens: each direction split into commands and records.
+
+    Call it as a tap: `recorder(direction, time, data)` with `>` for host→board bytes and
+    `<` for board→host bytes. Every line is flushed as it is written, and lines stay in
+    time order: a unit still incomplete when another direction's bytes come (a frame
+    whose end is still to come) is written as far as it goes, at its own time, and the
+    rest when it ends. Each line carries the arrival time of its first byte.
+    """
+
+    def __init__(
+        self,
+        out: TextIO | BoundedWriter,
+        origin: float = 0.0,
+        directives: tuple[str, ...] = (),
+        name: str | None = None,
+    ) -> None:
+        self._out = out
+        """A stream given by the caller (written at once, and left open), or the bounded
+        writer of a file `create` opened (written off the caller's thread)."""
+        self.name = name or str(getattr(out, "name", "the transcript"))
+        self._failed = False
+        self._closed = False
+        self._closes = False  # a file `create` opened, written on the caller's thread
+        self._origin = origin
+        self._reader = PortsReader()
+        self._held = {direction: _Held() for direction in DIRECTIONS}
+        self._queue: list[tuple[float, int, bytes, str]] = []  # lines not yet written
+        self._order = itertools.count()  # keeps lines of one time in the order they came
+        self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
+
+    @classmethod
+    def create(
+        cls,
+        path: str | os.PathLike[str],
+        origin: float = 0.0,
+        directives: tuple[str, ...] = (),
+        background: bool = True,
+    ) -> Recorder:
+        """A recorder of the file `path`, written by a `BoundedWriter`: a full disk, a
+        FIFO nobody reads or a stalled reader never holds up the caller (the recording
+        stops, and the next call or `close` says why). With `background` False it is
+        written on the caller's thread, which its reader may slow down (a simulated
+        board's own recording: nothing waits for it, and a flood is recorded whole)."""
+        shown = os.fspath(path)
+        if is_fifo(path) and background:  # its open waits for a reader: in the writer
+            opener = partial(open_fifo, path, "transcript", "the session goes on meanwhile")
+            return cls(BoundedWriter(opener, shown), origin, directives)
+        new = not os.path.lexists(path)
+        try:
+            if is_fifo(path):
+                fd = open_fifo(path, "transcript")
+            else:
+                fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | _CLOEXEC, 0o666)
+        except OSError as exc:
+            raise AppmodeError(f"cannot write transcript {shown}: {exc.strerror}") from None
+        try:
+            if not background:
+                recorder = cls(os.fdopen(fd, "w", encoding="utf-8"), origin, directives, shown)
+                recorder._closes = True
+                return recorder
+            recorder = cls(BoundedWriter(lambda: fd, shown), origin, directives)
+            writer = recorder._out
+            assert isinstance(writer, BoundedWriter)
+            if not writer.drained(HEADER_WAIT):  # not even the header fits (a full disk)
+                writer.close(0.0)
+                raise AppmodeError(f"cannot write transcript {shown}: {writer.failure}")
+        except AppmodeError:
+            if new:  # leave nothing
+                with contextlib.suppress(OSError):
+                    os.unlink(path)
+            raise
+        return recorder
+
+    def __call__(self, direction: str, time: float, data: bytes) -> None:
+        self._held[direction].add(data, time)
+        self._units(self._reader.feed(direction, data))
+        self._release(time)
+
+    def follow(self, system_mode: int, time: float) -> None:
+        """Read UART2 as a board with this system_mode does (`PortsReader.follow`)."""
+        self._units(self._reader.follow(system_mode))
+        self._release(time)
+
+    def _units(self, events: list[tuple[str, Event]]) -> None:
+        for shown, event in events:
+            when, raw = self._held[shown].take(len(event.raw))
+            if raw:
+                self._queue.append((when, next(self._order), raw, shown))
+
+    def _release(self, now: float) -> None:
+        """Write, in time order, the lines that no incomplete unit came before; a unit
+        incomplete for HOLD seconds is written as far as it goes."""
+        first = math.inf
+        for direction, held in self._held.items():
+            if len(held.data) > held.written:
+                start = held.time_at(held.written)
+                if start <= now - HOLD:
+                    when, raw = held.unshown()
+                    self._queue.append((when, next(self._order), raw, direction))
+                else:
+                    first = min(first, start)
+        self._queue.sort()
+        ready = [line for line in self._queue if line[0] < first]
+        del self._queue[: len(ready)]
+        for when, _, raw, direction in ready:
+            self._line(when, raw, direction)
+
+    def _line(self, time: float, raw: bytes, direction: str) -> None:
+        if direction in UART2_DIRECTIONS:
+            payload = uart2_payload(raw, self._reader.app_mode)
+        else:
+            payload = escape(raw)
+        self._write(f"{max(0.0, time - self._origin):.{TIME_DIGITS}f} {direction} {payload}\n")
+
+    def _write(self, text: str) -> None:
+        if isinstance(self._out, BoundedWriter):
+            if self._failed or not self._out.write(text.encode("utf-8")):
+                self._failed = True
+                raise AppmodeError(f"cannot write transcript {self.name}: {self._out.failure}")
+            return
+        try:
+            self._out.write(text)
+            self._out.flush()
+        except OSError as exc:
+            self._failed = True
+            reason = "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror
+            raise AppmodeError(f"cannot write transcript {self.name}: {reason}") from None
+
+    def close(self) -> None:
+        """Write what the decoders still hold, and close the file (if it opened it),
+        waiting at most CLOSE_WAIT for its writer; AppmodeError if the recording is not
+        whole. After a failed write it only closes the file: that failure was reported."""
+        if self._closed:
+            return
+        self._closed = True
+        failed_before, error = self._failed, None
+        if not self._failed:
+            try:
+                self._units(self._reader.flush())
+                self._release(math.inf)
+            except AppmodeError as exc:
+                error = exc
+        if isinstance(self._out, BoundedWriter):
+            if not self._out.close() and not failed_before:
+                raise AppmodeError(f"cannot write transcript {self.name}: {self._out.failure}")
+            return
+        if self._closes:
+            try:
+                self._out.close()
+            except OSError as exc:
+                error = error or AppmodeError(
+                    f"cannot write transcript {self.name}: {exc.strerror}"
+                )
+        if error is not None:
+            raise error
