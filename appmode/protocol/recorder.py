@@ -203,8 +203,7 @@ class Recorder:
             self._out.flush()
         except OSError as exc:
             self._failed = True
-            reason = "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror
-            raise AppmodeError(f"cannot write transcript {self.name}: {reason}") from None
+            raise AppmodeError(f"cannot write transcript {self.name}: {_reason(exc)}") from None
 
     def close(self) -> None:
         """Write what the decoders still hold, and close the file (if it opened it),
@@ -228,8 +227,11 @@ class Recorder:
             try:
                 self._out.close()
             except OSError as exc:
-                error = error or AppmodeError(
-                    f"cannot write transcript {self.name}: {exc.strerror}"
-                )
+                said = f"cannot write transcript {self.name}: {_reason(exc)}"
+                error = error or AppmodeError(said)
         if error is not None:
             raise error
+
+
+def _reason(exc: OSError) -> str | None:
+    return "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror
