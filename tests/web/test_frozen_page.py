@@ -42,11 +42,12 @@ def gap(received: list[tuple[float, str]], start: str, end: str) -> float:
 @pytest.mark.parametrize(
     ("lines", "letter"),
     [
+        ([], None),  # a press of the pad, then silence: neither repeats nor heartbeats
         (["latch on"], None),  # then a press of the pad
         (["send A"], "A"),
         (["drive C"], "C"),
     ],
-    ids=["latched-pad", "send", "drive-command"],
+    ids=["pad", "latched-pad", "send", "drive-command"],
 )
 def test_a_frozen_page_stops_the_car_however_the_motion_began(
     tmp_path: Path, lines: list[str], letter: str | None
