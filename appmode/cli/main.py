@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import errno
 import importlib
 import os
@@ -52,6 +53,13 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+def unknown_command(word: str) -> str:
+    """What to say of a command that is none: the nearest ones, if any are near."""
+    near = difflib.get_close_matches(word, list(COMMANDS), n=2, cutoff=0.6)
+    hint = f": did you mean {' or '.join(repr(n) for n in near)}?" if near else ""
+    return f"unknown command {word!r}{hint} (appmode --help lists the commands)"
+
+
 def command_in(argv: Sequence[str]) -> str:
     """The command `argv` names (its first word that is no option), or "" for none: only
     its module is loaded (`appmode --help` loads none)."""
@@ -72,7 +80,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     words = sys.argv[1:] if argv is None else argv
     command = command_in(words)
+    if command and command not in COMMANDS:
+        print(f"appmode: error: {unknown_command(command)}", file=sys.stderr)
+        return 2
     parser = build_parser(command)
+    if not words:  # as git and pip do: the commands, not an error
+        parser.print_help()
+        return 0
     signals.install()
     outlets = outlet.install() if command in DRIVES else None
     try:

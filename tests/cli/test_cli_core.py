@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.support.processes import run
+
 
 def appmode(*args: str, stdin: bytes = b"") -> subprocess.CompletedProcess[bytes]:
     return subprocess.run(
@@ -174,3 +176,18 @@ def test_the_command_line_loads_a_commands_machinery_only_to_run_it() -> None:
         check=True,
     )
     assert commands.stdout.strip() == "['send']", "only the command that runs is loaded"
+
+
+def test_appmode_alone_lists_the_commands_and_a_typo_gets_the_nearest() -> None:
+    """Issue 52.3: plain `appmode` said only 'the following arguments are required'."""
+    alone = run()
+    assert alone.returncode == 0 and "drive     drive and tune a car" in alone.stdout
+    typo = run("drvie")
+    assert typo.returncode == 2
+    assert typo.stderr == (
+        "appmode: error: unknown command 'drvie': did you mean 'drive'? (appmode --help "
+        "lists the commands)\n"
+    )
+    assert run("xyzzy").stderr.endswith(
+        "unknown command 'xyzzy' (appmode --help lists the commands)\n"
+    )
