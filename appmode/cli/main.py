@@ -8,9 +8,11 @@ import difflib
 import errno
 import importlib
 import os
+import subprocess
 import sys
 import traceback
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from types import ModuleType
 
 from appmode import __version__
@@ -41,7 +43,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         description="Drive, emulate and test robot-car boards that speak the APP protocol "
         "(9600 bps: letters drive, {…} frames read and set parameters).",
     )
-    parser.add_argument("--version", action="version", version=f"appmode {__version__}")
+    parser.add_argument(
+        "--version", action=_Version, nargs=0, help="print the version (and commit) and exit"
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
     for name, help in COMMANDS.items():
@@ -51,6 +55,34 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         else:
             sub.add_parser(name, help=help)  # its arguments are loaded when it runs
     return parser
+
+
+class _Version(argparse.Action):
+    """`--version`: appmode's version, and the commit when run from a git checkout (asked
+    of git only then: start-up stays short)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: object) -> None:
+        commit = checkout_commit()
+        sys.stdout.write(f"appmode {__version__}{f' ({commit})' if commit else ''}\n")
+        parser.exit()
+
+
+def checkout_commit() -> str | None:
+    """`git describe --always --dirty` of the checkout appmode runs from, or None."""
+    root = Path(__file__).resolve().parents[2]
+    if not (root / ".git").exists():
+        return None
+    try:
+        done = subprocess.run(
+            ["git", "-C", str(root), "describe", "--always", "--dirty"],
+            capture_output=True,
+            text=True,
+            timeout=5,
+            check=False,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return done.stdout.strip() or None if done.returncode == 0 else None
 
 
 def unknown_command(word: str) -> str:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.support.processes import run
+from tests.support.processes import ROOT, run
 
 
 def appmode(*args: str, stdin: bytes = b"") -> subprocess.CompletedProcess[bytes]:
@@ -191,3 +191,14 @@ def test_appmode_alone_lists_the_commands_and_a_typo_gets_the_nearest() -> None:
     assert run("xyzzy").stderr.endswith(
         "unknown command 'xyzzy' (appmode --help lists the commands)\n"
     )
+
+
+def test_version_names_the_commit_in_a_checkout() -> None:
+    """Issue 52.4: `appmode --version` run from a checkout also names its commit."""
+    head = subprocess.run(
+        ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT
+    )
+    done = run("--version")
+    assert done.returncode == 0 and done.stdout.startswith("appmode 0.1.0")
+    if head.returncode == 0:  # a checkout (an sdist has no .git)
+        assert head.stdout.strip() in done.stdout
