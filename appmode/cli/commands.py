@@ -23,3 +23,31 @@ COMMANDS: dict[str, str] = {
 }
 """Each command's one-line help; its module has `register(sub)` (its arguments) and
 `run(args)` (the job)."""
+
+EXAMPLES: dict[str, tuple[str, ...]] = {
+    "drive": (
+        "appmode drive",
+        "appmode drive /dev/ttyUSB0 --profile minibalance",
+        "printf 'drive A\\nwait 1\\n' | appmode drive",
+    ),
+    "web": ("appmode web", "appmode web /dev/rfcomm0 --listen 0.0.0.0:8080"),
+    "demo": ("appmode demo", "appmode demo --profile minibalance"),
+    "decode": ("appmode decode capture.bin", "appmode decode --from host < sent.bin"),
+    "board": ("appmode board --pty", "appmode board --listen 5000 --profile minibalance"),
+    "send": ("appmode send sim:// J A wait:1", "appmode send /dev/ttyUSB0 '{Q:P}' --json"),
+    "params": ("appmode params sim://", "appmode params /dev/ttyUSB0 --set max_speed=800 --save"),
+    "monitor": ("appmode monitor sim:// --count 4", "appmode monitor /dev/ttyUSB0 --json"),
+    "record": ("appmode record /dev/ttyUSB0 car.transcript --duration 60",),
+    "conform": ("appmode conform", "appmode conform --board /dev/ttyUSB0 --yes"),
+    "replay": (
+        "appmode replay car.transcript --to /dev/ttyUSB0",
+        "appmode replay car.transcript --to pty --side board",
+    ),
+    "tap": ("appmode tap pty /dev/ttyUSB0 --record app.transcript",),
+    "dump": ("appmode dump car.transcript", "appmode dump car.transcript --csv > car.csv"),
+    "plot": ("appmode plot car.transcript -o car.png",),
+    "ports": ("appmode ports",),
+    "doctor": ("appmode doctor", "appmode doctor /dev/ttyUSB0 --json"),
+}
+"""Two or three examples a command, shown at the end of its --help (each parses: a test
+checks them)."""

@@ -17,7 +17,7 @@ from types import ModuleType
 
 from appmode import __version__
 from appmode.cli import outlet
-from appmode.cli.commands import COMMANDS
+from appmode.cli.commands import COMMANDS, EXAMPLES
 from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
 from appmode.host import signals
@@ -51,7 +51,10 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     for name, help in COMMANDS.items():
         if command is None or name == command:
             module: ModuleType = importlib.import_module(f"appmode.cli.{name}")
-            module.register(sub).set_defaults(handler=module.run)
+            command_parser = module.register(sub)
+            command_parser.set_defaults(handler=module.run)
+            if isinstance(command_parser, Parser):
+                command_parser.examples = EXAMPLES[name]
         else:
             sub.add_parser(name, help=help)  # its arguments are loaded when it runs
     return parser

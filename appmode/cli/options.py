@@ -140,6 +140,13 @@ class Parser(argparse.ArgumentParser):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
+        self.examples: tuple[str, ...] = ()
+        """Command lines shown at the end of the help."""
+
+    def format_help(self) -> str:
+        """argparse's help, then the examples as they are typed."""
+        shown = "".join(f"  $ {example}\n" for example in self.examples)
+        return super().format_help() + (f"\nexamples:\n{shown}" if shown else "")
 
     def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
         """As argparse's, but a write that fails (a full disk, a closed pipe) is not passed

@@ -202,3 +202,27 @@ def test_version_names_the_commit_in_a_checkout() -> None:
     assert done.returncode == 0 and done.stdout.startswith("appmode 0.1.0")
     if head.returncode == 0:  # a checkout (an sdist has no .git)
         assert head.stdout.strip() in done.stdout
+
+
+def test_every_command_s_help_ends_with_examples_that_parse() -> None:
+    """Issue 52.3: no help text had an example."""
+    import shlex
+
+    from appmode.cli.commands import COMMANDS, EXAMPLES
+    from appmode.cli.main import build_parser
+
+    assert set(EXAMPLES) == set(COMMANDS)
+    for name, examples in EXAMPLES.items():
+        assert 1 <= len(examples) <= 3, name
+        parser = build_parser(name)
+        words = shlex.split(examples[0])
+        assert words[:2] == ["appmode", name]
+        for example in examples:
+            words = shlex.split(example)
+            words = words[words.index("appmode") + 1 :]
+            for stop in ("<", ">", "|"):
+                words = words[: words.index(stop)] if stop in words else words
+            assert words[0] == name, example
+            parser.parse_args(words)  # SystemExit (a usage error) fails the test
+        help_text = run(name, "--help").stdout
+        assert help_text.rstrip().endswith(f"$ {examples[-1]}"), name
