@@ -35,7 +35,6 @@ class BoundedWriter:
         opener: Callable[[], int],
         name: str,
         limit: int = LIMIT,
-        close_fd: bool = True,
     ) -> None:
         self.name = name
         self.limit = limit
@@ -46,7 +45,6 @@ class BoundedWriter:
         self.side_errors: dict[int, OSError] = {}
         """Errors writing another descriptor (its bytes are dropped from then on)."""
         self._opener = opener
-        self._close_fd = close_fd
         self._queue: deque[tuple[int | None, bytes]] = deque()
         self._held = 0  # bytes queued and not yet written
         self._closing = False
@@ -112,15 +110,14 @@ class BoundedWriter:
         except OSError as exc:
             with self._lock:
                 self.error = exc
-                self._fail(_reason(exc))
+                self._fail(reason(exc))
             self._done.set()
             return
         try:
             self._drain(fd)
         finally:
-            if self._close_fd:
-                with contextlib.suppress(OSError):
-                    os.close(fd)
+            with contextlib.suppress(OSError):
+                os.close(fd)
             self._done.set()
 
     def _drain(self, fd: int) -> None:
@@ -141,7 +138,7 @@ class BoundedWriter:
                 with self._lock:
                     if target is None:
                         self.error = exc
-                        self._fail(_reason(exc))
+                        self._fail(reason(exc))
                         return
                     self.side_errors[target] = exc
             with self._lock:
@@ -151,7 +148,8 @@ class BoundedWriter:
                     self._lock.notify_all()
 
 
-def _reason(exc: OSError) -> str:
+def reason(exc: OSError) -> str:
+    """Why a write failed, for people."""
     if exc.errno == errno.EPIPE:
         return "its reader left"
     if exc.errno == errno.EFBIG:

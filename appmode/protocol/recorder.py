@@ -22,7 +22,7 @@ from appmode.protocol.transcript import (
     UART2_DIRECTIONS,
     uart2_payload,
 )
-from appmode.writer import BoundedWriter
+from appmode.writer import BoundedWriter, reason
 
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
 HEADER_WAIT = 0.1
@@ -135,7 +135,13 @@ class Recorder:
             raise AppmodeError(f"cannot write transcript {shown}: {exc.strerror}") from None
         try:
             if not background:
-                recorder = cls(os.fdopen(fd, "w", encoding="utf-8"), origin, directives, shown)
+                out = os.fdopen(fd, "w", encoding="utf-8")
+                try:
+                    recorder = cls(out, origin, directives, shown)
+                except AppmodeError:  # not even the header fits
+                    with contextlib.suppress(OSError):
+                        out.close()
+                    raise
                 recorder._closes = True
                 return recorder
             recorder = cls(BoundedWriter(lambda: fd, shown), origin, directives)
@@ -203,7 +209,7 @@ class Recorder:
             self._out.flush()
         except OSError as exc:
             self._failed = True
-            raise AppmodeError(f"cannot write transcript {self.name}: {_reason(exc)}") from None
+            raise AppmodeError(f"cannot write transcript {self.name}: {reason(exc)}") from None
 
     def close(self) -> None:
         """Write what the decoders still hold, and close the file (if it opened it),
@@ -227,11 +233,7 @@ class Recorder:
             try:
                 self._out.close()
             except OSError as exc:
-                said = f"cannot write transcript {self.name}: {_reason(exc)}"
+                said = f"cannot write transcript {self.name}: {reason(exc)}"
                 error = error or AppmodeError(said)
         if error is not None:
             raise error
-
-
-def _reason(exc: OSError) -> str | None:
-    return "its reader left" if isinstance(exc, BrokenPipeError) else exc.strerror

@@ -43,7 +43,7 @@ class StopGuard:
         writes are serialised)."""
         self._beat = time.monotonic()
         self.fired = False
-        """The guard sent a stop the session has not acknowledged yet (`acknowledge`)."""
+        """The guard sent (or is sending) a stop the session has not noted yet (`beat`)."""
         self._closed = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -71,8 +71,10 @@ class StopGuard:
                 self._end_process()
                 return
             if not self.fired and now - self._beat > STALL and self._moving():
-                self._send_stop()
+                # first: a tick that notes it before the stop is out errs on the safe side
+                # (the view shows stopped, the stop follows), never the other way round
                 self.fired = True
+                self._send_stop()
 
     def _send_stop(self) -> None:
         with contextlib.suppress(Exception):  # a link that is down has nothing to stop
