@@ -173,12 +173,11 @@ def open_fifo(path: str | os.PathLike[str], what: str, meanwhile: str = "Ctrl-C 
     except OSError as exc:
         if exc.errno != errno.ENXIO:
             raise
-        print(
+        sys.stderr.write(  # one write: a line of another thread's never cuts it
             f"appmode: waiting for a program to read the FIFO {os.fspath(path)} before "
-            f"writing the {what} ({meanwhile})",
-            file=sys.stderr,
-            flush=True,
+            f"writing the {what} ({meanwhile})\n"
         )
+        sys.stderr.flush()
         return os.open(path, os.O_WRONLY | _CLOEXEC)
     os.set_blocking(fd, True)
     return fd

@@ -125,7 +125,8 @@ def run_monitor(
     with ExitStack() as stack:
         host = open_host(stack, url, record, stop_on_close=stop_on_exit, layout=layout)
         doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"
-        print(f"{doing} (Ctrl-C to stop)", file=sys.stderr, flush=True)
+        sys.stderr.write(f"{doing} (Ctrl-C to stop)\n")  # one write: the FIFO's note is another
+        sys.stderr.flush()
         wanted = (e for e in host.events(duration) if kinds is None or _kind(e) in kinds)
         try:
             for event in until_count(wanted, _is_record, count):

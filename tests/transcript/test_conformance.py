@@ -177,9 +177,34 @@ def test_missing_paths_are_one_line_errors() -> None:
     assert done.returncode == 2 and "no such transcript or directory: nowhere" in done.stderr
 
 
-def test_the_suite_passes_in_real_time_against_a_board_process() -> None:
-    """The whole suite over two ptys (the APP port and UART2), paced: about 150 s. The
-    parameters the board had before are restored afterwards."""
+LIVE_GROUPS = {
+    "frames and telemetry": ("s2_*", "s3_*"),
+    "letters omni": ("s4_letters_omni*",),
+    "letters mecanum": ("s4_letters_mecanum*",),
+    "letters diff": ("s4_letters_diff.transcript",),
+    "letters diff-gyro": ("s4_letters_diff_gyro*",),
+    "parameters and UART2 settings": ("s5_*", "uart2/s10_*", "uart2/s11_*", "uart2/s12_*"),
+    "UART2 frames and motion": ("uart2/s8_*", "uart2/s9_*"),
+}
+"""The suite in real time, cut into groups of 20–40 s that run side by side (each group
+in sequence against its own board, as `conform --board` runs a suite)."""
+
+
+def _group(patterns: tuple[str, ...]) -> list[Path]:
+    return sorted({path for pattern in patterns for path in SUITE_DIR.glob(pattern)})
+
+
+def test_the_live_groups_hold_the_whole_suite_once() -> None:
+    grouped = [path for patterns in LIVE_GROUPS.values() for path in _group(patterns)]
+    assert sorted(grouped) == SUITE
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", LIVE_GROUPS)
+def test_the_suite_passes_in_real_time_against_a_board_process(name: str) -> None:
+    """A group of the suite over two ptys (the APP port and UART2), paced. The parameters
+    the board had before are restored afterwards."""
+    paths = _group(LIVE_GROUPS[name])
     with board_process("--pty", "--quiet") as board:
         assert run("params", board.url, "--set", "max_speed=800").returncode == 0
         done = run(
@@ -189,17 +214,19 @@ def test_the_suite_passes_in_real_time_against_a_board_process() -> None:
             "--board2",
             board.uart2,
             "--yes",
-            "transcripts/suite",
-            timeout=500,
+            *(str(path.relative_to(ROOT)) for path in paths),
+            timeout=300,
         )
         assert done.returncode == 0, done.stdout
         _, values = board_state(board.url)
-    power_up = sum("start=power-up" in path.read_text() for path in SUITE)  # skipped live
-    assert f"{len(SUITE) - power_up} passed, 0 failed, {power_up} skipped against /dev/" in (
-        done.stdout
+    power_up = sum("start=power-up" in path.read_text() for path in paths)  # skipped live
+    counts = f"{len(paths) - power_up} passed, 0 failed" + (
+        f", {power_up} skipped" * bool(power_up)
     )
+    assert f"{counts} against /dev/" in done.stdout
     assert "restored the parameters found at the start (" in done.stdout
-    assert "note: the board's control port (UART2) has taken over its motion" in done.stdout
+    takes_over = any(path.parent.name == "uart2" for path in paths)
+    assert takes_over == ("note: the board's control port (UART2) has taken over" in done.stdout)
     assert values == (800, *params.DEFAULTS[1:])
 
 
