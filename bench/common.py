@@ -190,14 +190,30 @@ def over_floor(cpu: Share) -> str:
     )
 
 
-def floor_row(cpu: Share) -> tuple[str, str, str]:
+class Row(NamedTuple):
+    """A row of the benchmark table."""
+
+    benchmark: str
+    result: str
+    target: str
+    met: bool | None
+    """Whether the result meets the target; None for a row with no target of its own."""
+
+
+def floor_row(cpu: Share) -> Row:
     """The benchmark table's row for `cpu`'s floor."""
-    return (
+    return Row(
         "its floor: a bare loop, same wake-ups and pty writes",
         f"{cpu.floor:.2f} % of a core ({cpu.floor_wakeups:.0f} wake-ups/s, "
         f"{cpu.floor_writes:.0f} writes/s; the board {cpu.wakeups:.0f}, {cpu.writes:.0f})",
         "",
+        None,
     )
+
+
+def over_floor_met(cpu: Share, margin: float = 0.3) -> bool:
+    """Whether `cpu`'s median excess over its floor is within `margin` % of a core."""
+    return statistics.median(cpu.over) <= margin
 
 
 class Floor(NamedTuple):
