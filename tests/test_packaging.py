@@ -1,6 +1,7 @@
 """What `pip install .` puts on a machine: the wheel ships the conformance suite (kept in
-the repository's transcripts/suite, mapped into the package at build time) and the pytest
-plugin's entry point, and an installed `appmode conform` runs that suite."""
+the repository's transcripts/suite, mapped into the package at build time), the protocol
+reference (docs/protocol.md, likewise) and the pytest plugin's entry point, and an
+installed `appmode conform` runs that suite and `appmode protocol` reads that reference."""
 
 from __future__ import annotations
 
@@ -70,6 +71,26 @@ def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_pa
     sheet = len(list((ROOT / "transcripts" / "suite").glob("*.transcript")))
     sheet += len(list((ROOT / "transcripts" / "suite" / "uart2").glob("*.transcript")))
     assert f"{sheet} passed, 0 failed" in done.stdout
+    reference = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from appmode.cli.main import main; sys.exit(main())",
+            "protocol",
+            "8.3",
+        ],
+        cwd=elsewhere,
+        env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"},
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert reference.returncode == 0, reference.stderr
+    assert reference.stdout.startswith("### 8.3 Who drives")  # from the installed copy
+    assert (site / "appmode" / "docs" / "protocol.md").read_bytes() == (
+        ROOT / "docs" / "protocol.md"
+    ).read_bytes()
 
 
 def test_the_default_wheel_is_pure_python(wheel: Path) -> None:

@@ -128,13 +128,13 @@ class Profile:
         """AppmodeError when a board of this profile is asked for what it does not have."""
         if drive and not self.drive_types:
             raise AppmodeError(
-                f"the {self.name} profile has no drive types (docs/protocol.md §13): "
+                f"the {self.name} profile has no drive types (see appmode protocol 13): "
                 "leave out the drive type"
             )
         if flash and not self.saves:
             raise AppmodeError(
                 f"the {self.name} profile saves nothing and starts from its factory "
-                "defaults (docs/protocol.md §13): leave out the flash file"
+                "defaults (see appmode protocol 13): leave out the flash file"
             )
 
 

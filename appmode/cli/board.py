@@ -22,7 +22,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         description="Serve the simulated board so that any serial program (the phone app "
         "through a Bluetooth module, miniterm, appmode itself) can talk to it. Prints "
         "'port: URL' (the APP port, UART3 at 9600 bps) and 'uart2: URL' (the control "
-        "port, UART2 at 115200 bps, docs/protocol.md §8) for clients to open, then logs "
+        "port, UART2 at 115200 bps; see appmode protocol 8) for clients to open, then logs "
         "what it receives, port by port, until Ctrl-C.",
     )
     _add_where(board)
@@ -43,7 +43,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_profile(
         board,
         "the board's behaviour: sheet (the vendor's sheet, the default) or "
-        "minibalance (the reference firmware as measured, docs/protocol.md §13)",
+        "minibalance (the reference firmware as measured; see appmode protocol 13)",
     )
     board.add_argument(
         "--drive", choices=DRIVE_NAMES, help="drive type (default: the saved one, else omni)"

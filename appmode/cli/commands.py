@@ -20,6 +20,8 @@ COMMANDS: dict[str, str] = {
     "plot": "draw a transcript's telemetry (needs matplotlib)",
     "ports": "list serial ports (USB-UART adapters, Bluetooth rfcomm)",
     "doctor": "find the car: check each serial port and say how to drive it or what to fix",
+    "protocol": "print the protocol reference, or one of its sections",
+    "completion": "print the shell's completion script (bash, zsh, fish)",
 }
 """Each command's one-line help; its module has `register(sub)` (its arguments) and
 `run(args)` (the job)."""
@@ -48,6 +50,11 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "plot": ("appmode plot car.transcript -o car.png",),
     "ports": ("appmode ports",),
     "doctor": ("appmode doctor", "appmode doctor /dev/ttyUSB0 --json"),
+    "protocol": ("appmode protocol", "appmode protocol 8.3", "appmode protocol II"),
+    "completion": (
+        "appmode completion bash > ~/.local/share/bash-completion/completions/appmode",
+        "appmode completion fish > ~/.config/fish/completions/appmode.fish",
+    ),
 }
 """Two or three examples a command, shown at the end of its --help (each parses: a test
 checks them)."""

@@ -87,7 +87,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_profile(
         demo,
         "the simulated board's behaviour: sheet or minibalance (the reference firmware, "
-        "docs/protocol.md §13; it has no drive types)",
+        "see appmode protocol 13; it has no drive types)",
     )
     demo.add_argument(
         "--fast", action="store_true", help="run on virtual time instead of real time"

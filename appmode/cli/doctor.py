@@ -57,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         print(
             wrapped(
                 "no serial ports found: plug in the USB-UART adapter, or pair and bind the "
-                "car's Bluetooth module (see 'Connecting a car' in the README); "
+                "car's Bluetooth module (bluetoothctl: pair MAC; then sudo rfcomm bind 0 MAC 1); "
                 "'appmode board --pty' serves a simulated board to try this on",
                 indent="",
             ),

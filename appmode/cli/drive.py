@@ -109,7 +109,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
     add_profile(
         parser,
         "the board's profile: with no URL, the simulated board's (sheet or minibalance: the "
-        "reference firmware, docs/protocol.md §13); with a URL, what its A record holds",
+        "reference firmware; see appmode protocol 13); with a URL, what its A record holds",
         default=None,
     )
     add_record(parser)

@@ -60,7 +60,7 @@ def add_record(parser: argparse.ArgumentParser) -> None:
 
 HOLDS = (
     "for what its A record holds: sheet (x, y, z) or minibalance (|0.7x|, |0.7y|, battery; "
-    "docs/protocol.md §13)"
+    "see appmode protocol 13)"
 )
 A_RECORD = f"the board's profile, {HOLDS}"
 ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {HOLDS}"

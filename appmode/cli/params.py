@@ -74,7 +74,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_profile(
         prm,
         "the board's profile (with a sim:// URL, the simulated board's), for the defaults "
-        "shown: sheet or minibalance (the reference firmware, docs/protocol.md §13)",
+        "shown: sheet or minibalance (the reference firmware; see appmode protocol 13)",
         default=None,
     )
     add_record(prm)

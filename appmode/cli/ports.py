@@ -27,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
     if not ports:
         out.write(
             "no serial ports found: plug in the USB-UART adapter, or bind the car's "
-            "Bluetooth module (see 'Connecting a car' in the README); "
+            "Bluetooth module (appmode doctor /dev/rfcomm0 says how); "
             "'appmode board --pty' serves a simulated board\n"
         )
         return 0

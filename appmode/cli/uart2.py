@@ -22,13 +22,13 @@ from appmode.text import counted, wrapped
 
 QUIET_UART2 = (
     "a board sends replies only to reads, and encoder reports only while system_mode "
-    "bit 6 is set (docs/protocol.md §12); 'appmode send URL --uart2 wait:5' turns the "
+    "bit 6 is set (see appmode protocol 12); 'appmode send URL --uart2 wait:5' turns the "
     "report on for its session"
 )
 UNLIMITED = "a minibalance board takes velocities unlimited by max_speed (§13.1)"
 TAKEOVER = (
     "frames sent on the control port take over the car's motion from the APP port "
-    "(any 10 bytes, docs/protocol.md §8.3)"
+    "(any 10 bytes; see appmode protocol 8.3)"
 )
 
 

@@ -144,5 +144,5 @@ class ReadQuery:
         return (
             f"{what} reading {', '.join(missing)} on {self.where} after {self.rounds} "
             "tries: is this the board's control port (UART2, 115200 bps)? The reference "
-            "firmware does not answer reads (docs/protocol.md §13)"
+            "firmware does not answer reads (see appmode protocol 13)"
         )

@@ -62,7 +62,7 @@ def velocity_for(motion: Motion, speed: int, drive: DriveType) -> dict[str, int]
 
 
 NO_READS = (
-    "this board answers no reads (the reference firmware, docs/protocol.md §13): its "
+    "this board answers no reads (the reference firmware; see appmode protocol 13): its "
     "settings and wheels are not shown, and its velocities are not limited to max_speed"
 )
 

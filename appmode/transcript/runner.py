@@ -298,7 +298,7 @@ def run_conform(
 
 
 TAKEN_OVER = (
-    "the board's control port (UART2) has taken over its motion (docs/protocol.md §8.3): "
+    "the board's control port (UART2) has taken over its motion (see appmode protocol 8.3): "
     "drive letters on the APP port (the phone app, appmode send, drive) do nothing until "
     "the board is reset or powered off; nothing sent can give the APP port its motion back"
 )
