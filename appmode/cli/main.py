@@ -115,6 +115,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
+    if "_ARGCOMPLETE" in os.environ:  # the shell asks what to complete (appmode completion)
+        from appmode.cli.completion import complete
+
+        complete(build_parser(None))
     words = sys.argv[1:] if argv is None else argv
     command = command_in(words)
     if command and command not in COMMANDS:
