@@ -59,7 +59,7 @@ def test_no_reply_resends_each_timeout_then_fails_naming_what_to_check() -> None
     assert data == b""
     assert isinstance(outcome, QueryFailed)
     assert outcome.text.startswith("no reply reading max_speed on /dev/pts/9 after 3 tries")
-    assert "§13" in outcome.text
+    assert "(see appmode protocol 13)" in outcome.text
 
 
 def test_a_set_is_sent_each_round_until_the_value_reads_back() -> None:
