@@ -18,15 +18,17 @@ def test_api_examples_run() -> None:
 
 
 def test_protocol_reference_is_in_the_repository() -> None:
-    texts = [ROOT / "README.md", *ROOT.joinpath("docs").glob("*.md")]
+    texts = [ROOT / "README.md", *ROOT.joinpath("docs").rglob("*.md")]
     package = ROOT / "appmode"
     texts += [*package.rglob("*.py"), *ROOT.joinpath("transcripts").rglob("*.transcript")]
     for path in texts:
         text = path.read_text(encoding="utf-8")
         assert "shared/" not in text, f"{path} points outside the repository"
+        if ROOT / "docs" in path.parents:  # a page of the site links to its neighbours
+            continue
         assert not re.search(r"(?<![\w/])protocol\.md", text), f"{path}: say docs/protocol.md"
     assert (ROOT / "docs" / "protocol.md").is_file()
-    assert "[docs/protocol.md](docs/protocol.md)" in (ROOT / "README.md").read_text()
+    assert "](docs/protocol.md)" in (ROOT / "README.md").read_text()
 
 
 CITED = re.compile(
@@ -50,8 +52,8 @@ def _resolves(dotted: str) -> bool:
 
 
 def test_the_code_the_documents_name_exists() -> None:
-    """README's decision table and docs/design.md name modules and classes: they exist."""
-    for doc in (ROOT / "README.md", ROOT / "docs" / "design.md"):
+    """The decision table and the design notes name modules and classes: they exist."""
+    for doc in (ROOT / "docs" / "decisions.md", ROOT / "docs" / "design.md"):
         cited = set(CITED.findall(doc.read_text(encoding="utf-8")))
         assert len(cited) > 10
         missing = sorted(name for name in cited if not _resolves(name))

@@ -1,4 +1,5 @@
-"""The README stays true: its parameter table is the code's table."""
+"""The README and the documents stay true: the parameter table is the code's table, and
+the README stays a front door."""
 
 from __future__ import annotations
 
@@ -7,11 +8,13 @@ from pathlib import Path
 
 from appmode.protocol import params
 
-README = Path(__file__).resolve().parent.parent / "README.md"
+ROOT = Path(__file__).resolve().parent.parent
+README = ROOT / "README.md"
 
 
-def test_readme_parameter_table_matches_params() -> None:
-    rows = re.findall(r"^\| (\d) \| (\w+) \| (\d+)–(\d+) \| (\d+) \|$", README.read_text(), re.M)
+def test_the_parameter_table_matches_params() -> None:
+    decisions = (ROOT / "docs" / "decisions.md").read_text()
+    rows = re.findall(r"^\| (\d) \| (\w+) \| (\d+)–(\d+) \| (\d+) \|$", decisions, re.M)
     assert rows == [
         (str(p.index), p.name, str(p.minimum), str(p.maximum), str(p.default))
         for p in params.PARAMS
@@ -22,15 +25,16 @@ def test_readme_opens_with_two_setup_commands() -> None:
     block = re.search(r"```sh\n(.*?)```", README.read_text(), re.S)
     assert block is not None
     assert block.group(1).splitlines() == [
-        "pip install . && appmode drive",
+        "pip install '.[web]' && appmode drive",
         "pip install '.[test]' && pytest",
     ]
 
 
-def test_the_headings_appmode_points_at_are_in_the_readme() -> None:
-    """Issue 23.5: the `ports` hint pointed at a heading that does not exist."""
-    lines = README.read_text().splitlines()
-    headings = {line.lstrip("#").strip() for line in lines if line.startswith("#")}
-    for path in (README.parent / "appmode").rglob("*.py"):
-        for name in re.findall(r"see '([^']+)' in the README", path.read_text()):
-            assert name in headings, f"{path}: no heading {name!r} in the README"
+def test_readme_fits_on_a_screen_and_links_into_the_docs() -> None:
+    """Issue 52.1: at most 250 lines, and every document it links to is there."""
+    text = README.read_text()
+    assert len(text.splitlines()) <= 250
+    links = re.findall(r"\]\(((?:docs/)?[\w/.-]+\.(?:md|png|svg))\)", text)
+    assert len(links) > 10
+    missing = [link for link in links if not (ROOT / link).is_file()]
+    assert not missing, f"the README links to documents that are not there: {missing}"

@@ -1,13 +1,13 @@
-"""Issue 23.5: every `$ …` example of the README runs, in order, and prints what the
-README shows.
+"""Issue 23.5: every `$ …` example of the README and of the documentation site runs, in
+order, and prints what the document shows (issue 52: wherever an example moves).
 
-Boards the README starts (`$ appmode board …`) are started, and the pty names it shows
-stand for theirs. An example's output matches when its lines come in order (`…` alone
-on a line stands for any lines, `…` in a line for any text there). On a line of
-readings from a board in real time (a timed `0.123 <` line, the console's velocity row)
-a number may differ from the README's by 20 % (at least 3, or 0.1 with decimals): a
-speed read at a slightly other moment; elsewhere a duration may differ by 0.1 s or
-20 %, and every other number is exact.
+Each document runs in a folder of its own. Boards a document starts (`$ appmode board
+…`) are started, and the pty names it shows stand for theirs. An example's output
+matches when its lines come in order (`…` alone on a line stands for any lines, `…` in a
+line for any text there). On a line of readings from a board in real time (a timed
+`0.123 <` line, the console's velocity row) a number may differ from the document's by
+20 % (at least 3, or 0.1 with decimals): a speed read at a slightly other moment;
+elsewhere a duration may differ by 0.1 s or 20 %, and every other number is exact.
 """
 
 from __future__ import annotations
@@ -23,9 +23,11 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import pytest
+
 from tests.support.processes import ROOT
 
-README = ROOT / "README.md"
+DOCUMENTS = [ROOT / "README.md", *sorted(ROOT.joinpath("docs").rglob("*.md"))]
 
 NOT_RUN = {
     "appmode ports": "lists this machine's serial ports, which differ from machine to machine",
@@ -43,7 +45,7 @@ NOT_RUN = {
 """Examples not run here, and why."""
 
 SWITCH = 2.0
-"""Seconds between starting a board and the next command: the README's board logs show
+"""Seconds between starting a board and the next command: the documents' board logs show
 a person switching to another shell."""
 NUMBER = re.compile(r"(-?\d+(?:\.\d+)?)")
 LIVE = re.compile(r"\s*(\d+\.\d{3} |velocity |attitude |link up |APP port: )")
@@ -57,12 +59,12 @@ class Example:
     expected: list[str]
 
 
-def examples() -> list[Example]:
-    """The README's `$ …` commands, each with the lines shown after it in its block."""
+def examples(document: Path) -> list[Example]:
+    """A document's `$ …` commands, each with the lines shown after it in its block."""
     found: list[Example] = []
     block = False
     current: Example | None = None
-    for number, line in enumerate(README.read_text().splitlines(), 1):
+    for number, line in enumerate(document.read_text(encoding="utf-8").splitlines(), 1):
         if line.startswith("```"):
             block, current = not block, None
         elif block and line.startswith("$ "):
@@ -139,12 +141,12 @@ def output_matches(expected: list[str], actual: list[str], timed: bool) -> int |
 
 
 class Boards:
-    """The boards the README starts, and the names it shows for their ptys."""
+    """The boards a document starts, and the names it shows for their ptys."""
 
     def __init__(self, cwd: Path) -> None:
         self.cwd = cwd
         self.procs: list[subprocess.Popen[str]] = []
-        self.names: dict[str, str] = {}  # README name → this run's pty
+        self.names: dict[str, str] = {}  # the document's name → this run's pty
 
     def start(self, example: Example) -> list[str]:
         proc = subprocess.Popen(
@@ -200,16 +202,26 @@ def run_shell(command: str, cwd: Path) -> str:
     return done.stdout
 
 
-def test_every_readme_example_runs_and_prints_what_the_readme_shows(tmp_path: Path) -> None:
+WITH_EXAMPLES = [
+    document
+    for document in DOCUMENTS
+    if any(example.command not in NOT_RUN for example in examples(document))
+]
+"""The documents with examples to run."""
+
+
+@pytest.mark.parametrize("document", WITH_EXAMPLES, ids=lambda d: str(d.relative_to(ROOT)))
+def test_every_example_runs_and_prints_what_its_document_shows(
+    document: Path, tmp_path: Path
+) -> None:
     (tmp_path / "examples").symlink_to(ROOT / "examples")
     boards = Boards(tmp_path)
     failures: list[str] = []
-    ran = set()
+    name = document.relative_to(ROOT)
     try:
-        for example in examples():
+        for example in examples(document):
             if example.command in NOT_RUN:
                 continue
-            ran.add(example.command)
             if example.command.startswith("appmode board"):
                 out = "\n".join(boards.start(example))
                 expected = example.expected[:3]
@@ -222,15 +234,18 @@ def test_every_readme_example_runs_and_prints_what_the_readme_shows(tmp_path: Pa
             if failed is not None:
                 where = expected[failed] if failed < len(expected) else "(the end)"
                 failures.append(
-                    f"README.md:{example.line}: $ {example.command}\n  no match for: {where}\n"
+                    f"{name}:{example.line}: $ {example.command}\n  no match for: {where}\n"
                     + "\n".join(f"  | {line}" for line in shown)
                 )
     finally:
         boards.stop()
     assert not failures, "\n\n".join(failures)
-    listed = {e.command for e in examples()}
-    assert set(NOT_RUN) <= listed, "NOT_RUN names an example the README no longer has"
-    assert ran, "no example ran"
+
+
+def test_the_examples_not_run_are_in_the_documents() -> None:
+    listed = {e.command for document in DOCUMENTS for e in examples(document)}
+    assert set(NOT_RUN) <= listed, "NOT_RUN names an example no document has"
+    assert ROOT / "README.md" in WITH_EXAMPLES
 
 
 def test_the_matcher_tells_a_right_output_from_a_wrong_one() -> None:

@@ -178,9 +178,9 @@ def test_a_board_with_a_bad_option_says_what_it_takes(tmp_path: Path) -> None:
     assert "appmode_board: unknown option speed (it takes profile, drive, faults" in done.stdout
 
 
-def test_the_readme_example_passes(tmp_path: Path) -> None:
-    readme = (ROOT / "README.md").read_text()
-    section = readme[readme.index("### Testing your own host code") :]
+def test_the_guide_s_example_passes(tmp_path: Path) -> None:
+    """The example of docs/guide/pytest-plugin.md, as a user copies it."""
+    section = (ROOT / "docs" / "guide" / "pytest-plugin.md").read_text()
     code = section[section.index("```python\n") + 10 : section.index("```\n", 10)]
     (tmp_path / "pytest.ini").write_text("[pytest]\n")
     (tmp_path / "test_readme_example.py").write_text(code)
