@@ -14,9 +14,11 @@ import pytest
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: two workers a core. Most tests wait on boards, ptys and processes in
-    real time, so two a core keep the cores busy; their timing holds beside a second run."""
-    return 2 * (os.cpu_count() or 1)
+    """`-n auto`: three workers for two cores. Most tests wait on boards, ptys and
+    processes in real time, so more workers than cores keep the cores busy, and no more
+    than that leaves room for a second run beside this one (their timing holds)."""
+    cores = os.cpu_count() or 1
+    return cores + cores // 2
 
 
 @pytest.fixture(autouse=True)

@@ -292,6 +292,7 @@ def test_a_save_is_requested_then_verified_after_a_restart(tmp_path: Path) -> No
     assert "does not hold what was saved" in lost.stderr and "max_speed 900 → 500" in lost.stderr
 
 
+@pytest.mark.slow
 def test_a_car_still_moving_after_a_stop_is_said_loudly() -> None:
     from tests.support.lenient_board import runaway_board
 

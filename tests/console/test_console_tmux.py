@@ -12,6 +12,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from appmode.protocol import params
 from tests.support.processes import ROOT, board_process, board_state, sent_lines, wait_for
 
@@ -142,6 +144,7 @@ def test_sigterm_ends_the_console_with_z_last(tmp_path: Path) -> None:
     assert "A" in sent and sent[-1] == "Z"
 
 
+@pytest.mark.slow
 def test_sigterm_ends_script_mode_with_z_last(tmp_path: Path) -> None:
     record = tmp_path / "script.transcript"
     proc = subprocess.Popen(
@@ -209,6 +212,7 @@ def test_at_80x24_help_waveforms_and_the_message_log(tmp_path: Path) -> None:
             tmux("kill-session", "-t", SESSION)
 
 
+@pytest.mark.slow
 def test_two_ending_signals_end_the_console_with_z_last(tmp_path: Path) -> None:
     """Issue 22.2: SIGTERM and SIGHUP together. The console used to give the signals
     back to their default action before its final `Z`: a SIGHUP then killed it."""

@@ -6,6 +6,7 @@ import io
 import re
 import time
 import xml.etree.ElementTree as ET
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -186,8 +187,8 @@ LIVE_GROUPS = {
     "parameters and UART2 settings": ("s5_*", "uart2/s10_*", "uart2/s11_*", "uart2/s12_*"),
     "UART2 frames and motion": ("uart2/s8_*", "uart2/s9_*"),
 }
-"""The suite in real time, cut into groups of 20–40 s that run side by side (each group
-in sequence against its own board, as `conform --board` runs a suite)."""
+"""The suite in real time, cut into groups of 20–40 s, each run in sequence against a
+board of its own (as `conform --board` runs a suite), all at once: they mostly wait."""
 
 
 def _group(patterns: tuple[str, ...]) -> list[Path]:
@@ -199,14 +200,14 @@ def test_the_live_groups_hold_the_whole_suite_once() -> None:
     assert sorted(grouped) == SUITE
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("name", LIVE_GROUPS)
-def test_the_suite_passes_in_real_time_against_a_board_process(name: str) -> None:
-    """A group of the suite over two ptys (the APP port and UART2), paced. The parameters
-    the board had before are restored afterwards."""
+def _live(name: str) -> str | None:
+    """A group of the suite over two ptys (the APP port and UART2), paced, against a board
+    process of its own whose max_speed was 800: None when it passed and the board has its
+    parameters back, else why not."""
     paths = _group(LIVE_GROUPS[name])
     with board_process("--pty", "--quiet") as board:
-        assert run("params", board.url, "--set", "max_speed=800").returncode == 0
+        if run("params", board.url, "--set", "max_speed=800").returncode != 0:
+            return "max_speed could not be set before the run"
         done = run(
             "conform",
             "--board",
@@ -217,17 +218,31 @@ def test_the_suite_passes_in_real_time_against_a_board_process(name: str) -> Non
             *(str(path.relative_to(ROOT)) for path in paths),
             timeout=300,
         )
-        assert done.returncode == 0, done.stdout
         _, values = board_state(board.url)
     power_up = sum("start=power-up" in path.read_text() for path in paths)  # skipped live
     counts = f"{len(paths) - power_up} passed, 0 failed" + (
         f", {power_up} skipped" * bool(power_up)
     )
-    assert f"{counts} against /dev/" in done.stdout
-    assert "restored the parameters found at the start (" in done.stdout
     takes_over = any(path.parent.name == "uart2" for path in paths)
-    assert takes_over == ("note: the board's control port (UART2) has taken over" in done.stdout)
-    assert values == (800, *params.DEFAULTS[1:])
+    checks = {
+        "exit status 0": done.returncode == 0,
+        f"{counts}": f"{counts} against /dev/" in done.stdout,
+        "the parameters restored": "restored the parameters found at the start (" in done.stdout,
+        "UART2's take-over noted when it took over": takes_over
+        == ("note: the board's control port (UART2) has taken over" in done.stdout),
+        "max_speed 800 and the rest at their defaults": values == (800, *params.DEFAULTS[1:]),
+    }
+    failed = [what for what, held in checks.items() if not held]
+    return f"{name}: not {', '.join(failed)}\n{done.stdout}" if failed else None
+
+
+@pytest.mark.slow
+def test_the_suite_passes_in_real_time_against_board_processes() -> None:
+    """Every group at once, each against its own board: the whole suite in the time of
+    its longest group (about 45 s)."""
+    with ThreadPoolExecutor(len(LIVE_GROUPS)) as pool:
+        failures = [why for why in pool.map(_live, LIVE_GROUPS) if why is not None]
+    assert not failures, "\n".join(failures)
 
 
 def test_a_real_board_is_driven_only_when_the_user_agrees() -> None:

@@ -66,6 +66,7 @@ def test_a_recording_on_a_disk_already_full_leaves_no_empty_file(tmp_path: Path)
     assert not record.exists()
 
 
+@pytest.mark.slow
 def test_dump_streams_in_constant_memory(tmp_path: Path) -> None:
     path = tmp_path / "long.transcript"
     with path.open("w") as out:

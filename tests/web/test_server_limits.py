@@ -14,6 +14,8 @@ import socket
 import time
 from pathlib import Path
 
+import pytest
+
 from appmode.web.server import HEADER_TIMEOUT, MAX_CONNECTIONS
 from tests.support.web import WebProcess, web_process
 from tests.web.test_https import insecure, local
@@ -81,6 +83,7 @@ def test_a_flood_of_malformed_requests_logs_a_line_or_two(tmp_path: Path) -> Non
     assert len([line for line in err.splitlines() if line.startswith("appmode web: ")]) <= 2, err
 
 
+@pytest.mark.slow
 def test_connections_past_the_cap_are_closed_and_half_sent_requests_time_out(
     tmp_path: Path,
 ) -> None:
