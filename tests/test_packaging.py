@@ -42,22 +42,16 @@ def test_the_wheel_ships_the_suite_from_transcripts(wheel: Path) -> None:
     assert "[pytest11]\nappmode = appmode.testing.plugin" in text
 
 
-def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_path: Path) -> None:
-    site = tmp_path / "site"
-    subprocess.run(
-        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(site), wheel],
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
+def installed(site: Path, tmp_path: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    """`appmode ARGS` as installed in `site`, run from a folder away from the checkout."""
     elsewhere = tmp_path / "elsewhere"
-    elsewhere.mkdir()
-    done = subprocess.run(
+    elsewhere.mkdir(exist_ok=True)
+    return subprocess.run(
         [
             sys.executable,
             "-c",
             "import sys; from appmode.cli.main import main; sys.exit(main())",
-            "conform",
+            *args,
         ],
         cwd=elsewhere,
         env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"},
@@ -66,26 +60,23 @@ def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_pa
         timeout=120,
         check=False,
     )
+
+
+def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(site), wheel],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    done = installed(site, tmp_path, "conform")
     assert done.returncode == 0, done.stderr
     assert f"the shipped suite: {site / 'appmode' / 'suite'}" in done.stdout
     sheet = len(list((ROOT / "transcripts" / "suite").glob("*.transcript")))
     sheet += len(list((ROOT / "transcripts" / "suite" / "uart2").glob("*.transcript")))
     assert f"{sheet} passed, 0 failed" in done.stdout
-    reference = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            "import sys; from appmode.cli.main import main; sys.exit(main())",
-            "protocol",
-            "8.3",
-        ],
-        cwd=elsewhere,
-        env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"},
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
+    reference = installed(site, tmp_path, "protocol", "8.3")
     assert reference.returncode == 0, reference.stderr
     assert reference.stdout.startswith("### 8.3 Who drives")  # from the installed copy
     assert (site / "appmode" / "docs" / "protocol.md").read_bytes() == (
