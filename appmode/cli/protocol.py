@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         if not match:
             numbers = [name for _, level, name in sections if level == 2]
             raise AppmodeError(
-                f"no section {args.section} in the protocol reference: its sections are "
+                f"no section {args.section!r} in the protocol reference: its sections are "
                 f"{numbers[0]}–{numbers[-1]} and their subsections (appmode protocol lists them)"
             )
         start, level = match[0]

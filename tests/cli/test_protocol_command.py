@@ -35,7 +35,7 @@ def test_a_subsection_without_a_heading_is_told_within_its_section() -> None:
 def test_a_section_that_is_none_is_one_line() -> None:
     done = run("protocol", "99")
     assert done.returncode == 2 and done.stdout == ""
-    assert done.stderr.startswith("appmode: error: no section 99 in the protocol reference")
+    assert done.stderr.startswith("appmode: error: no section '99' in the protocol reference")
     assert len(done.stderr.splitlines()) == 1
 
 
