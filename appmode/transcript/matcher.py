@@ -13,11 +13,14 @@ start=power-up` names the board the transcript needs: its profile (default sheet
 type, and whether time 0 is the board's power-up. `@align` makes the next expectation
 match whenever it comes (after its sends, by its time + tolerance), and shifts the times
 of the expectations after it by how early or late it came: timing is then checked
-against the board's own rhythm.
+against the board's own rhythm. A `>` line sent late (a runner held up by a loaded
+machine) shifts the expectations that follow it by as much: the board is judged on when
+it got each command, not on when it was due.
 """
 
 from __future__ import annotations
 
+import bisect
 import re
 from dataclasses import dataclass, field
 
@@ -144,6 +147,8 @@ class Check:
     offset: float = 0.0
     """Shift of expectation times, set by an `@align` match."""
     sent: int = 0
+    late: list[float] = field(default_factory=list)
+    """How late each `>` line sent so far went out (seconds, never negative)."""
     matched: int = 0
     closest: dict[str, tuple[float, str]] = field(default_factory=dict)
     """Per letter, the unmatched record nearest the expectation's time: what came instead."""
@@ -208,6 +213,7 @@ class Check:
         while self.sent < len(self.sends) and self.sends[self.sent].time <= now:
             entry = self.sends[self.sent]
             out.append((UART2_PORT if entry.direction == SENT2 else APP_PORT, entry.data))
+            self.late.append(max(0.0, now - entry.time))
             self.sent += 1
         return out
 
@@ -252,7 +258,7 @@ class Check:
             return
         if exp.pattern.matches(record):
             if exp.align:
-                self.offset = now - exp.entry.time
+                self.offset = now - exp.entry.time - self._lateness(exp)
             self.matched += 1
             self.closest.clear()
             return
@@ -264,8 +270,14 @@ class Check:
             self.closest[letter] = (distance, f"{shown} at {now:.3f} s")
 
     def _time(self, exp: Expectation) -> float:
-        """When the expectation is due: its time, shifted by the last @align match."""
-        return exp.entry.time + (0.0 if exp.align else self.offset)
+        """When the expectation is due: its time, shifted by the last @align match and by
+        how late the `>` line before it went out."""
+        return exp.entry.time + (0.0 if exp.align else self.offset) + self._lateness(exp)
+
+    def _lateness(self, exp: Expectation) -> float:
+        """How late the last `>` line before the expectation went out (0 before any)."""
+        last = bisect.bisect_right(self.sends, exp.after, key=lambda e: e.time) - 1
+        return self.late[last] if 0 <= last < len(self.late) else 0.0
 
     def active(self) -> bool:
         """An expectation is waiting and every `>` line before it has been sent."""
