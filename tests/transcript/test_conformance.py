@@ -188,8 +188,7 @@ LIVE_GROUPS = {
     "letters diff-gyro": ("s4_letters_diff_gyro*",),
 }
 """The suite in real time, cut into groups of 20–45 s, each run in sequence against a
-board of its own (as `conform --board` runs a suite), longest first, four at a time:
-they mostly wait."""
+board of its own (as `conform --board` runs a suite), all at once: they mostly wait."""
 
 
 def _group(patterns: tuple[str, ...]) -> list[Path]:
@@ -238,10 +237,11 @@ def _live(name: str) -> str | None:
 
 
 @pytest.mark.slow
+@pytest.mark.alone
 def test_the_suite_passes_in_real_time_against_board_processes() -> None:
-    """Four groups at a time, each against its own board: the whole suite in about 50 s
-    (its longest group takes 45 s), and room left for a second test run beside it."""
-    with ThreadPoolExecutor(4) as pool:
+    """Every group at once, each against its own board, after the rest of the suite: the
+    whole suite in the time of its longest group (about 45 s)."""
+    with ThreadPoolExecutor(len(LIVE_GROUPS)) as pool:
         failures = [why for why in pool.map(_live, LIVE_GROUPS) if why is not None]
     assert not failures, "\n".join(failures)
 
