@@ -191,5 +191,6 @@ def test_history_is_kept_across_sessions_without_quit(
     run_console(tmp_path, first)
     history = (private_data_folder / "appmode" / "history").read_text()
     assert "+latch on" in history and "+quit" not in history
-    session, _, _ = run_console(tmp_path, [(":", 0.1), (UP, 0.2), ("\r", 0.3), (CTRL_C, 0.0)])
+    recall = [(":", 0.5), (UP, 0.5), ("\r", 0.5), (CTRL_C, 0.0)]  # a person's pace
+    session, _, _ = run_console(tmp_path, recall)
     assert session.messages.count("latched driving on") == 1  # recalled from the file
