@@ -80,6 +80,13 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         "IPv6; port 0 picks a free one)",
     )
     where.add_argument(
+        "--bluetooth",
+        action="store_true",
+        help="serve as a Bluetooth module (BLE HC-08 and classic HC-05) through a BlueZ "
+        "stand-in on a private D-Bus bus: prints 'bus: ADDRESS' for "
+        "DBUS_SYSTEM_BUS_ADDRESS (Linux, needs dbus-daemon and appmode[bluetooth])",
+    )
+    where.add_argument(
         "--port",
         metavar="DEV",
         help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
@@ -110,11 +117,20 @@ def run(args: argparse.Namespace) -> int:
     from appmode.ports.serve import ServeOptions, run_board
     from appmode.protocol.params import DriveType
 
-    alone = (args.listen, args.port, args.link, args.flash, args.record, args.listen2, args.port2)
+    alone = (
+        args.listen,
+        args.port,
+        args.bluetooth or None,
+        args.link,
+        args.flash,
+        args.record,
+        args.listen2,
+        args.port2,
+    )
     if args.count > 1 and any(option is not None for option in alone):
         raise AppmodeError(
             "--count serves several boards on ptys: it cannot be combined "
-            "with --listen, --port, --listen2, --port2, --link, --flash or --record"
+            "with --listen, --port, --bluetooth, --listen2, --port2, --link, --flash or --record"
         )
     options = ServeOptions(
         app=_app_endpoint(args),
@@ -140,6 +156,14 @@ def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
         return partial(endpoints.TcpEndpoint, host=host, port=port, baud=args.baud)
     if args.port is not None:
         return partial(endpoints.SerialEndpoint, device=args.port, baud=args.baud or BAUD)
+    if args.bluetooth:
+        try:
+            from appmode.bluetooth.endpoint import BluetoothEndpoint
+        except ImportError:
+            raise AppmodeError(
+                "--bluetooth needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+            ) from None
+        return partial(BluetoothEndpoint, baud=args.baud)
     return partial(endpoints.PtyEndpoint, link=args.link, baud=args.baud)
 
 

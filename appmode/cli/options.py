@@ -22,7 +22,8 @@ if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
-    "rfc2217://HOST:PORT, loop:// or sim:// (the simulated board)"
+    "rfc2217://HOST:PORT, ble://ADDRESS or NAME (a BLE module), bt://ADDRESS (a paired "
+    "classic module), loop:// or sim:// (the simulated board)"
 )
 
 

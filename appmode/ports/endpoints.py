@@ -13,6 +13,7 @@ import socket
 from collections.abc import Callable
 from functools import partial
 from pathlib import Path
+from typing import Protocol
 
 import serial
 
@@ -56,6 +57,8 @@ class PtyEndpoint:
     The server holds the slave open itself, so the master never sees EIO when a client
     closes, and the path stays the same for the next client.
     """
+
+    details: tuple[str, ...] = ()
 
     def __init__(
         self,
@@ -163,6 +166,8 @@ def _symlink(target: str, link: str) -> None:
 class TcpEndpoint:
     """A TCP listener serving one client at a time; others are refused while it stays."""
 
+    details: tuple[str, ...] = ()
+
     def __init__(
         self,
         sel: selectors.BaseSelector,
@@ -267,6 +272,8 @@ class TcpEndpoint:
 class SerialEndpoint:
     """A real serial port (a USB-UART, with a Bluetooth module for the phone app)."""
 
+    details: tuple[str, ...] = ()
+
     def __init__(
         self, sel: selectors.BaseSelector, log: Log, device: str, baud: int = BAUD
     ) -> None:
@@ -299,7 +306,19 @@ class SerialEndpoint:
         self._port.close()
 
 
-Endpoint = PtyEndpoint | TcpEndpoint | SerialEndpoint
+class Endpoint(Protocol):
+    """What the board server asks of an endpoint (the three above, and the Bluetooth
+    stand-in's)."""
+
+    url: str
+    baud: int | None
+    details: tuple[str, ...]
+    """Lines `appmode board` prints after the URLs (none but the Bluetooth stand-in's)."""
+
+    def pause(self, paused: bool) -> None: ...
+    def read(self, size: int, ready: object) -> bytes: ...
+    def write(self, data: bytes) -> None: ...
+    def close(self) -> None: ...
 
 
 def parse_listen(text: str, option: str = "--listen") -> tuple[str, int]:

@@ -148,6 +148,10 @@ class BoardServer:
         """The URLs of board `index`'s ports, by port name (`app`, `uart2`)."""
         return {name: e.url for name, e in self._served[index].endpoints.items()}
 
+    def details(self, index: int = 0) -> list[str]:
+        """What else clients need to reach board `index` (the Bluetooth stand-in's bus)."""
+        return [line for e in self._served[index].endpoints.values() for line in e.details]
+
     def look(self, index: int, see: Callable[[Board], T]) -> T:
         """`see(board)` for board `index` run to now, between two steps of the server."""
         with self.lock:
@@ -348,6 +352,8 @@ def run_board(options: ServeOptions) -> int:
             for i in range(options.count):
                 for name, url in server.urls(i).items():
                     print(f"{'port' if name == APP else name}: {url}", flush=True)
+                for line in server.details(i):
+                    print(line, flush=True)
             log(options.banner(boards[0].drive_type))
             server.run()
         finally:

@@ -27,15 +27,18 @@ if TYPE_CHECKING:
 
 NO_PTY = "this system has no pseudo-terminals (Windows)"
 
-if "appmode.ports" not in serial.protocol_handler_packages:
-    serial.protocol_handler_packages.append("appmode.ports")  # sim:// (protocol_sim.py)
+for _package in ("appmode.ports", "appmode.bluetooth"):  # sim://; ble:// and bt://
+    if _package not in serial.protocol_handler_packages:
+        serial.protocol_handler_packages.append(_package)
 
 BAUD = 9600
-SCHEMES = ("sim", "socket", "rfc2217", "loop")
+SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt")
 NETWORK_SCHEMES = ("socket", "rfc2217")
+OWN_WORDS = ("sim", "ble", "bt")
+"""Schemes whose ports say themselves what went wrong and what to do."""
 URL_HELP = (
     "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
-    "rfc2217://HOST:PORT, loop:// or sim://"
+    "rfc2217://HOST:PORT, ble://ADDRESS, bt://ADDRESS, loop:// or sim://"
 )
 
 
@@ -115,7 +118,7 @@ def is_rfcomm(where: str) -> bool:
 def explain_open_error(where: str, exc: Exception) -> str:
     code = getattr(exc, "errno", None)
     text = str(exc)
-    if is_simulated(where):  # the simulated board's own message: what, then the fix
+    if where.split("://", 1)[0].lower() in OWN_WORDS:  # the port's message: what, then the fix
         return text
     if code == errno.ENOENT or "No such file" in text:
         if is_rfcomm(where):

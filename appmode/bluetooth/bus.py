@@ -1,0 +1,110 @@
+"""A private D-Bus bus: Debian's `dbus-daemon` with a configuration of our own, listening
+on a socket in a new folder, so the BlueZ stand-in never touches the machine's system bus.
+Programs reach it with DBUS_SYSTEM_BUS_ADDRESS set to `address`."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import tempfile
+import threading
+from pathlib import Path
+from types import TracebackType
+
+from appmode.errors import AppmodeError
+
+CONFIG = """<!DOCTYPE busconfig PUBLIC "-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN"
+ "http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd">
+<busconfig>
+  <type>appmode</type>
+  <listen>unix:path={socket}</listen>
+  <auth>EXTERNAL</auth>
+  <policy context="default">
+    <allow user="*"/>
+    <allow own="*"/>
+    <allow send_destination="*" eavesdrop="true"/>
+    <allow receive_sender="*"/>
+  </policy>
+  <limit name="max_message_unix_fds">16</limit>
+</busconfig>
+"""
+"""Anyone on this machine who can reach the socket (a folder only its owner may enter)
+may own a name and call anything: the bus carries one stand-in and its clients."""
+START = 5.0
+"""Seconds the daemon may take to say its address."""
+NO_DAEMON = (
+    "dbus-daemon is not installed: the BlueZ stand-in runs its own D-Bus bus with it "
+    "(Debian, Ubuntu: sudo apt install dbus-daemon; Fedora: sudo dnf install dbus-daemon)"
+)
+
+
+class PrivateBus:
+    """A `dbus-daemon` of our own, stopped (and its folder removed) by `close`."""
+
+    def __init__(self) -> None:
+        daemon = shutil.which("dbus-daemon")
+        if daemon is None:
+            raise AppmodeError(NO_DAEMON)
+        self._folder = Path(tempfile.mkdtemp(prefix="appmode-bus-"))
+        config = self._folder / "bus.conf"
+        config.write_text(CONFIG.format(socket=self._folder / "bus"), encoding="utf-8")
+        self._process = subprocess.Popen(
+            [daemon, f"--config-file={config}", "--nofork", "--nopidfile", "--print-address"],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            self.address = self._read_address()
+        except BaseException:
+            self.close()
+            raise
+
+    def _read_address(self) -> str:
+        try:
+            line = _first_line(self._process, START)
+        except subprocess.TimeoutExpired:
+            raise AppmodeError(f"dbus-daemon did not start within {START:g} s") from None
+        if not line.startswith("unix:"):
+            why = (self._process.stderr.read() if self._process.stderr else "").strip()
+            raise AppmodeError(f"dbus-daemon did not start: {why or 'no address printed'}")
+        return line.strip()
+
+    def close(self) -> None:
+        if self._process.poll() is None:
+            self._process.terminate()
+            try:
+                self._process.wait(2)
+            except subprocess.TimeoutExpired:
+                self._process.kill()
+                self._process.wait()
+        for stream in (self._process.stdout, self._process.stderr):
+            if stream is not None:
+                stream.close()
+        shutil.rmtree(self._folder, ignore_errors=True)
+
+    def __enter__(self) -> PrivateBus:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+def _first_line(process: subprocess.Popen[str], timeout: float) -> str:
+    """The first line the daemon prints (its address), waiting at most `timeout`."""
+    got: list[str] = []
+    reader = threading.Thread(
+        target=lambda: got.append(process.stdout.readline() if process.stdout else ""),
+        daemon=True,
+    )
+    reader.start()
+    reader.join(timeout)
+    if reader.is_alive():
+        raise subprocess.TimeoutExpired("dbus-daemon", timeout)
+    return got[0] if got else ""
