@@ -13,6 +13,7 @@ raise SerialException, as an unplugged adapter does, so a host's link reconnects
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import threading
 import time
@@ -131,7 +132,7 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
                     await asyncio.sleep(wait)
                 try:
                     await client.write_gatt_char(write, chunk, response=response)
-                except Exception as exc:  # noqa: BLE001 (the link is gone: said once)
+                except Exception as exc:  # the link is gone: said once
                     self._disconnected(exc)
                     return
                 ahead.wrote(len(chunk), time.monotonic())
@@ -209,10 +210,8 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
                 self._ready.wait(0.05)
         client = self._client
         if client is not None:
-            try:
+            with contextlib.suppress(Exception):  # gone already: nothing to end
                 self._runner.run(client.disconnect(), CLOSE)
-            except Exception:  # noqa: BLE001, S110 (gone already: nothing to end)
-                pass
         self._runner.close()
 
 

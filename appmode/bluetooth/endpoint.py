@@ -28,7 +28,11 @@ class BluetoothEndpoint:
         self._private = PrivateBus()
         self.bus = self._private.address
         self.url = f"ble://{BLE_ADDRESS}"
-        self.details = (f"bus: {self.bus}", f"ble: {BLE_ADDRESS} {BLE_NAME}", f"spp: {SPP_ADDRESS}")
+        self.details: tuple[str, ...] = (
+            f"bus: {self.bus}",
+            f"ble: {BLE_ADDRESS} {BLE_NAME}",
+            f"spp: {SPP_ADDRESS}",
+        )
         self._mine, theirs = socket.socketpair()
         self._mine.setblocking(False)
         self._out = Overrun(log, "the stand-in")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import contextlib
 import threading
 from collections.abc import Coroutine
 from typing import TypeVar
@@ -44,10 +45,8 @@ class LoopThread:
             await asyncio.gather(*tasks, return_exceptions=True)
 
         if self._thread.is_alive():
-            try:
+            with contextlib.suppress(TimeoutError):
                 self.run(cancel_all(), 2.0)
-            except TimeoutError:
-                pass
             self.loop.call_soon_threadsafe(self.loop.stop)
             self._thread.join(2.0)
         if not self._thread.is_alive():
