@@ -40,6 +40,9 @@ WRITE_BUFFER = 4096
 AHEAD = PAYLOAD
 """Bytes the writer lets the module's buffer hold beyond what its UART has sent."""
 CLOSE = 3.0
+LINGER = 0.05
+"""Seconds between the last write and hanging up: a few connection events, so that
+what the radio holds (a session's stop) is sent before the link ends."""
 BAUD = 9600
 
 
@@ -208,6 +211,8 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
         with self._ready:
             while self._queued and self._lost is None and time.monotonic() < deadline:
                 self._ready.wait(0.05)
+        if self._lost is None:
+            time.sleep(LINGER)
         client = self._client
         if client is not None:
             with contextlib.suppress(Exception):  # gone already: nothing to end

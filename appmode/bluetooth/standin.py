@@ -188,6 +188,8 @@ class StandIn:
         if not device.le and self._spp_link is not None:
             self._spp_link.close()
             self._spp_link = None
+        if device.le:
+            self._deliver()  # what a central wrote goes before the link ends
         if device.connected:
             device.set_state(False)
             self._log(f"{'ble' if device.le else 'spp'}: {device.label} disconnected")
@@ -225,22 +227,23 @@ class StandIn:
 
     async def _events(self) -> None:
         """The BLE connection's events: writes in, notifications out."""
-        loop = asyncio.get_running_loop()
         while True:
             now = time.monotonic()
             await asyncio.sleep(next_event(now, self._origin) - now)
-            if not self.ble.connected:
-                self._writes.clear()
-                continue
-            for data in self._writes:
-                await self._to_board(loop, self.module.from_radio(data, time.monotonic()))
-            self._writes.clear()
+            self._deliver()
             for chunk in self.module.notifications():
                 self.characteristic.notify(chunk)
 
-    async def _to_board(self, loop: asyncio.AbstractEventLoop, data: bytes) -> None:
-        if data:
-            await loop.sock_sendall(self._board, data)
+    def _deliver(self) -> None:
+        """The writes made since the last connection event reach the module."""
+        for data in self._writes:
+            self._to_board(self.module.from_radio(data, time.monotonic()))
+        self._writes.clear()
+
+    def _to_board(self, data: bytes) -> None:
+        """Bytes out of the module's UART (the board's end reads all it is sent)."""
+        with contextlib.suppress(BlockingIOError):
+            self._board.send(data)
 
     async def _from_board(self, loop: asyncio.AbstractEventLoop) -> None:
         while True:
@@ -263,6 +266,6 @@ class StandIn:
                 data = b""
             if not data:
                 break
-            await self._to_board(loop, spp.from_radio(data, time.monotonic()))
+            self._to_board(spp.from_radio(data, time.monotonic()))
         if self._spp_link is link:
             self.disconnect(device)
