@@ -59,7 +59,7 @@ class Link(Generic[E]):
         self.tap = tap
         self._opener = opener
         self._port: serial.SerialBase | None = opener(url)
-        self._writing = threading.Lock()  # the stop guard may write from its thread
+        self._writing = threading.RLock()  # the stop guard may write from its thread
         # after opening: an in-process sim:// board booted just now, and its clock is ours
         board_origin = getattr(self._port, "clock_origin", None)
         self._origin = time.monotonic() if board_origin is None else float(board_origin)
@@ -118,6 +118,7 @@ class Link(Generic[E]):
             return
         self._heard = False
         if not self.proves_return:
+            self._stop_after_outage()
             self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
             return
         if self._proven:  # said once an outage
@@ -126,10 +127,18 @@ class Link(Generic[E]):
             )
         self._proven = False
 
+    def _stop_after_outage(self) -> None:
+        """The first thing a reopened link sends is the stop: the car kept its last
+        command while the link was down (the firmware has no time-out)."""
+        if self.stop_on_close and self._port is not None:
+            with self._writing, contextlib.suppress(LinkLost):
+                self._write_chunk(self._stop())
+
     def _proven_by_output(self) -> None:
         """The protocol decoded the board's output: a reopened link is back."""
         if not self._proven:
             self._proven = True
+            self._stop_after_outage()
             self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
 
     def _write(self, data: bytes) -> None:
