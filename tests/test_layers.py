@@ -13,6 +13,7 @@ LAYERS = (
     "board",
     "line",
     "ports",
+    "bluetooth",
     "host",
     "transcript",
     "session",

@@ -19,6 +19,7 @@ COMMANDS: dict[str, str] = {
     "dump": "decode a transcript",
     "plot": "draw a transcript's telemetry (needs matplotlib)",
     "ports": "list serial ports (USB-UART adapters, Bluetooth rfcomm)",
+    "scan": "list nearby Bluetooth modules (BLE and paired classic) and their URLs",
     "doctor": "find the car: check each serial port and say how to drive it or what to fix",
     "protocol": "print the protocol reference, or one of its sections",
     "completion": "print the shell's completion script (bash, zsh, fish)",
@@ -37,7 +38,11 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "decode": ("appmode decode capture.bin", "appmode decode --from host < sent.bin"),
     "board": ("appmode board --pty", "appmode board --listen 5000 --profile minibalance"),
     "send": ("appmode send sim:// J A wait:1", "appmode send /dev/ttyUSB0 '{Q:P}' --json"),
-    "params": ("appmode params sim://", "appmode params /dev/ttyUSB0 --set max_speed=800 --save"),
+    "params": (
+        "appmode params sim://",
+        "appmode params /dev/ttyUSB0 --set max_speed=800 --save",
+        "appmode params ble://HC-08",
+    ),
     "monitor": ("appmode monitor sim:// --count 4", "appmode monitor /dev/ttyUSB0 --json"),
     "record": ("appmode record /dev/ttyUSB0 car.transcript --duration 60",),
     "conform": ("appmode conform", "appmode conform --board /dev/ttyUSB0 --yes"),
@@ -49,6 +54,7 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "dump": ("appmode dump car.transcript", "appmode dump car.transcript --csv > car.csv"),
     "plot": ("appmode plot car.transcript -o car.png",),
     "ports": ("appmode ports",),
+    "scan": ("appmode scan", "appmode scan --time 10 --json"),
     "doctor": ("appmode doctor", "appmode doctor /dev/ttyUSB0 --json"),
     "protocol": ("appmode protocol", "appmode protocol 8.3", "appmode protocol II"),
     "completion": (

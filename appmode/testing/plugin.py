@@ -7,7 +7,10 @@ Fixtures:
   flash=…)`), stopped after it;
 - `appmode_board_factory`: `appmode_board_factory(**options)` makes more;
 - `appmode_sim_url`: an in-process `sim://` URL (same options), for code that takes a
-  pyserial URL.
+  pyserial URL;
+- `appmode_ble_board`: the simulated board as a Bluetooth module behind the BlueZ
+  stand-in (`.ble`, `.spp`: the URLs; `.bus`), with DBUS_SYSTEM_BUS_ADDRESS set to its
+  bus for the test, so bleak and `ble://`/`bt://` reach it (Linux, dbus-daemon).
 
 `--appmode-board URL` (and `--appmode-board2 URL` for its control port) runs the same
 tests against a real car: the fixtures give its URLs, and a test that needs what only
@@ -246,3 +249,36 @@ def appmode_sim_url(request: pytest.FixtureRequest) -> Iterator[str]:
         query["pace"] = int(bool(query["pace"]))
     query["share"] = f"pytest-{next(_SHARES)}"
     yield f"sim://?{urlencode(query)}"
+
+
+@pytest.fixture
+def appmode_ble_board(
+    request: pytest.FixtureRequest,
+    tmp_path_factory: pytest.TempPathFactory,
+    monkeypatch: pytest.MonkeyPatch,
+) -> Iterator[ServedBoard]:
+    """The simulated board as a Bluetooth module (BLE HC-08 and paired classic HC-05)
+    behind the BlueZ stand-in on a private bus: `.ble` and `.spp` are the URLs that reach
+    it, `.bus` the bus, which DBUS_SYSTEM_BUS_ADDRESS names for the test; the rest as
+    `appmode_board` (options by `@pytest.mark.appmode_board`, faults excepted)."""
+    from appmode.errors import AppmodeError
+    from appmode.testing.served import ServedBoard
+
+    options = _options(request)
+    _check_options(options)
+    failed = None
+    try:
+        board = ServedBoard(
+            tmp_path_factory.mktemp("appmode_ble_board"),
+            home=Path(request.path).parent,
+            bluetooth=True,
+            **options,
+        )
+    except AppmodeError as exc:
+        failed = str(exc)
+    if failed is not None:
+        pytest.fail(f"appmode_ble_board: {failed}", pytrace=False)
+    assert board.bus is not None
+    monkeypatch.setenv("DBUS_SYSTEM_BUS_ADDRESS", board.bus)
+    yield board
+    board.close()

@@ -1,7 +1,8 @@
 """A simulated board served on two pseudo-terminals from a thread of the caller's process,
 for tests of host code that opens a serial port (the pytest plugin's `appmode_board`).
 
-Its ports are what `appmode board` serves: the APP port (UART3, 9600 bps) and the
+With `bluetooth=True` its APP port is a Bluetooth module behind the BlueZ stand-in, as
+`appmode board --bluetooth` serves it. Its ports are otherwise what `appmode board` serves: the APP port (UART3, 9600 bps) and the
 control port (UART2, 115200 bps), paced like the real lines; on Windows, where there are
 no ptys, two loopback TCP ports (`socket://127.0.0.1:N`). Everything either port carries
 is recorded, as by `appmode board --record`.
@@ -96,6 +97,7 @@ class ServedBoard:
         pace: bool = True,
         flash: str | Path | None = None,
         home: str | Path | None = None,
+        bluetooth: bool = False,
     ) -> None:
         folder = Path(folder)
         self.home = Path(home) if home is not None else None
@@ -119,7 +121,7 @@ class ServedBoard:
         needs += [f"drive={drive}"] if drive else []
         try:
             self._server = BoardServer(
-                [_endpoint()],
+                [_bluetooth() if bluetooth else _endpoint()],
                 [Board(store, drive=self._drive, profile=self.profile)],
                 pace=pace,
                 log=self.log.append,
@@ -137,6 +139,13 @@ class ServedBoard:
         """The APP port (UART3, 9600 bps): a path or URL that pyserial opens."""
         self.uart2: str = urls[UART2]
         """The control port (UART2, 115200 bps)."""
+        details = dict(line.split(": ", 1) for line in self._server.details())
+        self.bus: str | None = details.get("bus")
+        """With `bluetooth`: the BlueZ stand-in's bus, for DBUS_SYSTEM_BUS_ADDRESS."""
+        self.ble: str | None = f"ble://{details['ble'].split()[0]}" if details else None
+        """With `bluetooth`: the URL of the car's BLE module (HC-08)."""
+        self.spp: str | None = f"bt://{details['spp']}" if details else None
+        """With `bluetooth`: the URL of the car's paired classic module (HC-05)."""
         self._thread = threading.Thread(target=self._run, name="appmode board", daemon=True)
         self._thread.start()
 
@@ -234,6 +243,17 @@ class ServedBoard:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _bluetooth() -> MakeEndpoint:
+    """The BlueZ stand-in on a private bus (Linux; needs dbus-daemon and dbus-fast)."""
+    try:
+        from appmode.bluetooth.endpoint import BluetoothEndpoint
+    except ImportError:
+        raise AppmodeError(
+            "appmode_ble_board needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+        ) from None
+    return BluetoothEndpoint
 
 
 def _endpoint() -> MakeEndpoint:

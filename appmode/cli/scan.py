@@ -1,0 +1,90 @@
+"""`appmode scan`: the nearby cars' Bluetooth modules, each with the URL that drives it."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from appmode.cli.commands import COMMANDS
+from appmode.cli.options import Subparsers, number_type
+from appmode.errors import AppmodeError
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    scan = sub.add_parser(
+        "scan",
+        help=COMMANDS["scan"],
+        description="Listen for BLE modules (HM-10, HC-08, JDY-08, … : a UART service "
+        "FFE0 or Nordic UART) and list the paired classic modules (HC-05, HC-06), each "
+        "with its signal and the URL to give drive, web or params. Needs the bluetooth "
+        "extra: pip install 'appmode[bluetooth]'.",
+    )
+    scan.add_argument(
+        "--time",
+        type=number_type(0.5, 120),
+        default=5.0,
+        metavar="S",
+        help="seconds to listen (default 5)",
+    )
+    scan.add_argument(
+        "--all", action="store_true", help="list every device heard, not only cars' modules"
+    )
+    scan.add_argument("--json", action="store_true", help="one JSON object a line")
+    return scan
+
+
+def run(args: argparse.Namespace) -> int:
+    import asyncio
+
+    from appmode.bluetooth.availability import NO_BLEAK, explain
+
+    try:
+        from appmode.bluetooth.scan import Found, scan
+    except ImportError:
+        raise AppmodeError(NO_BLEAK) from None
+    shown = sys.stderr.isatty()
+
+    def progress(elapsed: float, count: int) -> None:
+        if shown:
+            sys.stderr.write(f"\rscanning {elapsed:3.0f}/{args.time:g} s: {count} heard ")
+            sys.stderr.flush()
+
+    try:
+        found: list[Found] = asyncio.run(scan(args.time, progress))
+    except ImportError:
+        raise AppmodeError(NO_BLEAK) from None
+    except Exception as exc:
+        raise AppmodeError(explain(exc) or f"scanning failed: {exc}") from None
+    finally:
+        if shown:
+            sys.stderr.write("\r\033[K")
+    listed = [f for f in found if args.all or f.likely]
+    if args.json:
+        for one in listed:
+            print(json.dumps(one.as_json()))
+        return 0
+    if not listed:
+        hidden = len(found) - len(listed)
+        more = f" ({hidden} other devices: --all lists them)" if hidden else ""
+        print(
+            f"no car's module heard in {args.time:g} s{more}: switch the car on, bring "
+            "it near, and disconnect any phone using it; a classic module (HC-05) "
+            "shows once paired (bluetoothctl: pair ADDRESS)"
+        )
+        return 1
+    rows = [("kind", "name", "address", "signal", "service", "url")] + [
+        (
+            f.kind,
+            f.name or "?",
+            f.address,
+            f"{f.rssi} dBm" if f.rssi is not None else "paired",
+            f.service or "-",
+            f.url,
+        )
+        for f in listed
+    ]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
+    for row in rows:
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
+    return 0

@@ -1,0 +1,203 @@
+"""The simulated car as a Bluetooth module behind the BlueZ stand-in, reached as a user
+would: a bleak program, `appmode scan`, and `ble://`/`bt://` in the commands. Each is
+judged on the board's own recording."""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+import serial
+
+import appmode.ports.urls  # noqa: F401 - registers ble:// and bt:// with pyserial
+from appmode.testing.served import ServedBoard
+from tests.support.processes import ROOT, appmode_cmd, run, wait_for
+
+BLEAK_ONLY = textwrap.dedent(
+    """
+    import asyncio
+    from bleak import BleakClient, BleakScanner
+
+    async def main():
+        device = await BleakScanner.find_device_by_name("HC-08", timeout=5)
+        got = bytearray()
+        async with BleakClient(device) as client:
+            await client.start_notify("0000ffe1-0000-1000-8000-00805f9b34fb",
+                                      lambda _, data: got.extend(data))
+            await client.write_gatt_char("0000ffe1-0000-1000-8000-00805f9b34fb",
+                                         b"{Q:P}", response=False)
+            for _ in range(100):
+                if b"{C" in got and got.endswith(b"$") and got.rfind(b"{C") < got.rfind(b"$"):
+                    break
+                await asyncio.sleep(0.02)
+        start = got.rfind(b"{C")
+        print(got[start:got.index(b"$", start) + 1].decode())
+
+    asyncio.run(main())
+    """
+)
+
+
+def sent(board: ServedBoard) -> bytes:
+    return b"".join(e.data for e in board.recording().entries if e.direction == ">")
+
+
+def test_a_bleak_program_that_knows_nothing_of_appmode_reads_the_parameters(
+    appmode_ble_board: ServedBoard, tmp_path: Path
+) -> None:
+    script = tmp_path / "plain_bleak.py"
+    script.write_text(BLEAK_ONLY)
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "{C500:10000:20:0:10:10:10:0:0}$"
+    assert b"{Q:P}" in sent(appmode_ble_board)
+
+
+def test_scan_lists_the_ble_module_and_the_paired_classic_one(
+    appmode_ble_board: ServedBoard,
+) -> None:
+    done = run("scan", "--time", "1", "--json")
+    assert done.returncode == 0, done.stderr
+    assert [line for line in done.stdout.splitlines() if '"ble"' in line or '"spp"' in line]
+    assert appmode_ble_board.ble is not None and appmode_ble_board.spp is not None
+    assert f'"url": "{appmode_ble_board.ble}"' in done.stdout
+    assert f'"url": "{appmode_ble_board.spp}"' in done.stdout
+    table = run("scan", "--time", "1")
+    assert "HC-08" in table.stdout and "FFE0" in table.stdout and "paired" in table.stdout
+
+
+@pytest.mark.parametrize("which", ["ble", "spp"])
+def test_params_reads_the_nine_parameters(appmode_ble_board: ServedBoard, which: str) -> None:
+    url = getattr(appmode_ble_board, which)
+    done = run("params", url)
+    assert done.returncode == 0, done.stderr
+    assert "max_speed                 500" in done.stdout
+    assert "system_mode" in done.stdout
+    wait_for(lambda: sent(appmode_ble_board).endswith(b"Z"), 5)
+    assert b"{Q:P}" in sent(appmode_ble_board)
+
+
+@pytest.mark.parametrize("which", ["ble", "spp"])
+def test_a_driving_script_moves_the_car_and_ends_with_z(
+    appmode_ble_board: ServedBoard, which: str
+) -> None:
+    url = getattr(appmode_ble_board, which)
+    done = run("drive", url, stdin=b"drive A\nwait 0.8\n")
+    assert done.returncode == 0, done.stderr
+    wait_for(lambda: sent(appmode_ble_board).endswith(b"Z"), 5)
+    assert b"A" in sent(appmode_ble_board)
+    appmode_ble_board.wait_until(lambda s: not s.moving, what="a stopped car")
+
+
+def test_sigterm_mid_drive_leaves_z_last(appmode_ble_board: ServedBoard) -> None:
+    assert appmode_ble_board.ble is not None
+    proc = subprocess.Popen(
+        appmode_cmd("drive", appmode_ble_board.ble),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None
+    proc.stdin.write("drive A\nwait 60\n")
+    proc.stdin.flush()
+    appmode_ble_board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
+    proc.send_signal(signal.SIGTERM)
+    proc.communicate(timeout=15)
+    wait_for(lambda: sent(appmode_ble_board).endswith(b"Z"), 5)
+    appmode_ble_board.wait_until(lambda s: not s.moving, what="a stopped car")
+
+
+def _drop(bus: str) -> None:
+    """Ask the stand-in to drop its connections (the car out of range)."""
+    from dbus_fast import Message, MessageType
+    from dbus_fast.aio import MessageBus
+
+    async def call() -> None:
+        link = await MessageBus(bus_address=bus).connect()
+        reply = await link.call(
+            Message(
+                destination="org.bluez",
+                path="/org/appmode/standin",
+                interface="org.appmode.StandIn1",
+                member="Drop",
+            )
+        )
+        link.disconnect()
+        assert reply is not None and reply.message_type == MessageType.METHOD_RETURN
+
+    asyncio.run(call())
+
+
+def test_a_dropped_link_is_lost_then_retried_and_z_goes_first(
+    appmode_ble_board: ServedBoard,
+) -> None:
+    board = appmode_ble_board
+    assert board.ble is not None and board.bus is not None
+    proc = subprocess.Popen(
+        appmode_cmd("drive", board.ble),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None
+    proc.stdin.write("drive A\nwait 60\n")
+    proc.stdin.flush()
+    try:
+        board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
+        before = len(sent(board))
+        _drop(board.bus)
+        wait_for(lambda: len(sent(board)) > before, 15)  # reconnected, and sent
+        assert sent(board)[before : before + 1] == b"Z"
+        board.wait_until(lambda s: not s.moving, what="a stopped car")
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=15)
+    assert "lost" in out + err and "is back" in out + err
+
+
+def test_a_burst_larger_than_the_modules_buffer_is_paced_not_lost(
+    appmode_ble_board: ServedBoard,
+) -> None:
+    port = serial.serial_for_url(appmode_ble_board.ble, timeout=0.1)
+    started = time.monotonic()
+    port.write(b"J" * 600)  # 600 bytes: more than four of the module's buffers
+    port.close()  # what was written goes first
+    took = time.monotonic() - started
+    wait_for(lambda: sent(appmode_ble_board).count(b"J") >= 600, 10)
+    assert sent(appmode_ble_board).count(b"J") == 600
+    assert took >= 600 / 960 * 0.9  # never faster than the module's UART
+
+
+COMMANDS = [
+    ("params", "ble://HC-08"),
+    ("params", "bt://02:CA:40:00:00:05"),
+    ("monitor", "ble://02:CA:40:00:00:08", "--count", "1"),
+    ("scan", "--time", "1"),
+]
+
+
+@pytest.mark.parametrize("command", COMMANDS, ids=lambda c: " ".join(c[:2]))
+def test_without_bluez_each_command_says_so_in_one_line(
+    command: tuple[str, ...], tmp_path: Path
+) -> None:
+    started = time.monotonic()
+    done = run(*command, env={"DBUS_SYSTEM_BUS_ADDRESS": f"unix:path={tmp_path}/no-bus"})
+    assert time.monotonic() - started < 10
+    assert done.returncode != 0
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "no Bluetooth here" in lines[0], done.stderr
+    assert "Traceback" not in done.stderr
+    assert os.environ.get("DBUS_SYSTEM_BUS_ADDRESS") != f"unix:path={tmp_path}/no-bus"
