@@ -41,6 +41,15 @@ NOT_RUN = {
     "appmode web": "a server until Ctrl-C: tests/web drives it, and its page in Chromium",
     "appmode drive /dev/pts/1 --uart2": "a full-screen console: tests/console drives it in tmux",
     "appmode drive /dev/pts/0 /dev/pts/1": "a full-screen console: tests/console drives it in tmux",
+    "appmode scan": "lists the Bluetooth modules near this machine: tests/bluetooth runs it "
+    "against the BlueZ stand-in",
+    "appmode board --bluetooth": "the BlueZ stand-in: tests/bluetooth starts it, and runs the "
+    "commands of its page against it",
+    "export DBUS_SYSTEM_BUS_ADDRESS='unix:path=/tmp/appmode-bus-3apg0o8e/bus,"
+    "guid=91d20ecb8e5542c34ca59b3f6b087e63'": "the bus of the stand-in above",
+    "appmode params ble://HC-08": "needs the stand-in above: tests/bluetooth runs it",
+    "printf 'drive A\\nwait 1\\n' | appmode drive bt://02:CA:40:00:00:05": "needs the "
+    "stand-in above: tests/bluetooth runs it",
 }
 """Examples not run here, and why."""
 
