@@ -23,7 +23,9 @@ from appmode.protocol.app_decoders import BoardDecoder
 SLOT = 0.05
 
 
-def measure(url: str, trials: int) -> list[float]:
+def measure(url: str, trials: int, carried: float = 0.0) -> list[float]:
+    """The time beyond the board's next slot; `carried`: the most a write may take to
+    reach the board (a radio's connection event), whose slot is then the next one."""
     port = open_link(url, timeout=0.2)
     decoder = BoardDecoder()
     extra: list[float] = []
@@ -44,7 +46,7 @@ def measure(url: str, trials: int) -> list[float]:
             got = time.monotonic()
             if any(isinstance(r, ParamsRecord) for r in decoder.feed(data)):
                 break
-        slots = math.ceil((sent - last_record) / SLOT - 1e-9)
+        slots = math.ceil((sent + carried - last_record) / SLOT - 1e-9)
         next_slot = last_record + slots * SLOT
         extra.append(max(0.0, got - next_slot))
         decoder = BoardDecoder()

@@ -26,6 +26,7 @@ import tty
 from collections.abc import Callable
 from pathlib import Path
 
+import bluetooth
 import conform_timing
 import decode_command
 import decoder
@@ -522,6 +523,7 @@ def main() -> None:
         ("minibalance", lambda: minibalance.rows(30 if quick else 100)),
         ("uart2", lambda: uart2.rows(quick)),
         ("web", lambda: web.rows(quick)),
+        ("bluetooth", lambda: bluetooth.rows(quick)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

@@ -81,6 +81,7 @@ class StandIn:
         self._spp_link: socket.socket | None = None
         self._tasks: set[asyncio.Task[None]] = set()
         self._found = False
+        self._linked = asyncio.Event()
         self._origin = time.monotonic()
 
     async def start(self) -> None:
@@ -145,6 +146,7 @@ class StandIn:
                         self._bus.export(path, interface)
                 await asyncio.sleep(CONNECTION_INTERVAL)
                 device.set_state(True)
+                self._linked.set()
                 self._log(f"ble: {device.label} connected")
             return
         await self._connect_spp(device, uuid or SPP)
@@ -190,6 +192,8 @@ class StandIn:
             self._spp_link = None
         if device.le:
             self._deliver()  # what a central wrote goes before the link ends
+        if device.le:
+            self._linked.clear()
         if device.connected:
             device.set_state(False)
             self._log(f"{'ble' if device.le else 'spp'}: {device.label} disconnected")
@@ -226,8 +230,11 @@ class StandIn:
             self._writes.append(data)
 
     async def _events(self) -> None:
-        """The BLE connection's events: writes in, notifications out."""
+        """The BLE connection's events: writes in, notifications out (none while no
+        central is connected: the stand-in sleeps)."""
         while True:
+            if not self.ble.connected:
+                await self._linked.wait()
             now = time.monotonic()
             await asyncio.sleep(next_event(now, self._origin) - now)
             self._deliver()
