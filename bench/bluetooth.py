@@ -21,9 +21,9 @@ import selectors
 import statistics
 import time
 from collections.abc import Callable, Iterator
-from typing import Any
 from contextlib import contextmanager
 from multiprocessing.connection import Connection
+from typing import Any
 
 import link_roundtrip
 import serial
@@ -123,8 +123,8 @@ def own_latency(trials: int) -> tuple[list[float], list[float], list[float]]:
     child.start()
     before = os.environ.get("DBUS_SYSTEM_BUS_ADDRESS")
     os.environ["DBUS_SYSTEM_BUS_ADDRESS"] = mine.recv()
-    BleakClient.write_gatt_char = timed_write  # type: ignore[method-assign]
-    BleSerial._notified = timed_notified  # type: ignore[method-assign]
+    BleakClient.write_gatt_char = timed_write  # type: ignore[method-assign, assignment]
+    BleSerial._notified = timed_notified  # type: ignore[method-assign, assignment]
     port = serial.serial_for_url("ble://HC-08", timeout=1)
     trips, platform, own = [], [], []
     rng = random.Random(1)
