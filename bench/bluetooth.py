@@ -85,7 +85,9 @@ def echo_board(bus: Connection, trials: int) -> None:
 
         return wrapper
 
-    standin.characteristic.notify = timed("notified", standin.characteristic.notify)
+    standin.characteristic.notify = timed(  # type: ignore[method-assign]
+        "notified", standin.characteristic.notify
+    )
     standin.characteristic._received = timed("written", standin.characteristic._received)
     bus.send(endpoint.bus)
     for _ in range(trials):
@@ -123,7 +125,7 @@ def own_latency(trials: int) -> tuple[list[float], list[float], list[float]]:
     child.start()
     before = os.environ.get("DBUS_SYSTEM_BUS_ADDRESS")
     os.environ["DBUS_SYSTEM_BUS_ADDRESS"] = mine.recv()
-    BleakClient.write_gatt_char = timed_write  # type: ignore[method-assign, assignment]
+    BleakClient.write_gatt_char = timed_write  # type: ignore[method-assign]
     BleSerial._notified = timed_notified  # type: ignore[method-assign, assignment]
     port = serial.serial_for_url("ble://HC-08", timeout=1)
     trips, platform, own = [], [], []

@@ -4,8 +4,9 @@ for tests of host code that opens a serial port (the pytest plugin's `appmode_bo
 With `bluetooth=True` its APP port is a Bluetooth module behind the BlueZ stand-in, as
 `appmode board --bluetooth` serves it. Its ports are otherwise what `appmode board`
 serves: the APP port (UART3, 9600 bps) and the control port (UART2, 115200 bps), paced
-like the real lines; on Windows, where there are no ptys, two loopback TCP ports (`socket://127.0.0.1:N`). Everything either port carries
-is recorded, as by `appmode board --record`.
+like the real lines; on Windows, where there are no ptys, two loopback TCP ports
+(`socket://127.0.0.1:N`). Everything either port carries is recorded, as by
+`appmode board --record`.
 """
 
 from __future__ import annotations
