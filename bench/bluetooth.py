@@ -85,7 +85,7 @@ def echo_board(bus: Connection, trials: int) -> None:
 
         return wrapper
 
-    standin.characteristic.notify = timed(  # type: ignore[method-assign]
+    standin.characteristic.notify = timed(  # type: ignore[method-assign, assignment]
         "notified", standin.characteristic.notify
     )
     standin.characteristic._received = timed("written", standin.characteristic._received)
