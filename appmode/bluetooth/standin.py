@@ -79,6 +79,7 @@ class StandIn:
         self._writes: list[bytes] = []
         self._profiles: list[tuple[str, str, str]] = []  # (sender, path, uuid)
         self._spp_link: socket.socket | None = None
+        self._spp_reader: asyncio.Task[None] | None = None
         self._tasks: set[asyncio.Task[None]] = set()
         self._found = False
         self._linked = asyncio.Event()
@@ -184,10 +185,15 @@ class StandIn:
         self._spp_link = mine
         device.set_state(True)
         self._log(f"spp: {device.label} connected")
-        self._spawn(self._from_spp(mine, device))
+        self._spp_reader = asyncio.ensure_future(self._from_spp(mine, device))
 
     def disconnect(self, device: Device) -> None:
         if not device.le and self._spp_link is not None:
+            reader = self._spp_reader
+            if reader is not None and reader is not asyncio.current_task():
+                reader.cancel()  # before the close: a socket closed under a read is a
+                # descriptor the loop still watches, and the next link may get its number
+            self._spp_reader = None
             self._spp_link.close()
             self._spp_link = None
         if device.le:
@@ -260,8 +266,8 @@ class StandIn:
             if self.ble.connected and self.characteristic.notifying:
                 self.module.from_uart(data)
             if self._spp_link is not None:
-                with contextlib.suppress(OSError):
-                    await loop.sock_sendall(self._spp_link, data)
+                with contextlib.suppress(OSError):  # a host that reads nothing: dropped
+                    self._spp_link.send(data)
 
     async def _from_spp(self, link: socket.socket, device: Device) -> None:
         loop = asyncio.get_running_loop()

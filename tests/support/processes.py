@@ -56,6 +56,13 @@ class BoardProcess:
         )
         self.url = self._read_port_line()
         self.uart2 = self._read_uart2_line()
+        self.details: dict[str, str] = {}
+        """With --bluetooth: the stand-in's `bus`, `ble` and `spp` lines."""
+        if "--bluetooth" in args:
+            assert self.proc.stdout is not None
+            for _ in range(3):
+                name, _, value = self.proc.stdout.readline().strip().partition(": ")
+                self.details[name] = value
 
     def _read_port_line(self, timeout: float = 20.0) -> str:
         assert self.proc.stdout is not None

@@ -57,12 +57,16 @@ class WebProcess:
 
 
 @contextmanager
-def web_process(tmp_path: Path, *args: str, uart2: bool = False) -> Iterator[WebProcess]:
+def web_process(
+    tmp_path: Path, *args: str, uart2: bool = False, bluetooth: bool = False
+) -> Iterator[WebProcess]:
     """A board on a pty recording what it receives, and `appmode web` driving it (its
     data folder, where a certificate is kept, in `tmp_path`); with `uart2`, over the
-    board's control port."""
+    board's control port; with `bluetooth`, over its BLE module behind the stand-in."""
     record = tmp_path / "board.transcript"
-    with board_process("--pty", "--record", str(record), "--quiet") as board:
+    where = "--bluetooth" if bluetooth else "--pty"
+    with board_process(where, "--record", str(record), "--quiet") as board:
+        bus = {"DBUS_SYSTEM_BUS_ADDRESS": board.details["bus"]} if bluetooth else {}
         proc = subprocess.Popen(
             appmode_cmd(
                 "web",
@@ -75,7 +79,7 @@ def web_process(tmp_path: Path, *args: str, uart2: bool = False) -> Iterator[Web
             stderr=subprocess.PIPE,
             text=True,
             cwd=ROOT,
-            env={**os.environ, "XDG_DATA_HOME": str(tmp_path / "data")},
+            env={**os.environ, "XDG_DATA_HOME": str(tmp_path / "data"), **bus},
         )
         assert proc.stdout is not None
         sel = selectors.DefaultSelector()

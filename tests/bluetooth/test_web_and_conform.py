@@ -1,0 +1,49 @@
+"""The page and the conformance suite over `ble://` and `bt://`, judged on the board's
+recording."""
+
+from __future__ import annotations
+
+import asyncio
+from pathlib import Path
+
+import aiohttp
+import pytest
+
+from appmode.testing.served import ServedBoard
+from tests.support.processes import run
+from tests.support.web import WebProcess, wait_sent, web_process
+from tests.web.test_server import page, ready
+
+SUITE = Path(__file__).resolve().parents[2] / "transcripts" / "suite"
+SOME = ("s2_2_read_params", "s4_letters_omni", "s5_set_each_param")
+
+
+def test_the_page_drives_the_car_over_ble(tmp_path: Path) -> None:
+    async def scenario(web: WebProcess) -> None:
+        async with aiohttp.ClientSession() as session:
+            socket = await page(session, web)
+            await ready(socket)
+            await socket.send_json({"t": "press", "key": "forward"})
+            wait_sent(web, "A")
+            await socket.send_json({"t": "release"})
+            wait_sent(web, "Z")
+            await socket.send_json({"t": "press", "key": "left"})
+            wait_sent(web, "G")
+            await socket.close()  # a closed page stops the car
+            wait_sent(web, "Z")
+
+    with web_process(tmp_path, bluetooth=True) as web:
+        assert web.board.url.startswith("ble://")
+        asyncio.run(scenario(web))
+    assert web.sent()[-1] == "Z"
+
+
+@pytest.mark.parametrize("which", ["ble", "spp"])
+def test_conform_passes_over_the_module(appmode_ble_board: ServedBoard, which: str) -> None:
+    url = getattr(appmode_ble_board, which)
+    files = [str(SUITE / f"{name}.transcript") for name in SOME]
+    done = run("conform", "--board", url, "--yes", *files, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"{len(SOME)} passed, 0 failed" in done.stdout
+    sent = [e.data for e in appmode_ble_board.recording().entries if e.direction == ">"]
+    assert sent[-1] == b"Z", sent[-5:]
