@@ -23,6 +23,8 @@ WORKERS = 8
 """Ports listened to at once."""
 REFRESH = 0.1
 """Seconds between redraws of the progress line."""
+BLUETOOTH_SCAN = 3.0
+"""Seconds `doctor` listens for BLE modules."""
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -34,14 +36,22 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "APP records and at 115200 for the control port (UART2), try the other common "
         "rates when the bytes are not records, read the parameters with {Q:P} (the only "
         "bytes it sends, and only to a port that streams records: never a drive letter), "
-        "and tell the firmware from its record period. Ends with one verdict per port. "
+        "and tell the firmware from its record period. With no URL it also checks the "
+        "Bluetooth modules it hears (ble://) or finds paired (bt://). Ends with one "
+        "verdict per port. "
         "Exit status: 0 when a car's port was found, 1 when none.",
     )
     doctor.add_argument(
         "urls",
         nargs="*",
         metavar="URL",
-        help="the ports to check (default: every serial port, as appmode ports lists them)",
+        help="the ports to check (default: every serial port, as appmode ports lists them, "
+        "and the Bluetooth modules appmode scan finds)",
+    )
+    doctor.add_argument(
+        "--no-bluetooth",
+        action="store_true",
+        help="with no URL: do not look for Bluetooth modules (a 3-second scan)",
     )
     doctor.add_argument("--json", action="store_true", help="print one JSON object per port")
     return doctor
@@ -53,12 +63,14 @@ def run(args: argparse.Namespace) -> int:
         from appmode.ports.listing import serial_ports
 
         urls = [port.device for port in serial_ports()]
+        if not args.no_bluetooth:
+            urls += _bluetooth()
     if not urls:
         print(
             wrapped(
-                "no serial ports found: plug in the USB-UART adapter, or pair and bind the "
-                "car's Bluetooth module (bluetoothctl: pair MAC; then sudo rfcomm bind 0 MAC 1); "
-                "'appmode board --pty' serves a simulated board to try this on",
+                "no serial ports found: plug in the USB-UART adapter, or pair the car's "
+                "Bluetooth module (appmode scan lists what is near); 'appmode board --pty' "
+                "serves a simulated board to try this on",
                 indent="",
             ),
             file=sys.stderr,
@@ -71,6 +83,31 @@ def run(args: argparse.Namespace) -> int:
         else:
             sys.stdout.write(_text(finding) + "\n")
     return 0 if any(f.is_car for f in findings) else 1
+
+
+def _bluetooth() -> list[str]:
+    """The URLs of the cars' Bluetooth modules near or paired; where none can be looked
+    for, a line on stderr says why."""
+    import asyncio
+
+    try:
+        from appmode.bluetooth.availability import explain
+        from appmode.bluetooth.scan import scan
+    except ImportError:
+        print("doctor: Bluetooth not looked for: pip install 'appmode[bluetooth]'", file=sys.stderr)
+        return []
+    if sys.stderr.isatty():
+        sys.stderr.write("doctor: listening for Bluetooth modules …")
+        sys.stderr.flush()
+    try:
+        found = asyncio.run(scan(BLUETOOTH_SCAN, lambda *_: None))
+    except Exception as exc:  # no Bluetooth here: said, and the serial ports are checked
+        print(f"doctor: Bluetooth not looked for: {explain(exc) or exc}", file=sys.stderr)
+        return []
+    finally:
+        if sys.stderr.isatty():
+            sys.stderr.write("\r\x1b[K")
+    return [f.url for f in found if f.likely]
 
 
 def _text(finding: probe.Finding) -> str:

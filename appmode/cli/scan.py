@@ -17,8 +17,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help=COMMANDS["scan"],
         description="Listen for BLE modules (HM-10, HC-08, JDY-08, … : a UART service "
         "FFE0 or Nordic UART) and list the paired classic modules (HC-05, HC-06), each "
-        "with its signal and the URL to give drive, web or params. Needs the bluetooth "
-        "extra: pip install 'appmode[bluetooth]'.",
+        "with its signal and the URL to give drive, web or params; --probe says which "
+        "firmware answers on each. Needs the bluetooth extra: pip install "
+        "'appmode[bluetooth]'.",
     )
     scan.add_argument(
         "--time",
@@ -29,6 +30,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     scan.add_argument(
         "--all", action="store_true", help="list every device heard, not only cars' modules"
+    )
+    scan.add_argument(
+        "--probe",
+        action="store_true",
+        help="connect to each module listed, listen, and read the parameters ({Q:P}) of "
+        "one that streams records, as doctor does: say which firmware answered",
     )
     scan.add_argument("--json", action="store_true", help="one JSON object a line")
     return scan
@@ -60,9 +67,11 @@ def run(args: argparse.Namespace) -> int:
         if shown:
             sys.stderr.write("\r\033[K")
     listed = [f for f in found if args.all or f.likely]
+    firmware = _probe([f.url for f in listed], shown) if args.probe else {}
     if args.json:
         for one in listed:
-            print(json.dumps(one.as_json()))
+            extra = {"firmware": firmware.get(one.url)} if args.probe else {}
+            print(json.dumps(one.as_json() | extra))
         return 0
     if not listed:
         hidden = len(found) - len(listed)
@@ -73,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
             "shows once paired (bluetoothctl: pair ADDRESS)"
         )
         return 1
-    rows = [("kind", "name", "address", "signal", "service", "url")] + [
+    head = ("kind", "name", "address", "signal", "service", "url")
+    rows = [head + (("firmware",) if args.probe else ())] + [
         (
             f.kind,
             f.name or "?",
@@ -82,9 +92,34 @@ def run(args: argparse.Namespace) -> int:
             f.service or "-",
             f.url,
         )
+        + ((firmware.get(f.url) or "-",) if args.probe else ())
         for f in listed
     ]
     widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
     for row in rows:
         print("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
     return 0
+
+
+def _probe(urls: list[str], shown: bool) -> dict[str, str | None]:
+    """What answers at each URL, one after the other (a module takes one central): the
+    firmware's profile for a car, else None. {Q:P} goes only to a port that streams
+    records (host.probe)."""
+    import threading
+
+    from appmode.host.probe import probe
+
+    stop = threading.Event()
+    answers: dict[str, str | None] = {}
+    for url in urls:
+
+        def say(text: str, url: str = url) -> None:
+            if shown:
+                sys.stderr.write(f"\r\033[Kprobing {url}: {text}")
+                sys.stderr.flush()
+
+        finding = probe(url, stop, say)
+        answers[url] = (finding.profile or "unknown") if finding.is_car else None
+    if shown:
+        sys.stderr.write("\r\033[K")
+    return answers

@@ -201,3 +201,33 @@ def test_without_bluez_each_command_says_so_in_one_line(
     assert len(lines) == 1 and "no Bluetooth here" in lines[0], done.stderr
     assert "Traceback" not in done.stderr
     assert os.environ.get("DBUS_SYSTEM_BUS_ADDRESS") != f"unix:path={tmp_path}/no-bus"
+
+
+def test_scan_probe_names_the_firmware_and_doctor_checks_the_modules(
+    appmode_ble_board: ServedBoard,
+) -> None:
+    done = run("scan", "--time", "1", "--probe")
+    assert done.returncode == 0, done.stderr
+    rows = {line.split()[0]: line.split()[-1] for line in done.stdout.splitlines()[1:]}
+    assert rows == {"ble": "sheet", "spp": "sheet"}
+    doctor = run("doctor")
+    assert f"ok {appmode_ble_board.ble}: this is a car" in doctor.stdout
+    assert f"ok {appmode_ble_board.spp}: this is a car" in doctor.stdout
+    assert doctor.returncode == 0
+    sent_now = sent(appmode_ble_board)
+    assert set(sent_now.replace(b"{Q:P}", b"")) <= set(b"Z")  # only reads, and stops
+
+
+def test_ctrl_c_ends_a_scan_cleanly(appmode_ble_board: ServedBoard) -> None:
+    proc = subprocess.Popen(
+        appmode_cmd("scan", "--time", "30"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    time.sleep(2)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 130
+    assert "Traceback" not in err
