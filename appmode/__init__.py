@@ -5,8 +5,9 @@ The public API (docs/api.md):
 - `Board`: the simulated board, a state machine with an injected clock;
 - `HostDecoder`, `BoardDecoder` and `encode`: the APP codec, with no I/O;
 - `Host`: the host side over any URL; `ControlHost`: the same over the control port;
-- `open_link`: open a board by URL (importing appmode registers `sim://` with pyserial,
-  so `serial.serial_for_url("sim://")` opens the simulated board in any program);
+- `open_link`: open a board by URL or `Target` (importing appmode registers `sim://`,
+  `ble://` and `bt://` with pyserial, so `serial.serial_for_url("sim://")` opens the
+  simulated board in any program); `parse_target`: a URL parsed once into a `Target`;
 - `read_transcript`, `parse_transcript` and `Recorder`: the transcript reader and writer;
 - `AppmodeError` (what went wrong, where, how to fix it) and its `TranscriptError`.
 
@@ -29,13 +30,15 @@ import serial
 
 from appmode.errors import AppmodeError
 
-if "appmode.ports" not in serial.protocol_handler_packages:
-    serial.protocol_handler_packages.append("appmode.ports")  # sim:// (ports/protocol_sim.py)
+for _package in ("appmode.ports", "appmode.bluetooth"):  # sim://; ble:// and bt://
+    if _package not in serial.protocol_handler_packages:
+        serial.protocol_handler_packages.append(_package)
 
 if TYPE_CHECKING:
     from appmode.board.firmware import Board
     from appmode.host.client import Host
     from appmode.host.control_client import ControlHost
+    from appmode.ports.target import Target, parse_target
     from appmode.ports.urls import open_link
     from appmode.protocol.app import encode
     from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
@@ -53,6 +56,8 @@ _WHERE = {
     "Host": "appmode.host.client",
     "ControlHost": "appmode.host.control_client",
     "open_link": "appmode.ports.urls",
+    "Target": "appmode.ports.target",
+    "parse_target": "appmode.ports.target",
     "BoardDecoder": "appmode.protocol.app_decoders",
     "HostDecoder": "appmode.protocol.app_decoders",
     "encode": "appmode.protocol.app",
@@ -79,10 +84,12 @@ __all__ = [
     "Host",
     "HostDecoder",
     "Recorder",
+    "Target",
     "TranscriptError",
     "__version__",
     "encode",
     "open_link",
+    "parse_target",
     "parse_transcript",
     "read_transcript",
 ]

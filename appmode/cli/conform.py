@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, add_profile, board_url, file_name, profile_for
+from appmode.cli.options import Subparsers, add_profile, file_name, profile_for, target
 from appmode.errors import AppmodeError
 
 
@@ -28,11 +28,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "shipped with appmode)",
     )
     conform.add_argument(
-        "--board", metavar="URL", help="run in real time against this board instead"
+        "--board", metavar="URL", type=target, help="run in real time against this board instead"
     )
     conform.add_argument(
         "--board2",
         metavar="URL",
+        type=target,
         help="with --board: the same board's control port (UART2), for transcripts with "
         "2> / 2< lines (a sim:// board has its own; elsewhere they are skipped without it)",
     )
@@ -63,13 +64,12 @@ WARNING = (
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.ports.urls import is_simulated
     from appmode.transcript.runner import run_conform
 
     if args.board:
-        args.board = board_url(args.board, profile=args.profile)
+        args.board = args.board.with_sim(profile=args.profile)
     profile = profile_for(args.board, args.profile).name
-    if args.board and not is_simulated(args.board) and not args.yes:
+    if args.board and not args.board.simulated and not args.yes:
         warning = WARNING.format(url=args.board)
         if not sys.stdin.isatty():
             raise AppmodeError(f"{warning} Add --yes to run it without asking.")

@@ -8,25 +8,24 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from serial import SerialException
-
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     Subparsers,
     add_profile,
     add_record,
     add_uart2,
-    board_url,
     layout_for,
     number_type,
     profile_for,
     stop_again_for,
+    target,
 )
 from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 from appmode.session.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 if TYPE_CHECKING:
+    from appmode.ports.target import Target
     from appmode.session.base import BaseSession
     from appmode.session.hold import HoldToDrive
 
@@ -78,6 +77,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
         "url",
         nargs="?",
         default="sim://",
+        type=target,
         metavar="URL",
         help="the board (default: sim://, the simulated board); see "
         "'appmode params -h' for URL forms",
@@ -85,12 +85,14 @@ def add_board(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "url2",
         nargs="?",
+        type=target,
         metavar="URL2",
         help="the same board's control port: as --uart2-url",
     )
     add_uart2(parser, "drive over the board's control port (UART2, velocity frames)")
     parser.add_argument(
         "--uart2-url",
+        type=target,
         metavar="URL",
         help="open the board's control port there too: drive over it and show the APP "
         "port's records (two sim:// URLs are one simulated board)",
@@ -134,42 +136,41 @@ def make_session(
 ) -> BaseSession:
     """The session `add_board`'s arguments ask for: the APP port's, or the control port's
     (with the APP port of the same board if given)."""
-    from appmode.ports.urls import is_simulated
     from appmode.session.app_session import Session
     from appmode.session.control_session import ControlSession
 
-    url = board_url(args.url, profile=args.profile, drive=args.drive_type)
-    layout = layout_for(url, args.profile)
-    uart2_url = args.uart2_url or args.url2
+    board: Target = args.url.with_sim(profile=args.profile, drive=args.drive_type)
+    layout = layout_for(board, args.profile)
+    uart2: Target | None = args.uart2_url or args.url2
     if args.url2 and args.uart2_url:
         raise AppmodeError("give the control port once: a second URL or --uart2-url")
-    if uart2_url is None and not args.uart2:
-        if args.drive_type and not is_simulated(url):
+    if uart2 is None and not args.uart2:
+        if args.drive_type and not board.simulated:
             raise AppmodeError(
                 "--drive on a real board's APP port: its drive type is part of "
                 "system_mode (appmode params URL --set system_mode=N), or add --uart2"
             )
         return Session(
-            url,
+            board,
             driving,
             args.record,
             on_message,
             layout,
-            stop_again_for(url, args.profile),
-            profile_for(url, args.profile).steer_in_frames,
+            stop_again_for(board, args.profile),
+            profile_for(board, args.profile).steer_in_frames,
         )
-    app_url = None
-    if uart2_url is not None:
-        app_url, url = url, board_url(uart2_url, profile=args.profile, drive=args.drive_type)
-        if is_simulated(app_url) and is_simulated(url):
-            app_url, url = _one_board(app_url, url)
-    profile = profile_for(url, args.profile)
+    app: Target | None = None
+    if uart2 is not None:
+        app, board = board, uart2.with_sim(profile=args.profile, drive=args.drive_type)
+        if app.simulated and board.simulated:
+            app, board = _one_board(app, board)
+    profile = profile_for(board, args.profile)
     return ControlSession(
-        url,
+        board,
         driving,
         args.record,
         on_message,
-        app_url=app_url,
+        app_url=app,
         layout=layout,
         drive=DriveType.from_cli_name(args.drive_type) if args.drive_type else profile.fixed_drive,
         takeover_byte=profile.takeover_byte,
@@ -177,26 +178,22 @@ def make_session(
     )
 
 
-def _one_board(app_url: str, uart2_url: str) -> tuple[str, str]:
-    """Two sim:// URLs as the two ports of one simulated board (its options given on
+def _one_board(app: Target, uart2: Target) -> tuple[Target, Target]:
+    """Two sim:// targets as the two ports of one simulated board (its options given on
     the first, or the same on both)."""
-    from appmode.ports.sim import parse_sim_url
-
-    try:
-        app_options, uart2_options = (
-            {k: v for k, v in parse_sim_url(u).items() if k not in ("port", "share")}
-            for u in (app_url, uart2_url)
-        )
-    except SerialException:
-        return app_url, uart2_url  # opening them says what is wrong
+    app_options, uart2_options = (
+        {k: v for k, v in t.sim.items() if k not in ("port", "share")} for t in (app, uart2)
+    )
     if uart2_options and uart2_options != app_options:
         raise AppmodeError(
-            f"{app_url} and {uart2_url} are one simulated board: give its options once, on "
-            f"the first URL (appmode drive '{uart2_url}' sim://)"
+            f"{app} and {uart2} are one simulated board: give its options once, on "
+            f"the first URL (appmode drive '{uart2}' sim://)"
         )
-    if "share=" not in app_url.lower():
-        app_url += f"{'&' if '?' in app_url else '?'}share=drive-{os.getpid()}"
-    return app_url, app_url + "&port=uart2"
+    if "share" not in app.sim:
+        app = app.with_sim(share=f"drive-{os.getpid()}")
+    from appmode.ports.target import parse_target
+
+    return app, parse_target(f"{app.url}&port=uart2")  # `share` made the query
 
 
 def _print_message(text: str) -> None:

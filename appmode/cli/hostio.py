@@ -7,16 +7,18 @@ import json
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import ExitStack, closing
-from typing import TextIO, TypeVar
+from typing import TYPE_CHECKING, TextIO, TypeVar
 
 from appmode.host.client import Event, Host
 from appmode.host.control_client import ControlHost
 from appmode.host.query import QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
-from appmode.ports.sim import sim_directives
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.render import describe, line, to_json
+
+if TYPE_CHECKING:
+    from appmode.ports.target import Target
 
 H = TypeVar("H", Host, ControlHost)
 E = TypeVar("E")
@@ -24,7 +26,7 @@ E = TypeVar("E")
 
 def open_host(
     stack: ExitStack,
-    url: str,
+    url: Target,
     record: str | None,
     stop_on_close: bool = True,
     layout: ALayout = VELOCITY,
@@ -48,7 +50,7 @@ def with_recording(stack: ExitStack, host: H, record: str | None) -> H:
     """An opened host, then its recording: a URL that does not open leaves the file
     untouched. The recording is closed after the host, so it holds the final stop."""
     try:
-        recorder = Recorder.create(record, 0.0, sim_directives(host.url)) if record else None
+        recorder = Recorder.create(record, 0.0, host.target.directives) if record else None
     except BaseException:
         host.close()
         raise

@@ -16,7 +16,6 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
-    board_url,
     layout_for,
     number_type,
     profile_for,
@@ -28,6 +27,7 @@ from appmode.text import counted
 
 if TYPE_CHECKING:
     from appmode.host.client import Event
+    from appmode.ports.target import Target
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -75,7 +75,7 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    args.url = board_url(args.url, profile=args.profile)
+    args.url = args.url.with_sim(profile=args.profile)
     if args.uart2:
         from appmode.cli import uart2  # here: start-up stays short
 
@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def run_monitor(
-    url: str,
+    url: Target,
     *,
     as_json: bool,
     duration: float | None,

@@ -3,21 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import math
 import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeAlias
 
-from serial import SerialException
-
 from appmode.board.names import PROFILE_NAMES
-from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
     from _typeshed import SupportsWrite
 
     from appmode.board.profiles import Profile
+    from appmode.ports.target import Target
     from appmode.protocol.layouts import ALayout
 
 URL_FORMS = (
@@ -31,8 +28,15 @@ DAY = 86400.0
 """The longest wait any command takes: longer is surely a typing error."""
 
 
+def target(text: str) -> Target:
+    """An argument that names a board: parsed once into the Target every layer reads."""
+    from appmode.ports.target import parse_target
+
+    return parse_target(text)
+
+
 def add_url(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("url", metavar="URL", help=URL_FORMS)
+    parser.add_argument("url", metavar="URL", type=target, help=URL_FORMS)
 
 
 def add_uart2(parser: argparse.ArgumentParser, what: str) -> None:
@@ -85,53 +89,25 @@ def add_profile(
     )
 
 
-def profile_for(url: str | None, name: str | None) -> Profile:
-    """The profile `--profile NAME` names, else a sim:// URL's, else the sheet."""
+def profile_for(target: Target | None, name: str | None) -> Profile:
+    """The profile `--profile NAME` names, else a sim:// target's, else the sheet."""
     from appmode.board.profiles import PROFILES, SHEET
 
-    if name is None and url is not None and url.lower().startswith("sim://"):
-        with contextlib.suppress(SerialException):
-            from appmode.ports.sim import parse_sim_url
-
-            name = parse_sim_url(url).get("profile")
+    if name is None and target is not None:
+        name = target.profile
     return PROFILES.get(name or "sheet", SHEET)
 
 
-def stop_again_for(url: str | None, name: str | None) -> bytes:
-    """What a host sends when its stop did not take, on `profile_for(url, name)`."""
+def stop_again_for(target: Target | None, name: str | None) -> bytes:
+    """What a host sends when its stop did not take, on `profile_for(target, name)`."""
     from appmode.protocol.session_end import stop_again
 
-    return stop_again(frames_take_letters=not profile_for(url, name).steer_in_frames)
+    return stop_again(frames_take_letters=not profile_for(target, name).steer_in_frames)
 
 
-def board_url(url: str, **options: str | None) -> str:
-    """The URL a command opens: a sim:// URL takes the command's `--profile` and `--drive`
-    as its options where it has none (the simulated board is what they describe), and one
-    it sets otherwise is an error; other URLs as they are."""
-    if not url.lower().startswith("sim://"):
-        return url
-    from appmode.ports.sim import parse_sim_url
-
-    try:
-        given = parse_sim_url(url)
-    except SerialException:
-        return url  # opening it says what is wrong
-    for name, value in options.items():
-        if not value:
-            continue
-        if name not in given:
-            url += f"{'&' if '?' in url else '?'}{name}={value}"
-        elif given[name] != value:
-            raise AppmodeError(
-                f"{url} sets {name}={given[name]}, and --{name} {value} another: give "
-                f"the {name} once"
-            )
-    return url
-
-
-def layout_for(url: str | None, name: str | None) -> ALayout:
-    """The A record layout of `profile_for(url, name)`."""
-    return profile_for(url, name).a_layout
+def layout_for(target: Target | None, name: str | None) -> ALayout:
+    """The A record layout of `profile_for(target, name)`."""
+    return profile_for(target, name).a_layout
 
 
 class Parser(argparse.ArgumentParser):

@@ -14,7 +14,6 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
-    board_url,
     profile_for,
 )
 from appmode.errors import AppmodeError
@@ -22,6 +21,7 @@ from appmode.protocol import params
 
 if TYPE_CHECKING:  # imported when the command runs: start-up stays short
     from appmode.board.profiles import Profile
+    from appmode.ports.target import Target
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -82,7 +82,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    args.url = board_url(args.url, profile=args.profile)
+    args.url = args.url.with_sim(profile=args.profile)
     if args.uart2:
         if args.verify_saved:
             raise AppmodeError(
@@ -125,7 +125,7 @@ def parse_assignment(text: str) -> tuple[int, int]:
 
 
 def run_params(
-    url: str,
+    url: Target,
     assignments: list[str],
     *,
     save: bool,
@@ -144,7 +144,7 @@ def run_params(
     from appmode.protocol.render import params_table
 
     changes = [parse_assignment(text) for text in assignments]  # all checked first
-    saved = saves.recall(url) if verify else None
+    saved = saves.recall(url.url) if verify else None
     if verify and saved is None:
         raise AppmodeError(
             f"no save of {url} to check: appmode remembers the saves made with "
@@ -165,7 +165,7 @@ def run_params(
                 file=sys.stderr,
             )
             try:
-                saves.remember(url, values)
+                saves.remember(url.url, values)
             except AppmodeError as exc:  # the set and the save went out all the same
                 print(
                     f"appmode: WARNING: {exc}: --verify-saved will not know this save",

@@ -16,7 +16,6 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
-    board_url,
     layout_for,
     number_type,
     profile_for,
@@ -25,6 +24,7 @@ from appmode.cli.options import (
 from appmode.host.token_help import APP_TOKENS, CONTROL_TOKENS
 
 if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
+    from appmode.ports.target import Target
     from appmode.protocol.layouts import ALayout
 
 
@@ -60,7 +60,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    args.url = board_url(args.url, profile=args.profile)
+    args.url = args.url.with_sim(profile=args.profile)
     if args.uart2:
         from appmode.cli import uart2  # here: start-up stays short
 
@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def run_send(
-    url: str,
+    url: Target,
     tokens: list[str],
     *,
     listen: float,

@@ -7,7 +7,7 @@ import json
 import sys
 from collections.abc import Iterable
 from contextlib import ExitStack
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from appmode.board.profiles import SHEET, Profile
 from appmode.cli.hostio import until_count, with_recording
@@ -19,6 +19,9 @@ from appmode.protocol import control, params, reader, settings
 from appmode.protocol.control_view import settings_table, view
 from appmode.protocol.render import line
 from appmode.text import counted, wrapped
+
+if TYPE_CHECKING:
+    from appmode.ports.target import Target
 
 QUIET_UART2 = (
     "a board sends replies only to reads, and encoder reports only while system_mode "
@@ -34,7 +37,7 @@ TAKEOVER = (
 
 def open_control_host(
     stack: ExitStack,
-    url: str,
+    url: Target,
     record: str | None,
     stop_on_close: bool = True,
     profile: Profile = SHEET,
@@ -72,7 +75,7 @@ def show(
 
 
 def run_params(
-    url: str,
+    url: Target,
     assignments: list[str],
     *,
     store: str | None,
@@ -112,7 +115,7 @@ def run_params(
 
 
 def run_send(
-    url: str,
+    url: Target,
     tokens: list[str],
     *,
     listen: float,
@@ -165,7 +168,7 @@ def _drain(events: Iterable[Event]) -> None:
 
 
 def run_monitor(
-    url: str,
+    url: Target,
     *,
     as_json: bool,
     duration: float | None,

@@ -8,18 +8,15 @@ Thread-free: every call reads what the board has sent meanwhile and lets the hos
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable
-
-import serial
 
 from appmode.errors import AppmodeError
-from appmode.host.link import Link, LinkLost
+from appmode.host.link import Link, LinkLost, Opener
 from appmode.host.query import TIMEOUT, TRIES, Outcome, ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.stop_check import SETTLE, StopCheck
 from appmode.line.wire import UART2, Tap
-from appmode.ports.sim import sim_side
-from appmode.ports.urls import is_simulated, open_link
+from appmode.ports.target import Target, as_target
+from appmode.ports.urls import open_link
 from appmode.protocol import app, params, session_end
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, ALayout
@@ -40,21 +37,22 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
 
     def __init__(
         self,
-        url: str,
+        url: Target | str,
         tap: Tap | None = None,
-        opener: Callable[[str], serial.SerialBase] = open_link,
+        opener: Opener = open_link,
         stop_on_close: bool = True,
         layout: ALayout = VELOCITY,
         confirm_stop: bool = False,
         stop_again: bytes = session_end.stop_again(frames_take_letters=True),
         frames_stop: bool = False,
     ) -> None:
-        if is_simulated(url) and sim_side(url) == UART2:
+        target = as_target(url)
+        if target.simulated and target.sim_port == UART2:
             raise AppmodeError(
-                f"{url} is the simulated board's control port (UART2, binary frames): this "
+                f"{target} is the simulated board's control port (UART2, binary frames): this "
                 "command speaks the APP protocol; leave out port=uart2"
             )
-        super().__init__(url, tap, opener)
+        super().__init__(target, tap, opener)
         self.stop_on_close = stop_on_close
         self.state = HostState(layout, frames_stop)
         self.confirm_stop = confirm_stop

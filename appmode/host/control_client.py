@@ -15,8 +15,6 @@ import contextlib
 from collections.abc import Callable, Iterable, Iterator
 from functools import partial
 
-import serial
-
 from appmode.errors import AppmodeError
 from appmode.host.control_query import (
     ROTATE_POLL,
@@ -27,12 +25,12 @@ from appmode.host.control_query import (
     rotation_done,
 )
 from appmode.host.control_state import TAKEOVER_BYTE, ControlState
-from appmode.host.link import Link, LinkLost
+from appmode.host.link import Link, LinkLost, Opener
 from appmode.host.query import TRIES, QueryFailed
 from appmode.host.state import LinkStatus
 from appmode.line.wire import UART2_BAUD, Tap
-from appmode.ports.sim import sim_side
-from appmode.ports.urls import is_simulated, open_link
+from appmode.ports.target import Target, as_target
+from appmode.ports.urls import open_link
 from appmode.protocol import control, params, reader, settings
 from appmode.protocol.params import DriveType
 
@@ -43,14 +41,6 @@ Event = control.BoardEvent | ControlOutcome | LinkStatus
 OPEN_UART2 = partial(open_link, baud=UART2_BAUD)
 
 
-def uart2_url(url: str) -> str:
-    """The control port of `url`: a sim:// URL without `port=` opens the simulated
-    board's UART2; a device opens at 115200 bps unless it says `?baud=`."""
-    if is_simulated(url) and "port=" not in url.lower():
-        return url + ("&" if "?" in url else "?") + "port=uart2"
-    return url
-
-
 class ControlHost(Link[control.BoardEvent | ControlOutcome]):
     """A session with one board's control port."""
 
@@ -59,22 +49,22 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
 
     def __init__(
         self,
-        url: str,
+        url: Target | str,
         tap: Tap | None = None,
-        opener: Callable[[str], serial.SerialBase] = OPEN_UART2,
+        opener: Opener = OPEN_UART2,
         stop_on_close: bool = True,
         drive: DriveType | None = None,
         timeout: float = READ_TIMEOUT,
         tries: int = TRIES,
         takeover_byte: int = TAKEOVER_BYTE,
     ) -> None:
-        url = uart2_url(url)
-        if is_simulated(url) and sim_side(url) != "uart2":
+        target = as_target(url).for_uart2()  # a device opens at 115200 unless ?baud=
+        if target.simulated and target.sim_port != "uart2":
             raise AppmodeError(
-                f"{url} is the simulated board's APP port: --uart2 speaks the control "
+                f"{target} is the simulated board's APP port: --uart2 speaks the control "
                 "port's frames; use port=uart2 or leave port= out"
             )
-        super().__init__(url, tap, opener)
+        super().__init__(target, tap, opener)
         self.stop_on_close = stop_on_close
         self.timeout = timeout
         self.tries = tries

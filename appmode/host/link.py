@@ -21,8 +21,10 @@ from appmode.host import signals
 from appmode.host.state import LinkStatus
 from appmode.line.pacing import Ahead
 from appmode.line.wire import Tap
-from appmode.ports.urls import is_network
+from appmode.ports.target import Target, as_target
 
+Opener = Callable[[str], serial.SerialBase]
+"""Opens a port by URL (`ports.urls.open_link`, with options bound; any pyserial opener)."""
 RETRY = 0.5
 CHUNK = 64
 """Bytes written at once: 67 ms at 9600 bps, the longest an ending signal waits."""
@@ -51,14 +53,15 @@ class Link(Generic[E]):
 
     def __init__(
         self,
-        url: str,
+        url: Target | str,
         tap: Tap | None,
-        opener: Callable[[str], serial.SerialBase],
+        opener: Opener,
     ) -> None:
-        self.url = url
+        self.target = as_target(url)
+        self.url = self.target.url
         self.tap = tap
         self._opener = opener
-        self._port: serial.SerialBase | None = opener(url)
+        self._port: serial.SerialBase | None = opener(self.url)
         self._writing = threading.RLock()  # the stop guard may write from its thread
         # after opening: an in-process sim:// board booted just now, and its clock is ours
         board_origin = getattr(self._port, "clock_origin", None)
@@ -98,7 +101,7 @@ class Link(Generic[E]):
         self._port = None
         self._lost_at = self.now()
         self._on_lost()
-        if not self._heard and is_network(self.url):
+        if not self._heard and self.target.network:
             self.refused = (
                 f"{self.url} closed the connection before the board sent anything: a TCP "
                 "board serves one client at a time; close the other client and retry"

@@ -25,7 +25,8 @@ from appmode.board.profiles import PROFILES, Profile
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.line.wire import APP_BAUD, UART2_BAUD
-from appmode.ports.urls import is_simulated, open_link, parse_device
+from appmode.ports.target import Target, as_target
+from appmode.ports.urls import open_link
 from appmode.protocol import app, app_decoders, control, control_decoders, params
 from appmode.protocol.escaping import text_part
 
@@ -237,8 +238,9 @@ def probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
 
 
 def _probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
-    fixed = "://" in url  # TCP, sim://, loop://: no line rate of ours to get wrong
-    path, given = (url, 0) if fixed else parse_device(url, 0)
+    target = as_target(url)
+    fixed = bool(target.scheme)  # TCP, sim://, Bluetooth: no line rate of ours to get wrong
+    path, given = (url, 0) if fixed else (target.path, target.baud or 0)
     rates = RATES[:1] if fixed else (given, *(r for r in RATES if r != given)) if given else RATES
     heard: list[Heard] = []
     for baud in rates:
@@ -248,7 +250,7 @@ def _probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
         one, port = listen(path, baud, LISTEN_OTHER if heard else LISTEN, stop)
         heard.append(one)
         if one.carries_app:
-            return _car(url, path, one, port, heard, fixed, progress)
+            return _car(target, path, one, port, heard, progress)
         close_quietly(port)
         if one.carries_uart2 and (baud == UART2_BAUD or fixed):
             return _control_port(path, one, heard, fixed)
@@ -267,14 +269,14 @@ def _with_baud(url: str, baud: int, usual: int, fixed: bool) -> str:
 
 
 def _car(
-    url: str,
+    given: Target,
     path: str,
     one: Heard,
     port: serial.SerialBase,
     heard: list[Heard],
-    fixed: bool,
     progress: Progress,
 ) -> Finding:
+    url, fixed = given.url, bool(given.scheme)
     profile = firmware(one)
     ports = [port]
 
@@ -297,7 +299,7 @@ def _car(
     period = f"a record every {5 * round((one.period_ms or 0) / 5)} ms"  # to 5 ms: a rhythm
     what = f"{profile.name if profile else 'unknown'} firmware ({period})"
     flag = ""  # a sim:// URL names its own profile
-    if profile is not None and profile.name != "sheet" and not is_simulated(url):
+    if profile is not None and profile.name != "sheet" and not given.simulated:
         flag = f" --profile {profile.name}"
     drive = f"appmode drive {shlex.quote(target)}{flag}"
     if values is None:

@@ -20,7 +20,8 @@ import serial
 from appmode.errors import AppmodeError
 from appmode.files import temporary_beside
 from appmode.line.uart import misread
-from appmode.ports.urls import BAUD, NO_PTY, explain_open_error, parse_device
+from appmode.ports.target import parse_device
+from appmode.ports.urls import BAUD, NO_PTY, explain_open_error
 from appmode.protocol import params
 
 Log = Callable[[str], None]
@@ -277,7 +278,8 @@ class SerialEndpoint:
     def __init__(
         self, sel: selectors.BaseSelector, log: Log, device: str, baud: int = BAUD
     ) -> None:
-        path, baud = parse_device(device, baud)
+        path, given = parse_device(device)
+        baud = given or baud
         try:
             self._port = serial.Serial(path, baudrate=baud, timeout=0, exclusive=True)
         except (serial.SerialException, OSError, ValueError) as exc:

@@ -78,24 +78,6 @@ def parse_sim_url(url: str) -> dict[str, str]:
     return options
 
 
-def sim_directives(url: str) -> tuple[str, ...]:
-    """Transcript directives that describe a sim:// board, for replaying its sessions."""
-    if not url.lower().startswith("sim://"):
-        return ()
-    options = parse_sim_url(url)
-    needs = " ".join(f"{key}={options[key]}" for key in ("profile", "drive") if key in options)
-    return (f"board {needs}",) if needs else ()
-
-
-def sim_side(url: str) -> str:
-    """The port a sim:// URL opens: `app`, or `uart2` with `port=uart2` (`app` for a URL
-    that does not parse: opening it says why)."""
-    try:
-        return parse_sim_url(url).get("port", APP).lower()
-    except SerialException:
-        return APP
-
-
 def _flag(name: str, text: str) -> bool:
     if text.lower() in ("1", "true", "yes", "on"):
         return True

@@ -1,10 +1,12 @@
-"""Open any board by URL (docs/design.md, "Contracts"): a device path, pyserial's URLs, or `sim://`.
+"""Open any board by URL or Target (docs/design.md, "Contracts"): a device path,
+pyserial's URLs, `sim://`, `ble://` and `bt://`.
 
 | URL | what |
 |---|---|
 | `/dev/ttyUSB0`, `COM3`, `/dev/rfcomm0`, `/dev/pts/4` | a serial port, 9600 8N1 unless `?baud=N` |
 | `socket://HOST:PORT`, `rfc2217://HOST:PORT`, `loop://` | pyserial's own handlers |
 | `sim://?drive=…&flash=…&pace=…` | the simulated board in-process |
+| `ble://ADDRESS`, `bt://ADDRESS` | a Bluetooth module directly (bluetooth/) |
 
 Every failure to open becomes one AppmodeError that says what to do.
 """
@@ -14,13 +16,12 @@ from __future__ import annotations
 import errno
 import os
 from typing import TYPE_CHECKING
-from urllib.parse import parse_qs, urlsplit
 
 import serial
 
 from appmode.errors import AppmodeError
 from appmode.ports.holders import holders
-from appmode.protocol import params
+from appmode.ports.target import Target, as_target
 
 if TYPE_CHECKING:
     from appmode.ports.newpty import PtyPort
@@ -32,70 +33,29 @@ for _package in ("appmode.ports", "appmode.bluetooth"):  # sim://; ble:// and bt
         serial.protocol_handler_packages.append(_package)
 
 BAUD = 9600
-SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt")
-NETWORK_SCHEMES = ("socket", "rfc2217")
 OWN_WORDS = ("sim", "ble", "bt")
 """Schemes whose ports say themselves what went wrong and what to do."""
-URL_HELP = (
-    "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
-    "rfc2217://HOST:PORT, ble://ADDRESS, bt://ADDRESS, loop:// or sim://"
-)
 
 
-def is_network(url: str) -> bool:
-    """A TCP link (socket://, rfc2217://)."""
-    return url.split("://", 1)[0].lower() in NETWORK_SCHEMES if "://" in url else False
-
-
-def is_simulated(url: str) -> bool:
-    return url.lower().startswith("sim://")
-
-
-def open_link(url: str, timeout: float | None = 0.05, baud: int = BAUD) -> serial.SerialBase:
+def open_link(
+    url: Target | str, timeout: float | None = 0.05, baud: int = BAUD
+) -> serial.SerialBase:
     """An open pyserial port for `url`, at `baud` (9600) 8N1 unless the URL says otherwise."""
-    if "://" in url:
-        scheme = url.split("://", 1)[0].lower()
-        if scheme not in SCHEMES:
-            raise AppmodeError(f"unknown URL scheme {scheme + '://'!r} in {url!r}: {URL_HELP}")
-        if scheme in NETWORK_SCHEMES:
-            _check_address(url, scheme)
+    target = as_target(url)
+    if target.scheme:
         try:
-            return serial.serial_for_url(url, baudrate=baud, timeout=timeout)
+            return serial.serial_for_url(target.url, baudrate=baud, timeout=timeout)
         except (serial.SerialException, ValueError, OSError) as exc:
-            raise AppmodeError(explain_open_error(url, exc)) from None
-    path, baud = parse_device(url, baud)
+            raise AppmodeError(explain_open_error(target.url, exc, target.scheme)) from None
     try:
-        return serial.Serial(path, baudrate=baud, timeout=timeout, exclusive=os.name == "posix")
-    except (serial.SerialException, ValueError, OSError) as exc:
-        raise AppmodeError(explain_open_error(path, exc)) from None
-
-
-def _check_address(url: str, scheme: str) -> None:
-    """HOST:PORT must be there before pyserial sees the URL (its messages are Python's)."""
-    try:
-        parts = urlsplit(url)
-        host, port = parts.hostname, parts.port
-    except ValueError:  # an unclosed [IPv6 address, a port that is not a number
-        host, port = None, None
-    if not host or port is None or not 0 < port < 65536:
-        raise AppmodeError(
-            f"{url!r} needs a host and a port 1–65535: {scheme}://HOST:PORT, "
-            f"e.g. {scheme}://127.0.0.1:5000"
+        return serial.Serial(
+            target.path,
+            baudrate=target.baud or baud,
+            timeout=timeout,
+            exclusive=os.name == "posix",
         )
-
-
-def parse_device(url: str, baud: int = BAUD) -> tuple[str, int]:
-    """A device's path and baud rate (`?baud=N`, else `baud`)."""
-    path, _, query = url.partition("?")
-    if not path:
-        raise AppmodeError(f"empty port name in {url!r}: {URL_HELP}")
-    for name, values in parse_qs(query, keep_blank_values=True).items():
-        if name != "baud":
-            raise AppmodeError(f"unknown option {name!r} in {url!r}: only ?baud=N is known")
-        if not params.whole(values[-1]):
-            raise AppmodeError(f"bad baud rate {values[-1]!r} in {url!r}: use e.g. ?baud=9600")
-        baud = int(values[-1].strip())
-    return path, baud
+    except (serial.SerialException, ValueError, OSError) as exc:
+        raise AppmodeError(explain_open_error(target.path, exc)) from None
 
 
 LIST_PORTS = "list ports with: appmode ports"
@@ -115,10 +75,10 @@ def is_rfcomm(where: str) -> bool:
     return "rfcomm" in where.lower()
 
 
-def explain_open_error(where: str, exc: Exception) -> str:
+def explain_open_error(where: str, exc: Exception, scheme: str = "") -> str:
     code = getattr(exc, "errno", None)
     text = str(exc)
-    if where.split("://", 1)[0].lower() in OWN_WORDS:  # the port's message: what, then the fix
+    if scheme in OWN_WORDS:  # the port's own message: what, then the fix
         return text
     if code == errno.ENOENT or "No such file" in text:
         if is_rfcomm(where):

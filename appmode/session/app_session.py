@@ -16,6 +16,7 @@ from appmode.host.link import LinkLost
 from appmode.host.query import ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.tokens import Wait, parse_token
+from appmode.ports.target import Target
 from appmode.protocol import params
 from appmode.protocol.app import Move, Noise, Stop, SwitchPage
 from appmode.protocol.app_decoders import HostDecoder
@@ -61,7 +62,7 @@ class Session(BaseSession):
 
     def __init__(
         self,
-        url: str,
+        url: Target | str,
         driving: HoldToDrive | None = None,
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
@@ -71,7 +72,7 @@ class Session(BaseSession):
     ) -> None:
         super().__init__(url, driving, on_message)
         self.host = Host(
-            url,
+            self.target,
             tap=self._tap,
             layout=layout,
             confirm_stop=stop_again is not None,

@@ -16,8 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 from appmode.errors import AppmodeError
 from appmode.files import new_recording, recordings_folder
 from appmode.host.tokens import Wait, parse_token
-from appmode.ports.sim import sim_directives
-from appmode.ports.urls import is_simulated
+from appmode.ports.target import Target, as_target
 from appmode.protocol.recorder import Recorder
 from appmode.session.authority import STALL, StopGuard
 from appmode.session.hold import HoldToDrive
@@ -140,10 +139,14 @@ class BaseSession(ABC):
     """Whether the panel can show waveforms (key v)."""
 
     def __init__(
-        self, url: str, driving: HoldToDrive | None, on_message: Callable[[str], None] | None
+        self,
+        url: Target | str,
+        driving: HoldToDrive | None,
+        on_message: Callable[[str], None] | None,
     ) -> None:
-        self.url = url
-        self.simulated = is_simulated(url)
+        self.target = as_target(url)
+        self.url = self.target.url
+        self.simulated = self.target.simulated
         self.driving = driving or HoldToDrive()
         self.messages: deque[str] = deque(maxlen=LOG)
         self._down_said = False  # "link is down" said in this outage
@@ -362,7 +365,7 @@ class BaseSession(ABC):
         """Record from now on, times counted from `origin` (default: now)."""
         try:
             start = self.now() if origin is None else origin
-            recorder = Recorder.create(path, start, sim_directives(self.url))
+            recorder = Recorder.create(path, start, self.target.directives)
         except AppmodeError as exc:
             if self.recorder is None:
                 raise

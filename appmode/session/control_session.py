@@ -22,6 +22,7 @@ from appmode.host.link import LinkLost
 from appmode.host.query import QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
 from appmode.host.tokens import Wait
+from appmode.ports.target import Target
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.layouts import VELOCITY, ALayout
@@ -83,11 +84,11 @@ class ControlSession(BaseSession):
 
     def __init__(
         self,
-        url: str,
+        url: Target | str,
         driving: HoldToDrive | None = None,
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
-        app_url: str | None = None,
+        app_url: Target | str | None = None,
         layout: ALayout = VELOCITY,
         drive: DriveType | None = None,
         takeover_byte: int = TAKEOVER_BYTE,
@@ -96,8 +97,10 @@ class ControlSession(BaseSession):
         super().__init__(url, driving, on_message)
         self.reads = reads
         """The board answers reads (the reference firmware does not: §13)."""
-        self.host = ControlHost(url, tap=self._tap, drive=drive, takeover_byte=takeover_byte)
-        self.url = self.host.url
+        self.host = ControlHost(
+            self.target, tap=self._tap, drive=drive, takeover_byte=takeover_byte
+        )
+        self.target, self.url = self.host.target, self.host.url
         self.app: Host | None = None
         if app_url is not None:
             try:

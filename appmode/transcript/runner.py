@@ -24,7 +24,8 @@ from appmode.host.client import Host
 from appmode.host.link import LinkLost
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
-from appmode.ports.urls import is_simulated, open_link
+from appmode.ports.target import Target, as_target
+from appmode.ports.urls import open_link
 from appmode.protocol import app, app_decoders, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
@@ -101,24 +102,28 @@ def _result(transcript: Transcript, check: Check, now: float, wall: float) -> Re
     return Result(transcript.path, transcript.title, failure is None, now, wall, failure)
 
 
-def _shared(url: str) -> tuple[str, str]:
+def _shared(target: Target) -> tuple[Target, Target]:
     """Both ports of one new sim:// board."""
-    base = f"{url}{'&' if '?' in url else '?'}share=conform-{next(_SHARES)}"
-    return base, f"{base}&port=uart2"
+    base = target.with_sim(share=f"conform-{next(_SHARES)}")
+    return base, base.for_uart2()
 
 
 _SHARES = itertools.count(1)
 
 
 def run_live(
-    transcript: Transcript, url: str, progress: Progress | None = None, url2: str | None = None
+    transcript: Transcript,
+    url: Target | str,
+    progress: Progress | None = None,
+    url2: Target | str | None = None,
 ) -> Result:
     """Run in real time against any board URL (and its control port at `url2`)."""
+    url = as_target(url)
     started = time.perf_counter()
     check = Check(transcript)
     link2 = None
     if check.uses_uart2:
-        if url2 is None and is_simulated(url):
+        if url2 is None and url.simulated:
             url, url2 = _shared(url)
         if url2 is None:
             why = "has UART2 lines: give the board's control port with --board2 URL"
@@ -243,11 +248,11 @@ def write_junit(path: str, results: list[Result]) -> None:
 
 def run_conform(
     paths: list[str],
-    board: str | None,
+    board: Target | str | None,
     junit: str | None,
     out: TextIO,
     profile: str = "sheet",
-    board2: str | None = None,
+    board2: Target | str | None = None,
 ) -> int:
     """Run every transcript for `profile`; one line each; exit status 1 on any failure."""
     if junit:
@@ -272,7 +277,8 @@ def run_conform(
         if interactive:
             print(f"\r\033[K{text}", end="", file=sys.stderr, flush=True)
 
-    live = board is not None and not is_simulated(board)  # sim:// is a new board each time
+    board, board2 = (as_target(b) if b is not None else None for b in (board, board2))
+    live = board is not None and not board.simulated  # sim:// is a new board each time
     found = _read_params(board) if live and board is not None else None
     results: list[Result] = []
     between = None
@@ -284,7 +290,7 @@ def run_conform(
     finally:
         if board is not None and found is not None:
             out.write(restore_params(board, found) + "\n")
-    if board2 is not None and not is_simulated(board2) and _sent_on_uart2(transcripts, results):
+    if board2 is not None and not board2.simulated and _sent_on_uart2(transcripts, results):
         out.write(wrapped(f"note: {TAKEN_OVER}") + "\n")
     failed = sum(not r.passed for r in results)
     skipped = sum(r.skipped is not None for r in results)
@@ -314,12 +320,12 @@ def _sent_on_uart2(transcripts: list[Transcript], results: list[Result]) -> bool
 
 def _run_all(
     transcripts: list[Transcript],
-    board: str | None,
+    board: Target | None,
     progress: Progress,
     interactive: bool,
     results: list[Result],
     out: TextIO,
-    board2: str | None = None,
+    board2: Target | None = None,
     between: Callable[[], str | None] | None = None,
 ) -> None:
     """Run each transcript and write its line; `between` (a real board) puts back what a
@@ -328,7 +334,7 @@ def _run_all(
         needs = Check(transcript).needs
         if board is None:
             result = run_virtual(transcript)
-        elif needs.power_up and not is_simulated(board):
+        elif needs.power_up and not board.simulated:
             why = "starts at the board's power-up: run it on virtual time (no --board)"
             result = Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
         else:
@@ -368,7 +374,7 @@ def _for_profile(transcripts: list[Transcript], profile: Profile, out: TextIO) -
     return chosen
 
 
-def _read_params(url: str) -> tuple[int, ...]:
+def _read_params(url: Target) -> tuple[int, ...]:
     with Host(url) as host:
         try:
             return host.read_params()
@@ -385,7 +391,7 @@ def _set_back(host: Host, values: tuple[int, ...]) -> list[int]:
     return changed
 
 
-def put_back(url: str, values: tuple[int, ...]) -> str | None:
+def put_back(url: Target | str, values: tuple[int, ...]) -> str | None:
     """Between two transcripts on a real board: its parameters back to `values`
     (verified, not saved); what went wrong, in a line, or None."""
     try:
@@ -396,7 +402,7 @@ def put_back(url: str, values: tuple[int, ...]) -> str | None:
     return None
 
 
-def restore_params(url: str, values: tuple[int, ...]) -> str:
+def restore_params(url: Target | str, values: tuple[int, ...]) -> str:
     """Set the board's parameters back to `values` (verified) and send `{Q:W}`: what a
     run against a real board changed is undone. Returns what was done, in a line."""
     try:

@@ -228,6 +228,6 @@ def test_ctrl_c_ends_a_scan_cleanly(appmode_ble_board: ServedBoard) -> None:
     )
     time.sleep(2)
     proc.send_signal(signal.SIGINT)
-    out, err = proc.communicate(timeout=10)
+    _, err = proc.communicate(timeout=10)
     assert proc.returncode == 130
     assert "Traceback" not in err

@@ -13,6 +13,7 @@ import time
 import tty
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -195,12 +196,16 @@ def test_progress_shows_on_a_terminal_and_is_cleared() -> None:
 
 
 def test_no_ports_at_all_says_how_to_connect_one(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     monkeypatch.setattr("appmode.ports.listing.serial_ports", list)
+    monkeypatch.setenv("DBUS_SYSTEM_BUS_ADDRESS", f"unix:path={tmp_path}/no-bus")
     assert cli_main.main(["doctor"]) == 1
-    err = capsys.readouterr().err
-    assert err.startswith("no serial ports found: plug in the USB-UART adapter")
+    bluetooth, ports = capsys.readouterr().err.split("\n", 1)
+    assert bluetooth.startswith("doctor: Bluetooth not looked for: no Bluetooth here")
+    assert ports.startswith("no serial ports found: plug in the USB-UART adapter")
+    assert cli_main.main(["doctor", "--no-bluetooth"]) == 1
+    assert capsys.readouterr().err.startswith("no serial ports found")
 
 
 def timed_records(period_ms: float, records: list[bytes]) -> probe.Heard:

@@ -7,7 +7,8 @@ import pytest
 
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
-from appmode.host.control_client import ControlHost, uart2_url
+from appmode.host.control_client import ControlHost
+from appmode.ports.target import parse_target
 from appmode.protocol import app, control, params, settings
 from appmode.protocol.transcript import UART2_DIRECTIONS
 
@@ -19,9 +20,10 @@ def tapped(host: ControlHost) -> list[tuple[str, bytes]]:
 
 
 def test_uart2_url_opens_the_simulated_control_port() -> None:
-    assert uart2_url("sim://") == "sim://?port=uart2"
-    assert uart2_url("sim://?drive=diff") == "sim://?drive=diff&port=uart2"
-    assert uart2_url("/dev/ttyUSB0") == "/dev/ttyUSB0"
+    assert parse_target("sim://").for_uart2().url == "sim://?port=uart2"
+    assert parse_target("sim://?drive=diff").for_uart2().url == "sim://?drive=diff&port=uart2"
+    assert parse_target("/dev/ttyUSB0").for_uart2().url == "/dev/ttyUSB0"
+    assert ControlHost("sim://?drive=diff").url == "sim://?drive=diff&port=uart2"
     with pytest.raises(AppmodeError, match="APP port"):
         ControlHost("sim://?port=app")
 
