@@ -121,7 +121,7 @@ class Device(ServiceInterface):
         self._radio = radio
         self.address, self.label, self.le = address, name, le
         self.path = device_path(address)
-        self._uuids = uuids
+        self.uuids = uuids
         self.connected = False
         self.resolved = False
         self.rssi = -58
@@ -180,7 +180,7 @@ class Device(ServiceInterface):
 
     @dbus_property(access=PropertyAccess.READ)
     def UUIDs(self) -> DBusStrings:
-        return self._uuids
+        return self.uuids
 
     @dbus_property(access=PropertyAccess.READ)
     def Adapter(self) -> DBusObjectPath:

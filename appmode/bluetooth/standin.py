@@ -137,14 +137,13 @@ class StandIn:
 
     async def connect(self, device: Device, uuid: str | None) -> None:
         if device.le:
-            if uuid is not None and uuid not in device._uuids:
+            if uuid is not None and uuid not in device.uuids:
                 raise DBusError(FAILED, f"{device.label} has no profile {uuid}")
             if not device.connected and self._bus is not None:
                 self.module = ModuleModel()
                 self._origin = time.monotonic()
-                for path, interface in self._gatt:
-                    if path not in self._bus._path_exports:
-                        self._bus.export(path, interface)
+                while self._gatt:  # resolved once: BlueZ keeps a device's services
+                    self._bus.export(*self._gatt.pop(0))
                 await asyncio.sleep(CONNECTION_INTERVAL)
                 device.set_state(True)
                 self._linked.set()

@@ -186,6 +186,7 @@ COMMANDS = [
     ("params", "bt://02:CA:40:00:00:05"),
     ("monitor", "ble://02:CA:40:00:00:08", "--count", "1"),
     ("scan", "--time", "1"),
+    ("drive", "ble://HC-08"),
 ]
 
 

@@ -18,7 +18,8 @@ SUITE = Path(__file__).resolve().parents[2] / "transcripts" / "suite"
 SOME = ("s2_2_read_params", "s4_letters_omni", "s5_set_each_param")
 
 
-def test_the_page_drives_the_car_over_ble(tmp_path: Path) -> None:
+@pytest.mark.parametrize("which", ["ble", "spp"])
+def test_the_page_drives_the_car_over_the_module(tmp_path: Path, which: str) -> None:
     async def scenario(web: WebProcess) -> None:
         async with aiohttp.ClientSession() as session:
             socket = await page(session, web)
@@ -32,8 +33,8 @@ def test_the_page_drives_the_car_over_ble(tmp_path: Path) -> None:
             await socket.close()  # a closed page stops the car
             wait_sent(web, "Z")
 
-    with web_process(tmp_path, bluetooth=True) as web:
-        assert web.board.url.startswith("ble://")
+    with web_process(tmp_path, bluetooth=which) as web:
+        assert web.board.url.startswith("ble://" if which == "ble" else "bt://")
         asyncio.run(scenario(web))
     assert web.sent()[-1] == "Z"
 
