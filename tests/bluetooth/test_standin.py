@@ -98,10 +98,12 @@ def test_a_driving_script_moves_the_car_and_ends_with_z(
     appmode_ble_board.wait_until(lambda s: not s.moving, what="a stopped car")
 
 
-def test_sigterm_mid_drive_leaves_z_last(appmode_ble_board: ServedBoard) -> None:
-    assert appmode_ble_board.ble is not None
+def driving(board: ServedBoard) -> subprocess.Popen[str]:
+    """`appmode drive` over the board's BLE module, driving forward (script mode) until
+    it is stopped; the board moving."""
+    assert board.ble is not None
     proc = subprocess.Popen(
-        appmode_cmd("drive", appmode_ble_board.ble),
+        appmode_cmd("drive", board.ble),
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -111,7 +113,17 @@ def test_sigterm_mid_drive_leaves_z_last(appmode_ble_board: ServedBoard) -> None
     assert proc.stdin is not None
     proc.stdin.write("drive A\nwait 60\n")
     proc.stdin.flush()
-    appmode_ble_board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
+    try:
+        board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
+    except BaseException:
+        proc.kill()
+        proc.communicate()
+        raise
+    return proc
+
+
+def test_sigterm_mid_drive_leaves_z_last(appmode_ble_board: ServedBoard) -> None:
+    proc = driving(appmode_ble_board)
     proc.send_signal(signal.SIGTERM)
     proc.communicate(timeout=15)
     wait_for(lambda: sent(appmode_ble_board).endswith(b"Z"), 5)
@@ -143,20 +155,9 @@ def test_a_dropped_link_is_lost_then_retried_and_z_goes_first(
     appmode_ble_board: ServedBoard,
 ) -> None:
     board = appmode_ble_board
-    assert board.ble is not None and board.bus is not None
-    proc = subprocess.Popen(
-        appmode_cmd("drive", board.ble),
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    assert proc.stdin is not None
-    proc.stdin.write("drive A\nwait 60\n")
-    proc.stdin.flush()
+    assert board.bus is not None
+    proc = driving(board)
     try:
-        board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
         before = len(sent(board))
         _drop(board.bus)
         wait_for(lambda: len(sent(board)) > before, 15)  # reconnected, and sent

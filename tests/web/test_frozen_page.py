@@ -95,8 +95,7 @@ def test_a_frozen_page_stops_a_velocity_frame_over_uart2(tmp_path: Path) -> None
     async def scenario(web: WebProcess) -> float:
         async with aiohttp.ClientSession() as session:
             socket = await page(session, web)
-            while "settings read" not in (await status(socket))["messages"]:
-                pass
+            await ready(socket, "settings read")
             await socket.send_json({"t": "command", "line": "velocity 0 300 0"})
             wait_frame(web, "FF FE 01 00 00 01 2C")
             sent = time.monotonic()

@@ -56,12 +56,17 @@ async def status(socket: aiohttp.ClientWebSocketResponse) -> dict[str, Any]:
             return message
 
 
-async def ready(socket: aiohttp.ClientWebSocketResponse) -> dict[str, Any]:
-    """The first status after the session read the board's parameters."""
+async def ready(
+    socket: aiohttp.ClientWebSocketResponse, said: str = "parameters read", timeout: float = 20
+) -> dict[str, Any]:
+    """The first status after the session read the board's parameters (or said `said`);
+    AssertionError with what it said instead after `timeout` seconds."""
+    deadline = time.monotonic() + timeout
     while True:
         shown = await status(socket)
-        if "parameters read" in shown["messages"]:
+        if said in shown["messages"]:
             return shown
+        assert time.monotonic() < deadline, f"no {said!r} in {timeout:g} s: {shown['messages']}"
 
 
 async def error(socket: aiohttp.ClientWebSocketResponse) -> str:
@@ -271,8 +276,7 @@ def test_a_stick_that_goes_quiet_stops_the_car_and_the_app_port_takes_none(
     async def quiet_stick(web: WebProcess) -> float:
         async with aiohttp.ClientSession() as session:
             socket = await page(session, web)
-            while "settings read" not in (await status(socket))["messages"]:
-                pass
+            await ready(socket, "settings read")
             await socket.send_json({"t": "stick", "x": 0.5, "y": 1})
             wait_frame(web, "FF FE 01 00 96 01 2C")  # x 150, y 300
             pushed = time.monotonic()
