@@ -39,6 +39,8 @@ WRITE_BUFFER = 4096
 """Bytes `write` may queue ahead of the radio; past them it waits (its write_timeout)."""
 AHEAD = PAYLOAD
 """Bytes the writer lets the module's buffer hold beyond what its UART has sent."""
+RECEIVE_BUFFER = 65536
+"""Bytes notified and not yet read that the port keeps (about a minute of records)."""
 CLOSE = 3.0
 LINGER = 0.05
 """Seconds between the last write and hanging up: a few connection events, so that
@@ -114,6 +116,8 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
     def _notified(self, _: Any, data: bytearray) -> None:
         with self._ready:
             self._received += data
+            if len(self._received) > RECEIVE_BUFFER:  # nobody reads: the oldest go, as
+                del self._received[: len(self._received) - RECEIVE_BUFFER]  # an OS's do
             self._ready.notify_all()
 
     def _disconnected(self, _: Any) -> None:

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import threading
+
 import pytest
 
 from appmode.bluetooth.addresses import BadAddress, parse_ble, parse_bt
+from appmode.bluetooth.ble_port import RECEIVE_BUFFER, BleSerial
 from appmode.bluetooth.module import INPUT_BUFFER, PAYLOAD, UART_BYTES_PER_S, ModuleModel
 from appmode.bluetooth.uuids import UART_SERVICES, full, uart_service
 
@@ -74,3 +77,13 @@ def test_notifications_are_cut_to_the_payload_a_few_per_connection_event() -> No
         assert len(chunks) <= 4 and all(len(c) <= PAYLOAD for c in chunks)
         sent += chunks
     assert b"".join(sent) == record
+
+
+def test_what_nobody_reads_is_bounded_the_newest_kept() -> None:
+    port = BleSerial.__new__(BleSerial)  # the buffer alone: no radio
+    port._received = bytearray()
+    port._ready = threading.Condition()
+    for i in range(RECEIVE_BUFFER // 10):
+        port._notified(None, bytearray(b"%010d" % i) * 2)
+    assert len(port._received) == RECEIVE_BUFFER
+    assert port._received.endswith(b"%010d" % (RECEIVE_BUFFER // 10 - 1))
