@@ -7,6 +7,8 @@ HC-05 …), as a model with no I/O: what it takes from the radio, what it notifi
 - The UART side runs at 9600 bps 8N1 (960 bytes/s) both ways. What the radio brings
   faster than that waits in the module's INPUT_BUFFER; what arrives when it is full is
   lost, without a word (real modules drop it too, or reset): a host must pace its writes.
+  The other way, notifications carry more than the UART brings; a board that sent faster
+  than 9600 bps would find OUTPUT_BUFFER full, and lose the rest.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ PAYLOAD = MTU - 3
 CONNECTION_INTERVAL = 0.015
 NOTIFICATIONS_PER_EVENT = 4
 INPUT_BUFFER = 128
+OUTPUT_BUFFER = 512
 UART_BYTES_PER_S = 960.0
 
 
@@ -29,7 +32,7 @@ class ModuleModel:
     """Bytes waiting in the input buffer for the UART (drains at UART_BYTES_PER_S)."""
     at: float = 0.0
     lost: int = 0
-    """Bytes the radio brought that the full input buffer lost."""
+    """Bytes lost to a full buffer, either way."""
     outgoing: bytearray = field(default_factory=bytearray)
     """What the board sent that is not notified yet."""
 
@@ -44,8 +47,13 @@ class ModuleModel:
         return kept
 
     def from_uart(self, data: bytes) -> None:
-        """Bytes the board sent; notified at the coming connection events."""
+        """Bytes the board sent; notified at the coming connection events. What the
+        radio cannot keep up with past OUTPUT_BUFFER is lost (counted)."""
         self.outgoing += data
+        over = len(self.outgoing) - OUTPUT_BUFFER
+        if over > 0:
+            del self.outgoing[-over:]
+            self.lost += over
 
     def notifications(self) -> list[bytes]:
         """What one connection event notifies, in order."""

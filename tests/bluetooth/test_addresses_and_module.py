@@ -87,3 +87,11 @@ def test_what_nobody_reads_is_bounded_the_newest_kept() -> None:
         port._notified(None, bytearray(b"%010d" % i) * 2)
     assert len(port._received) == RECEIVE_BUFFER
     assert port._received.endswith(b"%010d" % (RECEIVE_BUFFER // 10 - 1))
+
+
+def test_a_board_faster_than_the_radio_loses_what_overflows_the_module() -> None:
+    from appmode.bluetooth.module import OUTPUT_BUFFER
+
+    module = ModuleModel()
+    module.from_uart(b"x" * (OUTPUT_BUFFER + 100))
+    assert len(module.outgoing) == OUTPUT_BUFFER and module.lost == 100
