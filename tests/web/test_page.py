@@ -142,8 +142,12 @@ def test_tilting_drives_past_the_dead_zone_and_level_stops(
                 [beta, gamma],
             )
 
+        level = page.get_by_role("button", name="Calibrate level")
+        level.click()  # before the sensor said anything: there is no level to set
+        assert "No tilt sensor has answered" in page.locator("#tilt-note").inner_text()
         tilt(40, 0)  # held at 40°: then calibrated as level
-        page.get_by_role("button", name="Calibrate level").click()
+        level.click()
+        assert "Level set" in page.locator("#tilt-note").inner_text()
         page.get_by_role("button", name="Drive by tilting").click()
         tilt(45, 3)  # inside the dead zone: nothing
         page.wait_for_timeout(300)
@@ -256,6 +260,8 @@ def test_over_uart2_the_analog_pad_s_deflection_is_the_speed(
         page = browser.new_page()
         page.goto(web.address)
         page.get_by_text("settings read").wait_for(timeout=10_000)
+        for name in ("Direction page", "Button page"):  # the APP port's pages: not here
+            assert not page.get_by_role("button", name=name, exact=True).is_visible()
         box = page.get_by_role("application").bounding_box()
         assert box is not None
         cx, cy, radius = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2, box["width"] / 2

@@ -246,7 +246,11 @@ function tiltOff() {
 window.addEventListener("deviceorientation", onTilt);
 $("tilt-on").addEventListener("click", () => (tilt.on ? tiltOff() : tiltOn()));
 $("level").addEventListener("click", () => {
-  if (tilt.beta !== null) tilt.level = [tilt.beta, tilt.gamma];
+  if (tilt.beta === null) {
+    tiltNote("No tilt sensor has answered: there is no level to set.");
+    return;
+  }
+  tilt.level = [tilt.beta, tilt.gamma];
   tiltNote("Level set: hold the phone like this to stop.");
 });
 
