@@ -75,13 +75,22 @@ async def _call(
     return reply
 
 
-async def _device(bus: MessageBus, address: str) -> str:
+async def devices(bus: MessageBus) -> dict[str, dict[str, Variant]]:
+    """BlueZ's devices (their org.bluez.Device1 properties) by object path; OSError (with
+    the bus's error name) when BlueZ does not answer."""
     reply = await _call(bus, "/", "org.freedesktop.DBus.ObjectManager", "GetManagedObjects")
     if reply.message_type == MessageType.ERROR:
         raise OSError(f"{reply.error_name}: {reply.body[0] if reply.body else ''}")
-    for path, interfaces in reply.body[0].items():
-        device = interfaces.get("org.bluez.Device1")
-        if device is not None and str(device["Address"].value).upper() == address:
+    return {
+        str(path): interfaces["org.bluez.Device1"]
+        for path, interfaces in reply.body[0].items()
+        if "org.bluez.Device1" in interfaces
+    }
+
+
+async def _device(bus: MessageBus, address: str) -> str:
+    for path, device in (await devices(bus)).items():
+        if str(device["Address"].value).upper() == address:
             if not device["Paired"].value:
                 raise SerialException(f"{address} is not paired: {PAIR.format(address)}")
             return str(path)

@@ -85,27 +85,19 @@ async def paired_spp() -> list[Found]:
         ]
     if not sys.platform.startswith("linux"):
         return []
-    from dbus_fast import BusType, Message
+    from dbus_fast import BusType
     from dbus_fast.aio import MessageBus
+
+    from appmode.bluetooth.profile import devices
 
     bus = await MessageBus(bus_type=BusType.SYSTEM).connect()
     try:
-        reply = await bus.call(
-            Message(
-                destination="org.bluez",
-                path="/",
-                interface="org.freedesktop.DBus.ObjectManager",
-                member="GetManagedObjects",
-            )
-        )
+        known = await devices(bus)
     finally:
         bus.disconnect()
-    if reply is None or not reply.body:
-        return []
     found = []
-    for interfaces in reply.body[0].values():
-        device = interfaces.get("org.bluez.Device1")
-        if device is None or not device["Paired"].value:
+    for device in known.values():
+        if not device["Paired"].value:
             continue
         uuids = device.get("UUIDs")
         if uuids is None or SPP not in [str(u).lower() for u in uuids.value]:

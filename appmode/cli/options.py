@@ -69,7 +69,7 @@ HOLDS = (
 )
 A_RECORD = f"the board's profile, {HOLDS}"
 ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {HOLDS}"
-"""--profile of a command that opens a board (`board_url`)."""
+"""--profile of a command that opens a board (`Target.with_sim`)."""
 FROM_URL = "a sim:// URL's profile, else sheet"
 
 
