@@ -33,3 +33,15 @@ def explain(exc: BaseException) -> str | None:
     if name == "BleakBluetoothNotAvailableError":
         return f"no Bluetooth here: {text.rstrip('.')}; {STANDIN}"
     return None
+
+
+def unsupported() -> str | None:
+    """Why appmode cannot be a Bluetooth module here (None on Linux, where BlueZ lets a
+    program register GATT services, advertisements and SPP servers)."""
+    if sys.platform.startswith("linux"):
+        return None
+    system = "macOS" if sys.platform == "darwin" else "Windows" if os.name == "nt" else sys.platform
+    return (
+        f"appmode serves as a Bluetooth module through BlueZ, on Linux only, not on {system}: "
+        "run it on a Linux machine with an adapter (a Raspberry Pi will do)"
+    )

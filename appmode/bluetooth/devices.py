@@ -25,7 +25,6 @@ FILTERS = ["UUIDs", "RSSI", "Pathloss", "Transport", "DuplicateData", "Discovera
 class Radio(Protocol):
     """What the adapter and devices ask of the stand-in."""
 
-    def discover(self, on: bool) -> None: ...
     async def connect(self, device: Device, uuid: str | None) -> None: ...
     def disconnect(self, device: Device) -> None: ...
 
@@ -35,6 +34,9 @@ def device_path(address: str) -> str:
 
 
 class Adapter(ServiceInterface):
+    """The adapter; StartDiscovery and StopDiscovery, which need the caller's bus name
+    (each client has its own discovery session), are the stand-in's."""
+
     def __init__(self, radio: Radio, address: str) -> None:
         super().__init__("org.bluez.Adapter1")
         self._radio, self._address = radio, address
@@ -83,14 +85,6 @@ class Adapter(ServiceInterface):
     @dbus_property(access=PropertyAccess.READ)
     def Roles(self) -> DBusStrings:
         return ["central", "peripheral"]
-
-    @dbus_method()
-    def StartDiscovery(self) -> Nothing:
-        self._radio.discover(True)
-
-    @dbus_method()
-    def StopDiscovery(self) -> Nothing:
-        self._radio.discover(False)
 
     @dbus_method()
     def SetDiscoveryFilter(self, properties: DBusDict) -> Nothing:

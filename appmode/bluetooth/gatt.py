@@ -1,6 +1,8 @@
-"""The GATT objects BlueZ exports for a connected BLE module (org.bluez.GattService1,
-GattCharacteristic1, GattDescriptor1 in BlueZ's doc/), as the stand-in serves them: one
-UART service whose characteristic takes writes and notifies what the board sends."""
+"""GATT objects (org.bluez.GattService1, GattCharacteristic1, GattDescriptor1 in BlueZ's
+doc/): a UART service whose characteristic takes writes and notifies. `Service` and
+`Characteristic` are what an application registers with BlueZ (the advertised module);
+`GattService` and `UartCharacteristic` add what BlueZ exports for a connected device's
+(the stand-in's view of a module: its device, its handles, the MTU)."""
 
 from __future__ import annotations
 
@@ -27,10 +29,12 @@ FLAGS = ["read", "write-without-response", "write", "notify"]
 """What an HM-10's FFE1 allows (an HC-08's the same)."""
 
 
-class GattService(ServiceInterface):
-    def __init__(self, uuid: str, device: str, handle: int) -> None:
+class Service(ServiceInterface):
+    """A primary service, as an application registers it."""
+
+    def __init__(self, uuid: str) -> None:
         super().__init__("org.bluez.GattService1")
-        self._uuid, self._device, self._handle = uuid, device, handle
+        self._uuid = uuid
 
     @dbus_property(access=PropertyAccess.READ)
     def UUID(self) -> DBusStr:
@@ -39,6 +43,14 @@ class GattService(ServiceInterface):
     @dbus_property(access=PropertyAccess.READ)
     def Primary(self) -> DBusBool:
         return True
+
+
+class GattService(Service):
+    """A connected device's service, as BlueZ exports it."""
+
+    def __init__(self, uuid: str, device: str, handle: int) -> None:
+        super().__init__(uuid)
+        self._device, self._handle = device, handle
 
     @dbus_property(access=PropertyAccess.READ)
     def Device(self) -> DBusObjectPath:
@@ -49,16 +61,21 @@ class GattService(ServiceInterface):
         return self._handle
 
 
-class UartCharacteristic(ServiceInterface):
-    """Writes go to `received`; `notify` sends what the board sent to subscribed centrals
-    (a PropertiesChanged of Value, as BlueZ relays a notification)."""
+class Characteristic(ServiceInterface):
+    """A UART characteristic: writes go to `received`; `subscribed` hears StartNotify
+    (True) and StopNotify (False); `notify` sends a notification to a subscribed central
+    (a PropertiesChanged of Value, as BlueZ relays one)."""
 
     def __init__(
-        self, uuid: str, service: str, handle: int, received: Callable[[bytes], None]
+        self,
+        uuid: str,
+        service: str,
+        received: Callable[[bytes], None],
+        subscribed: Callable[[bool], None] = lambda on: None,
     ) -> None:
         super().__init__("org.bluez.GattCharacteristic1")
-        self._uuid, self._service, self._handle = uuid, service, handle
-        self._received = received
+        self._uuid, self._service = uuid, service
+        self._received, self._subscribed = received, subscribed
         self._value = b""
         self.notifying = False
 
@@ -71,10 +88,6 @@ class UartCharacteristic(ServiceInterface):
         return self._service
 
     @dbus_property(access=PropertyAccess.READ)
-    def Handle(self) -> DBusUInt16:
-        return self._handle
-
-    @dbus_property(access=PropertyAccess.READ)
     def Value(self) -> DBusBytes:
         return self._value
 
@@ -85,10 +98,6 @@ class UartCharacteristic(ServiceInterface):
     @dbus_property(access=PropertyAccess.READ)
     def Flags(self) -> DBusStrings:
         return FLAGS
-
-    @dbus_property(access=PropertyAccess.READ)
-    def MTU(self) -> DBusUInt16:
-        return MTU
 
     @dbus_method()
     def ReadValue(self, options: DBusDict) -> DBusBytes:
@@ -103,21 +112,47 @@ class UartCharacteristic(ServiceInterface):
 
     @dbus_method()
     def StartNotify(self) -> Nothing:
-        if not self.notifying:
-            self.notifying = True
-            self.emit_properties_changed({"Notifying": True})
+        self.set_notifying(True)
 
     @dbus_method()
     def StopNotify(self) -> Nothing:
-        if self.notifying:
-            self.notifying = False
-            self.emit_properties_changed({"Notifying": False})
+        self.set_notifying(False)
+
+    def set_notifying(self, on: bool) -> None:
+        """Subscribed or not (a central's request, or its link's end)."""
+        if on != self.notifying:
+            self.notifying = on
+            self.emit_properties_changed({"Notifying": on})
+            self._subscribed(on)
 
     def notify(self, data: bytes) -> None:
         """One notification (at most the MTU's payload), if a central subscribed."""
         self._value = data
         if self.notifying:
             self.emit_properties_changed({"Value": data})
+
+
+class UartCharacteristic(Characteristic):
+    """A connected device's UART characteristic, as BlueZ exports it."""
+
+    def __init__(
+        self,
+        uuid: str,
+        service: str,
+        handle: int,
+        received: Callable[[bytes], None],
+        subscribed: Callable[[bool], None] = lambda on: None,
+    ) -> None:
+        super().__init__(uuid, service, received, subscribed)
+        self._handle = handle
+
+    @dbus_property(access=PropertyAccess.READ)
+    def Handle(self) -> DBusUInt16:
+        return self._handle
+
+    @dbus_property(access=PropertyAccess.READ)
+    def MTU(self) -> DBusUInt16:
+        return MTU
 
 
 class Cccd(ServiceInterface):

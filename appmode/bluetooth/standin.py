@@ -17,14 +17,16 @@ import socket
 import time
 from collections.abc import Callable, Coroutine
 
-from dbus_fast import DBusError, Message, MessageType
+from dbus_fast import DBusError, Message, MessageType, Variant
 from dbus_fast.aio import MessageBus
 from dbus_fast.service import ServiceInterface, dbus_method
 
 from appmode.bluetooth.devices import ADAPTER, Adapter, Device
 from appmode.bluetooth.gatt import Cccd, GattService, UartCharacteristic
 from appmode.bluetooth.module import CONNECTION_INTERVAL, ModuleModel, next_event
+from appmode.bluetooth.peers import Peers
 from appmode.bluetooth.signatures import Nothing
+from appmode.bluetooth.spp_links import new_connection
 from appmode.bluetooth.uuids import SPP, UART_SERVICES
 
 Log = Callable[[str], None]
@@ -77,7 +79,9 @@ class StandIn:
         ]
         self.module = ModuleModel()
         self._writes: list[bytes] = []
-        self._profiles: list[tuple[str, str, str]] = []  # (sender, path, uuid)
+        self._profiles: list[tuple[str, str, str, str]] = []  # (sender, path, uuid, role)
+        self.peers = Peers(self, log, lambda: self.adapter.discovering)
+        self._discoverers: set[str] = set()
         self._spp_link: socket.socket | None = None
         self._spp_reader: asyncio.Task[None] | None = None
         self._tasks: set[asyncio.Task[None]] = set()
@@ -89,7 +93,9 @@ class StandIn:
         bus = await MessageBus(bus_address=self._address, negotiate_unix_fd=True).connect()
         self._bus = bus
         bus.add_message_handler(self._profile_manager)
+        bus.add_message_handler(self._peer_message)
         bus.export(ADAPTER, self.adapter)
+        self.peers.start(bus)
         bus.export(self.spp.path, self.spp)  # paired: BlueZ knows it from the start
         bus.export(CONTROL, Control(self))
         reply = await bus.request_name("org.bluez")
@@ -108,6 +114,7 @@ class StandIn:
             await stop.wait()
         finally:
             self.drop("the stand-in stops")
+            self.peers.close()
             for task in self._tasks:
                 task.cancel()
             if self._bus is not None:
@@ -121,21 +128,31 @@ class StandIn:
     # ------------------------------------------------------------ discovery
 
     def discover(self, on: bool) -> None:
+        started = on and not self.adapter.discovering
         self.adapter.set_discovering(on)
         if on and not self._found and self._bus is not None:
             self._found = True
             self._bus.export(self.ble.path, self.ble)
-        if on:
+        if started:
+            self.peers.discovered()
             self._spawn(self._advertise())
 
     async def _advertise(self) -> None:
         while self.adapter.discovering:
-            self.ble.advertise(-58 + random.randint(-4, 4))
+            for device in [self.ble, *self.peers.heard()]:
+                device.advertise(-58 + random.randint(-4, 4))
             await asyncio.sleep(ADVERTISING)
 
     # ------------------------------------------------------------ connections
 
     async def connect(self, device: Device, uuid: str | None) -> None:
+        peer = self.peers.owner(device)
+        if peer is not None and device.le:
+            self.peers.connect_ble(peer, device)
+            return
+        if peer is not None:
+            await self.peers.connect_spp(peer, device, self._client_profile(device, uuid or SPP))
+            return
         if device.le:
             if uuid is not None and uuid not in device.uuids:
                 raise DBusError(FAILED, f"{device.label} has no profile {uuid}")
@@ -152,41 +169,36 @@ class StandIn:
         await self._connect_spp(device, uuid or SPP)
 
     async def _connect_spp(self, device: Device, uuid: str) -> None:
-        if uuid != SPP:
-            raise DBusError("org.bluez.Error.NotAvailable", f"{device.label} offers only SPP")
         if self._spp_link is not None:
             raise DBusError("org.bluez.Error.AlreadyConnected", "Already Connected")
-        registered = [p for p in reversed(self._profiles) if p[2] == SPP]
-        if not registered or self._bus is None:
-            raise DBusError(
-                "org.bluez.Error.NotAvailable",
-                "no application registered the Serial Port profile (ProfileManager1)",
-            )
-        sender, path, _ = registered[0]
-        mine, theirs = socket.socketpair()
-        reply = await self._bus.call(
-            Message(
-                destination=sender,
-                path=path,
-                interface="org.bluez.Profile1",
-                member="NewConnection",
-                signature="oha{sv}",
-                body=[device.path, 0, {}],
-                unix_fds=[theirs.fileno()],
-            )
-        )
-        theirs.close()
-        if reply is None or reply.message_type == MessageType.ERROR:
-            mine.close()
-            why = reply.body[0] if reply is not None and reply.body else "no answer"
-            raise DBusError(FAILED, f"the profile refused the connection: {why}")
-        mine.setblocking(False)
+        assert self._bus is not None
+        mine = await new_connection(self._bus, self._client_profile(device, uuid), device.path)
         self._spp_link = mine
         device.set_state(True)
         self._log(f"spp: {device.label} connected")
         self._spp_reader = asyncio.ensure_future(self._from_spp(mine, device))
 
+    def _client_profile(self, device: Device, uuid: str) -> tuple[str, str]:
+        """The profile registered last to connect to `uuid` as a client: BlueZ hands it
+        the connection."""
+        if uuid != SPP:
+            raise DBusError("org.bluez.Error.NotAvailable", f"{device.label} offers only SPP")
+        for sender, path, registered, role in reversed(self._profiles):
+            if registered == SPP and role != "server":
+                return sender, path
+        raise DBusError(
+            "org.bluez.Error.NotAvailable",
+            "no application registered the Serial Port profile (ProfileManager1)",
+        )
+
     def disconnect(self, device: Device) -> None:
+        peer = self.peers.owner(device)
+        if peer is not None:
+            if device.le:
+                self.peers.disconnect_ble(peer, device)
+            else:
+                self.peers.spp_links.disconnect(device)
+            return
         if not device.le and self._spp_link is not None:
             reader = self._spp_reader
             if reader is not None and reader is not asyncio.current_task():
@@ -206,8 +218,9 @@ class StandIn:
             self.characteristic.notifying = False
 
     def drop(self, why: str) -> None:
-        """Both links end at once, as when the car goes out of range."""
-        for device in (self.ble, self.spp):
+        """Every link ends at once, as when the car goes out of range."""
+        peers = [d for p in self.peers.all() for d in (p.ble, p.spp) if d is not None]
+        for device in (self.ble, self.spp, *peers):
             if device.connected:
                 self._log(f"{why}: {device.label}")
             self.disconnect(device)
@@ -216,16 +229,60 @@ class StandIn:
         """org.bluez.ProfileManager1, answered here: it needs the caller's bus name."""
         if message.interface != "org.bluez.ProfileManager1" or message.path != "/org/bluez":
             return None
+        sender = str(message.sender)
         if message.member == "RegisterProfile" and message.signature == "osa{sv}":
-            path, uuid, _ = message.body
-            self._profiles.append((str(message.sender), path, uuid.lower()))
+            path, uuid, options = message.body
+            role = str(options.get("Role", Variant("s", "")).value)
+            self._profiles.append((sender, path, uuid.lower(), role))
+            if role == "server" and uuid.lower() == SPP:
+                self.peers.profile(sender, path, options, added=True)
             return Message.new_method_return(message)
         if message.member == "UnregisterProfile" and message.signature == "o":
-            self._profiles = [
-                p for p in self._profiles if (p[0], p[1]) != (message.sender, message.body[0])
-            ]
+            path = message.body[0]
+            self._profiles = [p for p in self._profiles if (p[0], p[1]) != (sender, path)]
+            self.peers.profile(sender, path, {}, added=False)
             return Message.new_method_return(message)
         return Message.new_error(message, "org.bluez.Error.InvalidArguments", "bad call")
+
+    def _peer_message(self, message: Message) -> bool:
+        """What the server side takes: GattManager1's and LEAdvertisingManager1's calls,
+        an application's notifications, a registered client leaving the bus."""
+        if message.message_type == MessageType.METHOD_CALL:
+            return self._discovery(message) or self.peers.handle(message)
+        if message.message_type == MessageType.SIGNAL:
+            self._session_ends(message)
+            return self.peers.notified(message) or self.peers.gone(message)
+        return False
+
+    def _discovery(self, message: Message) -> bool:
+        """Adapter1.StartDiscovery and StopDiscovery: as BlueZ, one discovery session per
+        client, and the adapter discovers while any is open (one client stopping does
+        not stop another's)."""
+        if message.path != ADAPTER or message.interface != "org.bluez.Adapter1":
+            return False
+        if message.member not in ("StartDiscovery", "StopDiscovery") or self._bus is None:
+            return False
+        sender = str(message.sender)
+        if message.member == "StartDiscovery":
+            if sender not in self._discoverers:
+                self._discoverers.add(sender)
+                self.peers.spawn(self.peers.watch_name(sender))
+        elif sender in self._discoverers:
+            self._discoverers.discard(sender)
+        else:
+            self._bus.send(Message.new_error(message, FAILED, "No discovery started"))
+            return True
+        self.discover(bool(self._discoverers))
+        self._bus.send(Message.new_method_return(message))
+        return True
+
+    def _session_ends(self, message: Message) -> None:
+        """A client that left the bus leaves its discovery session."""
+        if message.member == "NameOwnerChanged" and message.signature == "sss":
+            name, _, new = message.body
+            if not new and name in self._discoverers:
+                self._discoverers.discard(name)
+                self.discover(bool(self._discoverers))
 
     # ------------------------------------------------------------ bytes
 

@@ -11,7 +11,12 @@ from appmode.cli.options import Subparsers, add_profile, add_record, file_name, 
 from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES
 
+ADVERTISED_NAME = "HC-08"
+"""The name a BLE module ships with, and the vendor's app lists."""
+
 if TYPE_CHECKING:
+    from types import ModuleType
+
     from appmode.ports.endpoints import MakeEndpoint
 
 
@@ -87,6 +92,15 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         "DBUS_SYSTEM_BUS_ADDRESS (Linux, needs dbus-daemon and appmode[bluetooth])",
     )
     where.add_argument(
+        "--advertise",
+        nargs="?",
+        const=ADVERTISED_NAME,
+        metavar="NAME",
+        help=f"serve as a Bluetooth module on this machine's adapter, for a phone (the "
+        f"vendor's app) to connect to: advertised on BLE as NAME (default {ADVERTISED_NAME}) "
+        "and offered as a classic SPP server (Linux with BlueZ; pair the phone first for SPP)",
+    )
+    where.add_argument(
         "--port",
         metavar="DEV",
         help="serve on a real serial port, e.g. /dev/ttyUSB0 (?baud=N to change 9600)",
@@ -101,6 +115,11 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         "--port2",
         metavar="DEV",
         help="serve UART2 on a real serial port (?baud=N to change 115200)",
+    )
+    board.add_argument(
+        "--nus",
+        action="store_true",
+        help="with --advertise: offer the Nordic UART service instead of FFE0/FFE1",
     )
     board.add_argument(
         "--baud",
@@ -121,6 +140,7 @@ def run(args: argparse.Namespace) -> int:
         args.listen,
         args.port,
         args.bluetooth or None,
+        args.advertise,
         args.link,
         args.flash,
         args.record,
@@ -130,8 +150,11 @@ def run(args: argparse.Namespace) -> int:
     if args.count > 1 and any(option is not None for option in alone):
         raise AppmodeError(
             "--count serves several boards on ptys: it cannot be combined "
-            "with --listen, --port, --bluetooth, --listen2, --port2, --link, --flash or --record"
+            "with --listen, --port, --bluetooth, --advertise, --listen2, --port2, --link, "
+            "--flash or --record"
         )
+    if args.nus and args.advertise is None:
+        raise AppmodeError("--nus is an option of --advertise: add --advertise [NAME]")
     options = ServeOptions(
         app=_app_endpoint(args),
         uart2=_uart2_endpoint(args),
@@ -157,14 +180,29 @@ def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
     if args.port is not None:
         return partial(endpoints.SerialEndpoint, device=args.port, baud=args.baud or BAUD)
     if args.bluetooth:
-        try:
-            from appmode.bluetooth.endpoint import BluetoothEndpoint
-        except ImportError:
-            raise AppmodeError(
-                "--bluetooth needs the bluetooth extra: pip install 'appmode[bluetooth]'"
-            ) from None
-        return partial(BluetoothEndpoint, baud=args.baud)
+        return partial(_bluetooth("--bluetooth").BluetoothEndpoint, baud=args.baud)
+    if args.advertise is not None:
+        from appmode.bluetooth.uuids import UART_SERVICES
+
+        endpoint = _bluetooth("--advertise").AdvertisedEndpoint
+        service = UART_SERVICES[1 if args.nus else 0]
+        return partial(endpoint, name=args.advertise, service=service, baud=args.baud)
     return partial(endpoints.PtyEndpoint, link=args.link, baud=args.baud)
+
+
+def _bluetooth(option: str) -> ModuleType:
+    """appmode.bluetooth.endpoint, or one line on what to install and what it runs on."""
+    from appmode.bluetooth.availability import unsupported
+
+    if (why := unsupported()) is not None:
+        raise AppmodeError(f"{option}: {why}")
+    try:
+        from appmode.bluetooth import endpoint
+    except ImportError:
+        raise AppmodeError(
+            f"{option} needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+        ) from None
+    return endpoint
 
 
 def _uart2_endpoint(args: argparse.Namespace) -> MakeEndpoint:

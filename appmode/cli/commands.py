@@ -50,7 +50,10 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
         "appmode replay car.transcript --to /dev/ttyUSB0",
         "appmode replay car.transcript --to pty --side board",
     ),
-    "tap": ("appmode tap pty /dev/ttyUSB0 --record app.transcript",),
+    "tap": (
+        "appmode tap pty /dev/ttyUSB0 --record app.transcript",
+        "appmode tap advertise:HC-08 ble://AA:BB:CC:DD:EE:FF --record phone.transcript",
+    ),
     "dump": ("appmode dump car.transcript", "appmode dump car.transcript --csv > car.csv"),
     "plot": ("appmode plot car.transcript -o car.png",),
     "ports": ("appmode ports",),

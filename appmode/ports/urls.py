@@ -37,6 +37,11 @@ OWN_WORDS = ("sim", "ble", "bt")
 """Schemes whose ports say themselves what went wrong and what to do."""
 
 
+class LinkLeft(ConnectionError):
+    """The other end of a link left it (a phone that disconnected from the module
+    appmode serves): the end of a session, not a fault."""
+
+
 def open_link(
     url: Target | str, timeout: float | None = 0.05, baud: int = BAUD
 ) -> serial.SerialBase:

@@ -162,6 +162,12 @@ class Recorder:
         self._units(self._reader.feed(direction, data))
         self._release(time)
 
+    def note(self, text: str, time: float) -> None:
+        """A comment line at `time`: what happened that no byte shows (the first comment
+        of a transcript is its title)."""
+        self._queue.append((time, next(self._order), " ".join(text.split()).encode(), "#"))
+        self._release(time)
+
     def follow(self, system_mode: int, time: float) -> None:
         """Read UART2 as a board with this system_mode does (`PortsReader.follow`)."""
         self._units(self._reader.follow(system_mode))
@@ -192,6 +198,9 @@ class Recorder:
             self._line(when, raw, direction)
 
     def _line(self, time: float, raw: bytes, direction: str) -> None:
+        if direction == "#":
+            self._write(f"# {raw.decode()}\n")
+            return
         if direction in UART2_DIRECTIONS:
             payload = uart2_payload(raw, self._reader.app_mode)
         else:

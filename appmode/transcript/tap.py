@@ -1,8 +1,10 @@
 """`appmode tap`: sit between an app and a board, forwarding and recording both ways.
 
 Two threads each read one side and write to the other; the recorder hears both. The app
-side may be `pty` — a new pseudo-terminal for the app to open (its path is printed). On
-the way out the board gets `Z`: the app can no longer stop it.
+side may be `pty` — a new pseudo-terminal for the app to open (its path is printed) — or
+`advertise[:NAME]`: appmode advertised as the car's Bluetooth module, for the phone's app
+to connect to. When a side leaves, the transcript says which; on the way out the board
+gets `Z` (after closing any frame the app left open): the app can no longer stop it.
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ from typing import Protocol
 
 import serial
 
+from appmode.errors import AppmodeError
 from appmode.line.pacing import Ahead
-from appmode.ports.urls import new_pty, open_link
+from appmode.ports.urls import LinkLeft, new_pty, open_link
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.session_end import SessionEnd
 
@@ -44,21 +47,61 @@ def _read(port: Stream) -> bytes:
     return port.read(max(1, port.in_waiting))
 
 
-def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
-    """Forward until interrupted, recording both directions."""
-    app: Stream
+ADVERTISE = "advertise"
+"""The app side that is appmode advertised as a Bluetooth module (`advertise:NAME`)."""
+ADVERTISED_NAME = "HC-08"
+
+
+def _app_side(app_url: str, nus: bool, quiet: bool) -> Stream:
+    """The app's side, open; its address printed as `port: …` when tap made it."""
     if app_url == "pty":
         pty_port = new_pty()
-        app = pty_port
         print(f"port: {pty_port.path}", flush=True)
-    else:
-        app = open_link(app_url, timeout=READ_TIMEOUT)
+        return pty_port
+    word, _, name = app_url.partition(":")
+    if word != ADVERTISE:
+        link: Stream = open_link(app_url, timeout=READ_TIMEOUT)
+        return link
+    from appmode.bluetooth.availability import unsupported
+
+    if (why := unsupported()) is not None:
+        raise AppmodeError(f"tap {app_url}: {why}")
+    try:
+        from appmode.bluetooth.advertised_port import AdvertisedPort
+        from appmode.bluetooth.uuids import UART_SERVICES
+    except ImportError:
+        raise AppmodeError(
+            f"tap {app_url} needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+        ) from None
+
+    def log(text: str) -> None:
+        if not quiet:
+            print(f"tap: {text}", file=sys.stderr, flush=True)
+
+    name = name or ADVERTISED_NAME
+    port = AdvertisedPort(name, UART_SERVICES[1 if nus else 0], log, READ_TIMEOUT)
+    print(f"port: ble://{name}", flush=True)
+    return port
+
+
+def run_tap(app_url: str, board_url: str, record: str, quiet: bool, nus: bool = False) -> int:
+    """Forward until interrupted or a side leaves, recording both directions."""
+    if nus and not app_url.startswith(ADVERTISE):
+        raise AppmodeError("--nus is for an advertised app side: tap advertise[:NAME] …")
+    app = _app_side(app_url, nus, quiet)
     try:
         board = open_link(board_url, timeout=READ_TIMEOUT)
     except BaseException:
         app.close()
         raise
-    tap = Tap(app, board, Recorder.create(record))
+    try:
+        recorder = Recorder.create(record)
+    except BaseException:
+        board.close()
+        app.close()
+        raise
+    recorder.note(f"tap: {app_url} <-> {board_url}", 0.0)
+    tap = Tap(app, board, recorder)
     if not quiet:
         print(
             f"tap: {app_url} <-> {board_url}, recording to {record} (Ctrl-C to stop)",
@@ -71,6 +114,8 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool) -> int:
         print(
             f"tap: {counts['>']} bytes app->board, {counts['<']} bytes board->app", file=sys.stderr
         )
+    if tap.left and not quiet:
+        print(f"tap: {tap.left}; the board got Z", file=sys.stderr)
     for error in tap.errors:
         print(f"tap: stopped: {error}", file=sys.stderr)
     return 1 if tap.errors else 0
@@ -84,6 +129,8 @@ class Tap:
         self.app, self.board, self.recorder = app, board, recorder
         self.counts = {">": 0, "<": 0}
         self.errors: list[str] = []
+        self.left = ""
+        """Which side left, and why (a phone that disconnected: not an error)."""
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._origin = time.monotonic()
@@ -149,7 +196,14 @@ class Tap:
                         if direction == ">":
                             self._end.sent(chunk)
                         self.recorder(direction, time.monotonic() - self._origin, chunk)
-        except Exception as exc:  # a lost port, a failed recording: end the tap, say why
+        except Exception as exc:  # a side left, a failed recording: end the tap, say why
             name = "app side" if direction == ">" else "board side"
-            self.errors.append(f"{name}: {exc}")
+            if not isinstance(exc, AppmodeError):  # a side's end: the transcript says it
+                with self._lock, contextlib.suppress(AppmodeError):
+                    when = time.monotonic() - self._origin
+                    self.recorder.note(f"the {name} left at {when:.3f} s: {exc}", when)
+            if isinstance(exc, LinkLeft):
+                self.left = f"the {name} left: {exc}"
+            else:
+                self.errors.append(f"{name}: {exc}")
             stop.set()

@@ -43,6 +43,27 @@ def test_recorder_writes_one_unit_a_line_and_escapes_bytes() -> None:
     ]
 
 
+def test_a_note_is_a_comment_in_time_order_after_the_units_before_it() -> None:
+    out = io.StringIO()
+    recorder = Recorder(out)
+    recorder.note("tap: pty <-> sim://", 0.0)
+    recorder(">", 0.1, b"A{1:")  # a frame open when the note comes: it waits for its end
+    recorder.note("the app side\nleft", 0.2)  # one line, whatever it is given
+    recorder(">", 0.3, b"}Z")
+    recorder.close()
+    assert out.getvalue().splitlines() == [
+        HEADER,
+        "# tap: pty <-> sim://",
+        "0.1000 > A",
+        "0.1000 > {1:}",
+        "# the app side left",
+        "0.3000 > Z",
+    ]
+    transcript = parse_transcript(out.getvalue())
+    assert transcript.title == "tap: pty <-> sim://"
+    assert b"".join(e.data for e in transcript.entries) == b"A{1:}Z"
+
+
 def test_concatenated_payloads_give_back_the_exact_bytes() -> None:
     stream = bytes(range(256)) + b"{A1:2:3:0}${C1:2}$"
     out = io.StringIO()

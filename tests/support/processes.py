@@ -57,10 +57,12 @@ class BoardProcess:
         self.url = self._read_port_line()
         self.uart2 = self._read_uart2_line()
         self.details: dict[str, str] = {}
-        """With --bluetooth: the stand-in's `bus`, `ble` and `spp` lines."""
-        if "--bluetooth" in args:
+        """With --bluetooth: the stand-in's `bus`, `ble` and `spp` lines; with
+        --advertise: the `ble` and `spp` lines."""
+        lines = 3 if "--bluetooth" in args else 2 if "--advertise" in args else 0
+        if lines:
             assert self.proc.stdout is not None
-            for _ in range(3):
+            for _ in range(lines):
                 name, _, value = self.proc.stdout.readline().strip().partition(": ")
                 self.details[name] = value
 

@@ -7,6 +7,7 @@ import io
 import json
 import os
 import pty
+import re
 import select
 import signal
 import subprocess
@@ -20,7 +21,7 @@ import serial
 
 from appmode.protocol.transcript import parse_transcript, read_transcript
 from appmode.transcript.replay import EARLY, plan, play
-from tests.support.processes import ROOT, board_process, run
+from tests.support.processes import ROOT, board_process, run, wait_for
 
 SESSION = """# appmode transcript v1
 # a short session
@@ -179,6 +180,27 @@ def test_tap_forwards_and_records_both_ways(tmp_path: Path) -> None:
         if " > " in line
     ]
     assert board_sent[-1] == "Z"
+
+
+def test_tap_says_in_the_transcript_which_side_left(tmp_path: Path) -> None:
+    record = tmp_path / "tap.transcript"
+    with board_process("--listen", "0", "--quiet") as board:
+        tap = subprocess.Popen(
+            [sys.executable, "-m", "appmode", "tap", "pty", board.url, "--record", str(record)],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert tap.stdout is not None
+        tap.stdout.readline()
+        wait_for(lambda: record.exists() and " < {A" in record.read_text())
+        board.stop()  # the car's side goes away
+        _, err = tap.communicate(timeout=10)
+    assert tap.returncode == 1 and "tap: stopped: board side:" in err
+    transcript = read_transcript(record)
+    assert transcript.title == f"tap: pty <-> {board.url}"
+    assert re.search(r"^# the board side left at \d+\.\d{3} s: ", record.read_text(), re.M)
 
 
 def test_dump_text_json_csv(tmp_path: Path) -> None:

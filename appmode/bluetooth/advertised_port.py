@@ -1,0 +1,83 @@
+"""The phone's side of `appmode tap` over the air: appmode advertised as the car's module,
+read and written as a port. What the phone writes is read here; what is written here is
+notified to it. When the phone leaves, a read says so (`LinkLeft`): the tap ends."""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+
+from appmode.bluetooth.loop import LoopThread
+from appmode.bluetooth.peripheral import AdvertisedModule, Log
+from appmode.bluetooth.uuids import UartService
+from appmode.ports.urls import BAUD, LinkLeft
+
+START = 10.0
+"""Seconds BlueZ may take to register the module."""
+RECEIVE_BUFFER = 65536
+"""Bytes kept unread at most (the phone writes at the module's 960 bytes/s)."""
+
+
+class AdvertisedPort:
+    """A module named `name` offering `service`, until closed."""
+
+    baudrate = BAUD
+    """The module's UART rate, which the tap paces the phone's bytes at."""
+
+    def __init__(self, name: str, service: UartService, log: Log, timeout: float) -> None:
+        self._timeout = timeout
+        self._received = bytearray()
+        self._ready = threading.Condition()
+        self._left: str | None = None
+        self._runner = LoopThread("advertised module")
+        self.module = AdvertisedModule(name, service, log, self._got, left=self._gone)
+        try:
+            self._runner.run(self.module.start(), START)
+        except BaseException:
+            self.close()
+            raise
+
+    def _got(self, data: bytes) -> None:
+        with self._ready:
+            self._received += data
+            if len(self._received) > RECEIVE_BUFFER:  # nobody reads: the oldest go
+                del self._received[: len(self._received) - RECEIVE_BUFFER]
+            self._ready.notify_all()
+
+    def _gone(self, why: str) -> None:
+        with self._ready:
+            self._left = why
+            self._ready.notify_all()
+
+    @property
+    def in_waiting(self) -> int:
+        return len(self._received)
+
+    def read(self, size: int = 1) -> bytes:
+        """What the phone wrote (at most `size` bytes), waiting at most the timeout;
+        once the phone has left and all it wrote was read, LinkLeft."""
+        deadline = time.monotonic() + self._timeout
+        with self._ready:
+            while not self._received:
+                if self._left is not None:
+                    raise LinkLeft(self._left)
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return b""
+                self._ready.wait(left)
+            data = bytes(self._received[:size])
+            del self._received[:size]
+        return data
+
+    def write(self, data: bytes) -> int:
+        """To the phone, as the module's notifications (or its SPP link)."""
+        self._runner.loop.call_soon_threadsafe(self.module.send, bytes(data))
+        return len(data)
+
+    def close(self) -> None:
+        """Unregister the module and stop its loop."""
+        if not self._runner.loop.is_closed():
+            with contextlib.suppress(TimeoutError):
+                self._runner.run(self.module.stop(), 3.0)
+            self._runner.close()
