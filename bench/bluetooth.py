@@ -78,14 +78,14 @@ def echo_board(bus: Connection, trials: int) -> None:
     standin = endpoint.standin
     marks: dict[str, float] = {}
 
-    def timed(name: str, call: Callable[[bytes], None]) -> Callable[[bytes], None]:
-        def wrapper(data: bytes) -> None:
+    def timed(name: str, call: Callable[..., None]) -> Callable[..., None]:
+        def wrapper(*args: object) -> None:
             marks[name] = time.monotonic()
-            call(data)
+            call(*args)
 
         return wrapper
 
-    standin.characteristic.notify = timed(  # type: ignore[method-assign, assignment]
+    standin.characteristic.notify = timed(  # type: ignore[method-assign]
         "notified", standin.characteristic.notify
     )
     standin.characteristic._received = timed("written", standin.characteristic._received)

@@ -47,7 +47,7 @@ class AdvertisedPort:
 
     def _gone(self, why: str) -> None:
         with self._ready:
-            self._left = why
+            self._left = self._left or why  # the first reason heard
             self._ready.notify_all()
 
     @property

@@ -62,7 +62,8 @@ class GattService(Service):
 
 
 class Characteristic(ServiceInterface):
-    """A UART characteristic: writes go to `received`; `subscribed` hears StartNotify
+    """A UART characteristic: writes go to `received`, with the object path of the device
+    that wrote ("" when BlueZ does not say); `subscribed` hears StartNotify
     (True) and StopNotify (False); `notify` sends a notification to a subscribed central
     (a PropertiesChanged of Value, as BlueZ relays one)."""
 
@@ -70,7 +71,7 @@ class Characteristic(ServiceInterface):
         self,
         uuid: str,
         service: str,
-        received: Callable[[bytes], None],
+        received: Callable[[bytes, str], None],
         subscribed: Callable[[bool], None] = lambda on: None,
     ) -> None:
         super().__init__("org.bluez.GattCharacteristic1")
@@ -108,7 +109,7 @@ class Characteristic(ServiceInterface):
         offset = options.get("offset", Variant("q", 0)).value
         if offset:
             raise DBusError("org.bluez.Error.InvalidOffset", "a module takes no offset")
-        self._received(bytes(value))
+        self._received(bytes(value), str(options.get("device", Variant("o", "/")).value))
 
     @dbus_method()
     def StartNotify(self) -> Nothing:
@@ -140,7 +141,7 @@ class UartCharacteristic(Characteristic):
         uuid: str,
         service: str,
         handle: int,
-        received: Callable[[bytes], None],
+        received: Callable[[bytes, str], None],
         subscribed: Callable[[bool], None] = lambda on: None,
     ) -> None:
         super().__init__(uuid, service, received, subscribed)

@@ -28,8 +28,10 @@ from appmode.bluetooth.spp_links import SppLinks
 from appmode.bluetooth.uuids import SPP
 
 Log = Callable[[str], None]
-CENTRAL = device_path("02:CA:40:00:00:01")
-"""The central as the application's BlueZ names it: the stand-in's own adapter."""
+CENTRAL_ADDRESS = "02:CA:40:00:00:01"
+CENTRAL = device_path(CENTRAL_ADDRESS)
+"""The central as the application's BlueZ shows it (a Device1, connected while it has
+a link): the stand-in's own adapter."""
 CHARACTERISTIC = "org.bluez.GattCharacteristic1"
 INVALID = "org.bluez.Error.InvalidArguments"
 READ = 4096
@@ -43,9 +45,11 @@ class Peers:
         self._radio, self._log, self._discovering = radio, log, discovering
         self._bus: MessageBus | None = None
         self._peers: dict[str, Peer] = {}
-        self.spp_links = SppLinks(log)
+        self.spp_links = SppLinks(log, self._central_changed)
+        self._central = Device(_CentralRadio(self), CENTRAL_ADDRESS, "appmode-standin", [], le=True)
         self._centrals: dict[str, set[Device]] = {}
         self._watched: set[str] = set()
+        self._exported: set[str] = set()
         """The peer devices each central connected, by its bus name."""
         self._tasks: set[asyncio.Task[None]] = set()
         self.advertising = AdvertisingManager(lambda: sum(1 for p in self.all() if p.advertisement))
@@ -314,6 +318,7 @@ class Peers:
             self._resolve(peer, device)
         device.set_state(True)
         self._log(f"ble: {device.label} connected")
+        self._central_changed()
 
     def _resolve(self, peer: Peer, device: Device) -> None:
         handles = count(0x10)
@@ -344,9 +349,27 @@ class Peers:
         if device.connected:
             device.set_state(False)
             self._log(f"ble: {device.label} disconnected")
+        self._central_changed()
 
-    def _write(self, peer: Peer, path: str, data: bytes) -> None:
-        """A central's write, forwarded in order (write without response: no wait)."""
+    def _central_changed(self) -> None:
+        """The central's device, as the applications' BlueZ shows it: connected while
+        any of its links to them is up."""
+        linked = [d for p in self._peers.values() for d in (p.ble, p.spp) if d and d.connected]
+        if linked and self._bus is not None and self._central.path not in self._exported:
+            self._bus.export(self._central.path, self._central)
+            self._exported.add(self._central.path)
+        self._central.set_state(bool(linked))
+
+    def drop_central(self) -> None:
+        """An application disconnected the central: every link it has ends."""
+        for peer in self.all():
+            for device in (peer.ble, peer.spp):
+                if device is not None and device.connected:
+                    self._radio.disconnect(device)
+
+    def _write(self, peer: Peer, path: str, data: bytes, _: str) -> None:
+        """A central's write, forwarded in order (write without response: no wait); the
+        application hears it from the central's device."""
         options = {
             "device": Variant("o", CENTRAL),
             "link": Variant("s", "LE"),
@@ -395,6 +418,19 @@ class Peers:
         for task in list(self._tasks):
             task.cancel()
         self.spp_links.close()
+
+
+class _CentralRadio:
+    """What the central's device does when an application calls it."""
+
+    def __init__(self, peers: Peers) -> None:
+        self._peers = peers
+
+    async def connect(self, device: Device, uuid: str | None) -> None:
+        raise DBusError("org.bluez.Error.NotSupported", "the central connects, not the module")
+
+    def disconnect(self, device: Device) -> None:
+        self._peers.drop_central()
 
 
 def _address() -> str:

@@ -35,6 +35,7 @@ from appmode.errors import AppmodeError
 
 Log = Callable[[str], None]
 BLUEZ = "org.bluez"
+NOT_PERMITTED = "org.bluez.Error.NotPermitted"
 ROOT = "/org/appmode/module"
 """Where the application's objects are exported (one module per process)."""
 READ = 4096
@@ -89,8 +90,8 @@ class SerialServer(ServiceInterface):
 
 class AdvertisedModule:
     """The module a phone connects to. `received` gets the bytes the phone sends (after
-    the module's input buffer), `joined` and `left` each link's start and end; `send` is
-    what the board sends. Runs on the event loop that calls `start`."""
+    the module's input buffer), `left` each link's end; `send` is what the board sends.
+    Runs on the event loop that calls `start`."""
 
     def __init__(
         self,
@@ -98,12 +99,12 @@ class AdvertisedModule:
         service: UartService,
         log: Log,
         received: Callable[[bytes], None],
-        joined: Callable[[str], None] = lambda how: None,
         left: Callable[[str], None] = lambda why: None,
     ) -> None:
         self.name, self.service = name, service
-        self._log, self._received = log, received
-        self._joined, self._left = joined, left
+        self._log, self._received, self._left = log, received, left
+        self._holder = ""
+        """The device of the phone that holds the BLE link (one at a time, as a module)."""
         self._bus: MessageBus | None = None
         self.adapter = ""
         self._model = ModuleModel()
@@ -131,6 +132,7 @@ class AdvertisedModule:
         except Exception as exc:
             raise AppmodeError(explain(exc) or f"cannot reach BlueZ: {exc}") from None
         self._bus = bus
+        bus.add_message_handler(self._device_changed)
         self.adapter = await self._find_adapter()
         for path, interface in self._objects:
             bus.export(path, interface)
@@ -232,17 +234,61 @@ class AdvertisedModule:
 
     # ------------------------------------------------------------ BLE
 
-    def _from_ble(self, data: bytes) -> None:
+    def _from_ble(self, data: bytes, device: str) -> None:
+        """A phone's write. The first phone to write holds the module until it leaves;
+        another's writes are refused (a module takes one link)."""
+        if device != "/" and device != self._holder:
+            if self._holder:
+                raise DBusError(NOT_PERMITTED, "the module is held by another phone")
+            self._holder = device
+            self._log(f"ble: held by {device}")
+            self._spawn(self._watch(device))
         self._received(self._model.from_radio(data, time.monotonic()))
+
+    async def _watch(self, device: str) -> None:
+        """Hear BlueZ say the holder's device is no longer connected."""
+        assert self._bus is not None
+        rule = (
+            f"type='signal',sender='{BLUEZ}',interface='org.freedesktop.DBus.Properties',"
+            f"member='PropertiesChanged',path='{device}'"
+        )
+        await self._bus.call(
+            Message(
+                destination="org.freedesktop.DBus",
+                path="/org/freedesktop/DBus",
+                interface="org.freedesktop.DBus",
+                member="AddMatch",
+                signature="s",
+                body=[rule],
+            )
+        )
+
+    def _device_changed(self, message: Message) -> bool:
+        """The holder's device disconnected (a phone that wrote and never subscribed
+        leaves so too)."""
+        if (
+            message.message_type == MessageType.SIGNAL
+            and message.member == "PropertiesChanged"
+            and message.path == self._holder
+            and message.signature == "sa{sv}as"
+            and message.body[0] == "org.bluez.Device1"
+            and message.body[1].get("Connected", Variant("b", True)).value is False
+        ):
+            self._end_ble("the phone disconnected")
+        return False
 
     def _subscribed(self, on: bool) -> None:
         if on:
             self._model = ModuleModel()
             self._log("ble: a phone subscribed to the module's notifications")
-            self._joined("ble")
         else:  # BlueZ stops the notifications when the central that asked leaves
-            self._log("ble: the phone unsubscribed or left")
-            self._left("the phone left the BLE link")
+            self._end_ble("the phone unsubscribed or left")
+
+    def _end_ble(self, why: str) -> None:
+        """The BLE link's end: the next phone may hold the module."""
+        self._holder = ""
+        self._log(f"ble: {why}")
+        self._left(f"the phone left the BLE link ({why})")
 
     def _released(self) -> None:
         self._log("BlueZ released the advertisement: the module is no longer heard")
@@ -265,7 +311,6 @@ class AdvertisedModule:
         link.setblocking(False)
         self._spp, self._spp_model = link, ModuleModel()
         self._log(f"spp: a phone connected ({device})")
-        self._joined("spp")
         self._spawn(self._from_spp(link))
 
     def _spp_ended(self, why: str) -> None:

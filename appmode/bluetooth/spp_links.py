@@ -45,10 +45,11 @@ async def new_connection(bus: MessageBus, profile: tuple[str, str], device: str)
 
 
 class SppLinks:
-    """The SPP links between centrals and servers on the bus, one per device."""
+    """The SPP links between centrals and servers on the bus, one per device; `changed`
+    is called when one starts or ends."""
 
-    def __init__(self, log: Log) -> None:
-        self._log = log
+    def __init__(self, log: Log, changed: Callable[[], None]) -> None:
+        self._log, self._changed = log, changed
         self._links: dict[str, _Link] = {}
 
     async def connect(
@@ -71,6 +72,7 @@ class SppLinks:
         link = self._links[device.path] = _Link((to_client, to_server))
         device.set_state(True)
         self._log(f"spp: {device.label} connected")
+        self._changed()
         for source, sink in ((to_client, to_server), (to_server, to_client)):
             link.carriers.append(asyncio.ensure_future(self._carry(source, sink, device)))
 
@@ -94,6 +96,7 @@ class SppLinks:
         if device.connected:
             device.set_state(False)
             self._log(f"spp: {device.label} disconnected")
+            self._changed()
 
     def close(self) -> None:
         for link in self._links.values():

@@ -286,7 +286,7 @@ class StandIn:
 
     # ------------------------------------------------------------ bytes
 
-    def _from_central(self, data: bytes) -> None:
+    def _from_central(self, data: bytes, device: str) -> None:
         """A central's write: it reaches the module at the next connection event."""
         if self.ble.connected:
             self._writes.append(data)

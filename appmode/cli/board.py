@@ -95,6 +95,7 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         "--advertise",
         nargs="?",
         const=ADVERTISED_NAME,
+        type=_advertised_name,
         metavar="NAME",
         help=f"serve as a Bluetooth module on this machine's adapter, for a phone (the "
         f"vendor's app) to connect to: advertised on BLE as NAME (default {ADVERTISED_NAME}) "
@@ -188,6 +189,14 @@ def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
         service = UART_SERVICES[1 if args.nus else 0]
         return partial(endpoint, name=args.advertise, service=service, baud=args.baud)
     return partial(endpoints.PtyEndpoint, link=args.link, baud=args.baud)
+
+
+def _advertised_name(text: str) -> str:
+    from appmode.bluetooth.addresses import name_problem
+
+    if (why := name_problem(text)) is not None:
+        raise argparse.ArgumentTypeError(why)
+    return text
 
 
 def _bluetooth(option: str) -> ModuleType:

@@ -62,9 +62,11 @@ def _app_side(app_url: str, nus: bool, quiet: bool) -> Stream:
     if word != ADVERTISE:
         link: Stream = open_link(app_url, timeout=READ_TIMEOUT)
         return link
+    from appmode.bluetooth.addresses import name_problem
     from appmode.bluetooth.availability import unsupported
 
-    if (why := unsupported()) is not None:
+    name = name or ADVERTISED_NAME
+    if (why := name_problem(name) or unsupported()) is not None:
         raise AppmodeError(f"tap {app_url}: {why}")
     try:
         from appmode.bluetooth.advertised_port import AdvertisedPort
@@ -78,7 +80,6 @@ def _app_side(app_url: str, nus: bool, quiet: bool) -> Stream:
         if not quiet:
             print(f"tap: {text}", file=sys.stderr, flush=True)
 
-    name = name or ADVERTISED_NAME
     port = AdvertisedPort(name, UART_SERVICES[1 if nus else 0], log, READ_TIMEOUT)
     print(f"port: ble://{name}", flush=True)
     return port

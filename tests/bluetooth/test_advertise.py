@@ -5,6 +5,7 @@ appmode stands in for the phone's app. Judged on the boards' recordings."""
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import re
@@ -168,7 +169,7 @@ def test_tap_records_the_phone_and_the_car_and_stops_the_car_when_the_phone_vani
             tap.kill()
             tap.communicate()
     assert tap.returncode == 0, err
-    assert "the app side left: the phone left the BLE link; the board got Z" in err
+    assert re.search(r"the app side left: the phone left the BLE link \(.*\); the board got Z", err)
     # the transcript: both directions, who left, the stop last
     transcript = read_transcript(record)
     assert transcript.title == f"tap: advertise:{NAME} <-> {appmode_ble_board.ble}"
@@ -242,3 +243,103 @@ def test_elsewhere_than_linux_advertising_is_refused_in_a_line(
     monkeypatch.setattr(os, "name", "nt" if platform == "win32" else "posix")
     why = unsupported()
     assert why is not None and named in why and "Linux" in why and "\n" not in why
+
+
+MUTE_PHONE = textwrap.dedent(
+    f"""
+    import asyncio
+    from bleak import BleakClient, BleakScanner
+
+    async def main():
+        device = await BleakScanner.find_device_by_name("{NAME}", timeout=10)
+        async with BleakClient(device) as client:  # writes, never subscribes
+            await client.write_gatt_char("0000ffe1-0000-1000-8000-00805f9b34fb", b"JA",
+                                         response=False)
+            await asyncio.sleep(0.5)
+
+    asyncio.run(main())
+    """
+)
+
+
+def test_tap_sees_a_phone_that_never_subscribed_leave_and_stops_the_car(
+    appmode_ble_board: ServedBoard, tmp_path: Path
+) -> None:
+    record = tmp_path / "tap.transcript"
+    script = tmp_path / "mute.py"
+    script.write_text(MUTE_PHONE)
+    assert appmode_ble_board.ble is not None
+    tap = subprocess.Popen(
+        appmode_cmd("tap", f"advertise:{NAME}", appmode_ble_board.ble, "--record", str(record)),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert tap.stdout is not None
+        tap.stdout.readline()
+        done = subprocess.run(
+            [sys.executable, str(script)], capture_output=True, text=True, timeout=60, check=False
+        )
+        assert done.returncode == 0, done.stderr
+        _, err = tap.communicate(timeout=20)
+    finally:
+        if tap.poll() is None:
+            tap.kill()
+            tap.communicate()
+    assert tap.returncode == 0, err
+    assert "the app side left: the phone left the BLE link (the phone disconnected)" in err
+    assert sent_lines(record) == ["J", "A", "Z"]
+    assert car_heard(appmode_ble_board) == ["J", "A", "Z"]
+    appmode_ble_board.wait_until(lambda s: not s.moving, what="a stop")
+
+
+def test_the_advertised_module_takes_one_phone_at_a_time(
+    appmode_ble_board: ServedBoard, tmp_path: Path
+) -> None:
+    from dbus_fast import Message, MessageType, Variant
+    from dbus_fast.aio import MessageBus
+
+    record = tmp_path / "advertised.transcript"
+
+    async def write(bus: MessageBus, owner: str, device: str, data: bytes) -> Message:
+        reply = await bus.call(
+            Message(
+                destination=owner,
+                path="/org/appmode/module/service0/char0",
+                interface="org.bluez.GattCharacteristic1",
+                member="WriteValue",
+                signature="aya{sv}",
+                body=[data, {"device": Variant("o", device)}],
+            )
+        )
+        assert reply is not None
+        return reply
+
+    async def two_phones() -> tuple[Message, Message]:
+        bus = await MessageBus(bus_address=appmode_ble_board.bus).connect()
+        owner = next(
+            line.rsplit(" ", 1)[1] for line in appmode_ble_board.log if "advertised by" in line
+        )
+        first = await write(bus, owner, "/org/bluez/hci0/dev_02_00_00_00_00_0A", b"A")
+        second = await write(bus, owner, "/org/bluez/hci0/dev_02_00_00_00_00_0B", b"B")
+        bus.disconnect()
+        return first, second
+
+    with board_process("--advertise", NAME, "--record", str(record)) as board:
+        wait_for(lambda: any("advertised by" in line for line in appmode_ble_board.log))
+        first, second = asyncio.run(two_phones())
+        wait_for(lambda: sent_lines(record) == ["A"])
+        err = board.stop()
+    assert first.message_type == MessageType.METHOD_RETURN
+    assert second.message_type == MessageType.ERROR
+    assert second.error_name == "org.bluez.Error.NotPermitted"
+    assert "held by /org/bluez/hci0/dev_02_00_00_00_00_0A" in err
+
+
+def test_an_advertised_name_must_fit_an_advertisement(tmp_path: Path) -> None:
+    done = run("board", "--advertise", "a-name-too-long-to-advertise")
+    assert done.returncode == 2 and "an advertised name fits 20 at most" in done.stderr
+    done = run("tap", "advertise:bad\tname", "sim://", "--record", str(tmp_path / "t"))
+    assert done.returncode == 2 and "is not a name to advertise" in done.stderr
+    assert not (tmp_path / "t").exists()
