@@ -50,6 +50,11 @@ NOT_RUN = {
     "appmode params ble://HC-08": "needs the stand-in above: tests/bluetooth runs it",
     "printf 'drive A\\nwait 1\\n' | appmode drive bt://02:CA:40:00:00:05": "needs the "
     "stand-in above: tests/bluetooth runs it",
+    "appmode board --advertise": "registers with this machine's BlueZ, which has no adapter "
+    "here: tests/bluetooth/test_advertise.py runs it against the stand-in",
+    "appmode tap advertise:HC-08 ble://AA:BB:CC:DD:EE:FF --record phone.transcript": "a phone "
+    "and a real car: tests/bluetooth/test_advertise.py taps a bleak program and a second "
+    "simulated car",
 }
 """Examples not run here, and why."""
 

@@ -36,7 +36,11 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "web": ("appmode web", "appmode web /dev/rfcomm0 --listen 0.0.0.0:8080"),
     "demo": ("appmode demo", "appmode demo --profile minibalance"),
     "decode": ("appmode decode capture.bin", "appmode decode --from host < sent.bin"),
-    "board": ("appmode board --pty", "appmode board --listen 5000 --profile minibalance"),
+    "board": (
+        "appmode board --pty",
+        "appmode board --listen 5000 --profile minibalance",
+        "appmode board --advertise HC-08",
+    ),
     "send": ("appmode send sim:// J A wait:1", "appmode send /dev/ttyUSB0 '{Q:P}' --json"),
     "params": (
         "appmode params sim://",
