@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import contextlib
 import threading
-import time
 
+from appmode.bluetooth.inbox import Inbox
 from appmode.bluetooth.loop import LoopThread
 from appmode.bluetooth.peripheral import AdvertisedModule, Log
 from appmode.bluetooth.uuids import UartService
@@ -15,8 +15,6 @@ from appmode.ports.urls import BAUD, LinkLeft
 
 START = 10.0
 """Seconds BlueZ may take to register the module."""
-RECEIVE_BUFFER = 65536
-"""Bytes kept unread at most (the phone writes at the module's 960 bytes/s)."""
 
 
 class AdvertisedPort:
@@ -27,23 +25,16 @@ class AdvertisedPort:
 
     def __init__(self, name: str, service: UartService, log: Log, timeout: float) -> None:
         self._timeout = timeout
-        self._received = bytearray()
         self._ready = threading.Condition()
+        self._received = Inbox(self._ready)
         self._left: str | None = None
         self._runner = LoopThread("advertised module")
-        self.module = AdvertisedModule(name, service, log, self._got, left=self._gone)
+        self.module = AdvertisedModule(name, service, log, self._received.add, left=self._gone)
         try:
             self._runner.run(self.module.start(), START)
         except BaseException:
             self.close()
             raise
-
-    def _got(self, data: bytes) -> None:
-        with self._ready:
-            self._received += data
-            if len(self._received) > RECEIVE_BUFFER:  # nobody reads: the oldest go
-                del self._received[: len(self._received) - RECEIVE_BUFFER]
-            self._ready.notify_all()
 
     def _gone(self, why: str) -> None:
         with self._ready:
@@ -57,18 +48,11 @@ class AdvertisedPort:
     def read(self, size: int = 1) -> bytes:
         """What the phone wrote (at most `size` bytes), waiting at most the timeout;
         once the phone has left and all it wrote was read, LinkLeft."""
-        deadline = time.monotonic() + self._timeout
-        with self._ready:
-            while not self._received:
-                if self._left is not None:
-                    raise LinkLeft(self._left)
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    return b""
-                self._ready.wait(left)
-            data = bytes(self._received[:size])
-            del self._received[:size]
-        return data
+        return self._received.read(size, self._timeout, self._check)
+
+    def _check(self) -> None:
+        if self._left is not None:
+            raise LinkLeft(self._left)
 
     def write(self, data: bytes) -> int:
         """To the phone, as the module's notifications (or its SPP link)."""

@@ -23,6 +23,7 @@ from serial import SerialBase, SerialException, SerialTimeoutException
 
 from appmode.bluetooth.addresses import BadAddress, BleTarget, parse_ble
 from appmode.bluetooth.availability import NO_BLEAK, explain
+from appmode.bluetooth.inbox import Inbox
 from appmode.bluetooth.loop import LoopThread
 from appmode.bluetooth.module import PAYLOAD
 from appmode.bluetooth.uuids import UART_SERVICES, UartService, uart_service
@@ -39,8 +40,6 @@ WRITE_BUFFER = 4096
 """Bytes `write` may queue ahead of the radio; past them it waits (its write_timeout)."""
 AHEAD = PAYLOAD
 """Bytes the writer lets the module's buffer hold beyond what its UART has sent."""
-RECEIVE_BUFFER = 65536
-"""Bytes notified and not yet read that the port keeps (about a minute of records)."""
 CLOSE = 3.0
 LINGER = 0.05
 """Seconds between the last write and hanging up: a few connection events, so that
@@ -64,8 +63,8 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
             raise SerialException(NO_BLEAK) from None
         logging.getLogger("bleak.backends.bluezdbus.version").setLevel(logging.ERROR)
         self._target = target
-        self._received = bytearray()
         self._ready = threading.Condition()
+        self._received = Inbox(self._ready)
         self._lost: str | None = None
         self._queued = 0
         self._runner = LoopThread(f"ble {target.shown}")
@@ -114,11 +113,7 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
         self._writer = asyncio.ensure_future(self._write_loop(client, write))
 
     def _notified(self, _: Any, data: bytearray) -> None:
-        with self._ready:
-            self._received += data
-            if len(self._received) > RECEIVE_BUFFER:  # nobody reads: the oldest go, as
-                del self._received[: len(self._received) - RECEIVE_BUFFER]  # an OS's do
-            self._ready.notify_all()
+        self._received.add(data)
 
     def _disconnected(self, _: Any) -> None:
         with self._ready:
@@ -164,17 +159,7 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
         return len(self._received)
 
     def read(self, size: int = 1) -> bytes:
-        deadline = None if self._timeout is None else time.monotonic() + self._timeout
-        with self._ready:
-            while not self._received:
-                self._check()
-                left = None if deadline is None else deadline - time.monotonic()
-                if left is not None and left <= 0:
-                    return b""
-                self._ready.wait(left)
-            data = bytes(self._received[:size])
-            del self._received[:size]
-        return data
+        return self._received.read(size, self._timeout, self._check)
 
     def write(self, data: bytes) -> int:
         self._check()
@@ -202,8 +187,7 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
                 self._ready.wait(0.1)
 
     def reset_input_buffer(self) -> None:
-        with self._ready:
-            self._received.clear()
+        self._received.clear()
 
     def close(self) -> None:
         """What was written goes first (a session's stop is its last write), then the

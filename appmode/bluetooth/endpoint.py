@@ -16,6 +16,7 @@ from collections.abc import Callable, Coroutine
 
 from appmode.bluetooth.bus import PrivateBus
 from appmode.bluetooth.peripheral import AdvertisedModule
+from appmode.bluetooth.spp_links import chunks
 from appmode.bluetooth.standin import BLE_ADDRESS, BLE_NAME, SPP_ADDRESS, StandIn
 from appmode.bluetooth.uuids import UartService
 from appmode.errors import AppmodeError
@@ -23,7 +24,6 @@ from appmode.ports.endpoints import Log, Overrun
 
 START = 10.0
 """Seconds the loop's service may take to be on its bus."""
-READ = 4096
 Serve = Callable[[asyncio.Event, Callable[[], None]], Coroutine[object, object, None]]
 """Serves until the event is set; calls the function once it is ready."""
 
@@ -145,7 +145,6 @@ class AdvertisedEndpoint(LoopEndpoint):
             self.board.send(data)
 
     async def _serve(self, stop: asyncio.Event, ready: Callable[[], None]) -> None:
-        loop = asyncio.get_running_loop()
         self.board.setblocking(False)
         try:
             await self.module.start()
@@ -153,13 +152,13 @@ class AdvertisedEndpoint(LoopEndpoint):
             await self.module.stop()
             raise
         ready()
-        pump = asyncio.ensure_future(self._from_board(loop))
+        pump = asyncio.ensure_future(self._from_board())
         try:
             await stop.wait()
         finally:
             pump.cancel()
             await self.module.stop()
 
-    async def _from_board(self, loop: asyncio.AbstractEventLoop) -> None:
-        while data := await loop.sock_recv(self.board, READ):
+    async def _from_board(self) -> None:
+        async for data in chunks(self.board):
             self.module.send(data)

@@ -16,10 +16,11 @@ from functools import partial
 from itertools import count
 from typing import Any
 
-from dbus_fast import DBusError, Message, MessageType, Variant
+from dbus_fast import DBusError, Message, Variant
 from dbus_fast.aio import MessageBus
 from dbus_fast.service import ServiceInterface
 
+from appmode.bluetooth.calls import add_match, call
 from appmode.bluetooth.devices import ADAPTER, Device, Radio, device_path
 from appmode.bluetooth.gatt import Cccd, GattService, UartCharacteristic
 from appmode.bluetooth.module import MTU
@@ -34,7 +35,6 @@ CENTRAL = device_path(CENTRAL_ADDRESS)
 a link): the stand-in's own adapter."""
 CHARACTERISTIC = "org.bluez.GattCharacteristic1"
 INVALID = "org.bluez.Error.InvalidArguments"
-READ = 4096
 _addresses = count(1)
 
 
@@ -163,14 +163,8 @@ class Peers:
             )
 
     async def _add_match(self, rule: str) -> None:
-        await self._ask(
-            "org.freedesktop.DBus",
-            "/org/freedesktop/DBus",
-            "org.freedesktop.DBus",
-            "AddMatch",
-            "s",
-            [rule],
-        )
+        assert self._bus is not None
+        await add_match(self._bus, rule)
 
     async def _ask(
         self,
@@ -183,20 +177,7 @@ class Peers:
     ) -> Any:
         """A call's first return value; DBusError when it fails."""
         assert self._bus is not None
-        reply = await self._bus.call(
-            Message(
-                destination=destination,
-                path=path,
-                interface=interface,
-                member=member,
-                signature=signature,
-                body=body,
-            )
-        )
-        if reply is None or reply.message_type == MessageType.ERROR:
-            name = reply.error_name if reply is not None else "org.bluez.Error.Failed"
-            why = reply.body[0] if reply is not None and reply.body else "no answer"
-            raise DBusError(str(name), f"{member} at {path}: {why}")
+        reply = await call(self._bus, destination, path, interface, member, signature, body)
         return reply.body[0] if reply.body else None
 
     async def _application(self, peer: Peer, path: str) -> None:

@@ -27,18 +27,18 @@ from dbus_fast.constants import PropertyAccess
 from dbus_fast.service import ServiceInterface, dbus_method, dbus_property
 
 from appmode.bluetooth.availability import explain
+from appmode.bluetooth.calls import BLUEZ, add_match, call
 from appmode.bluetooth.gatt import Characteristic, Service
 from appmode.bluetooth.module import CONNECTION_INTERVAL, ModuleModel
 from appmode.bluetooth.signatures import DBusStrings, Nothing
+from appmode.bluetooth.spp_links import chunks
 from appmode.bluetooth.uuids import SPP, UartService
 from appmode.errors import AppmodeError
 
 Log = Callable[[str], None]
-BLUEZ = "org.bluez"
 NOT_PERMITTED = "org.bluez.Error.NotPermitted"
 ROOT = "/org/appmode/module"
 """Where the application's objects are exported (one module per process)."""
-READ = 4096
 
 
 class Advertisement(ServiceInterface):
@@ -182,26 +182,16 @@ class AdvertisedModule:
     async def _call(
         self, path: str, interface: str, member: str, signature: str, body: list[Any]
     ) -> Message:
+        """BlueZ's reply; AppmodeError, in a line, if BlueZ cannot be reached or refuses."""
         assert self._bus is not None
         try:
-            reply = await self._bus.call(
-                Message(
-                    destination=BLUEZ,
-                    path=path,
-                    interface=interface,
-                    member=member,
-                    signature=signature,
-                    body=body,
-                )
-            )
+            return await call(self._bus, BLUEZ, path, interface, member, signature, body)
+        except DBusError as exc:
+            raise AppmodeError(
+                explain(exc) or f"BlueZ refused {member}: {exc.type} {exc.text}"
+            ) from None
         except Exception as exc:
             raise AppmodeError(explain(exc) or f"BlueZ: {member} failed: {exc}") from None
-        if reply is None or reply.message_type == MessageType.ERROR:
-            name = reply.error_name if reply is not None else "no answer"
-            why = reply.body[0] if reply is not None and reply.body else ""
-            explained = explain(DBusError(str(name), str(why)))
-            raise AppmodeError(explained or f"BlueZ refused {member}: {name} {why}".rstrip())
-        return reply
 
     def _spawn(self, work: Any) -> None:
         task = asyncio.ensure_future(work)
@@ -252,16 +242,7 @@ class AdvertisedModule:
             f"type='signal',sender='{BLUEZ}',interface='org.freedesktop.DBus.Properties',"
             f"member='PropertiesChanged',path='{device}'"
         )
-        await self._bus.call(
-            Message(
-                destination="org.freedesktop.DBus",
-                path="/org/freedesktop/DBus",
-                interface="org.freedesktop.DBus",
-                member="AddMatch",
-                signature="s",
-                body=[rule],
-            )
-        )
+        await add_match(self._bus, rule)
 
     def _device_changed(self, message: Message) -> bool:
         """The holder's device disconnected (a phone that wrote and never subscribed
@@ -321,14 +302,7 @@ class AdvertisedModule:
             self._left(f"the phone left the SPP link ({why})")
 
     async def _from_spp(self, link: socket.socket) -> None:
-        loop = asyncio.get_running_loop()
-        while True:
-            try:
-                data = await loop.sock_recv(link, READ)
-            except OSError:
-                data = b""
-            if not data:
-                break
+        async for data in chunks(link):
             self._received(self._spp_model.from_radio(data, time.monotonic()))
         if self._spp is link:
             self._spp_ended("the phone closed the link")

@@ -5,22 +5,23 @@ file descriptor BlueZ hands to NewConnection."""
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import os
 from collections.abc import Callable, Coroutine
 from itertools import count
 from typing import Any
 
-from dbus_fast import BusType, Message, MessageType, Variant
+from dbus_fast import BusType, DBusError, Message, Variant
 from dbus_fast.aio import MessageBus
 from dbus_fast.annotations import DBusDict, DBusObjectPath, DBusUnixFd
 from dbus_fast.service import ServiceInterface, dbus_method
 from serial import SerialException
 
 from appmode.bluetooth.addresses import BtTarget
+from appmode.bluetooth.calls import BLUEZ, call
 from appmode.bluetooth.signatures import Nothing
 from appmode.bluetooth.uuids import SPP
 
-BLUEZ = "org.bluez"
 PAIR = (
     "pair it once (bluetoothctl: scan on, pair {0}, trust {0}; the PIN is usually 1234), then retry"
 )
@@ -61,26 +62,16 @@ async def _call(
     signature: str = "",
     body: list[Any] | None = None,
 ) -> Message:
-    reply = await bus.call(
-        Message(
-            destination=BLUEZ,
-            path=path,
-            interface=interface,
-            member=member,
-            signature=signature,
-            body=body or [],
-        )
-    )
-    assert reply is not None
-    return reply
+    return await call(bus, BLUEZ, path, interface, member, signature, body)
 
 
 async def devices(bus: MessageBus) -> dict[str, dict[str, Variant]]:
     """BlueZ's devices (their org.bluez.Device1 properties) by object path; OSError (with
     the bus's error name) when BlueZ does not answer."""
-    reply = await _call(bus, "/", "org.freedesktop.DBus.ObjectManager", "GetManagedObjects")
-    if reply.message_type == MessageType.ERROR:
-        raise OSError(f"{reply.error_name}: {reply.body[0] if reply.body else ''}")
+    try:
+        reply = await _call(bus, "/", "org.freedesktop.DBus.ObjectManager", "GetManagedObjects")
+    except DBusError as exc:
+        raise OSError(f"{exc.type}: {exc.text}") from None
     return {
         str(path): interfaces["org.bluez.Device1"]
         for path, interfaces in reply.body[0].items()
@@ -108,36 +99,39 @@ async def connect_spp(
     device = ""
 
     async def end() -> None:
-        if device:
-            await _call(bus, device, "org.bluez.Device1", "DisconnectProfile", "s", [SPP])
-        if registered:
-            await _call(
-                bus, "/org/bluez", "org.bluez.ProfileManager1", "UnregisterProfile", "o", [path]
-            )
+        with contextlib.suppress(DBusError):  # already gone: nothing left to end
+            if device:
+                await _call(bus, device, "org.bluez.Device1", "DisconnectProfile", "s", [SPP])
+            if registered:
+                await _call(
+                    bus, "/org/bluez", "org.bluez.ProfileManager1", "UnregisterProfile", "o", [path]
+                )
         bus.disconnect()
 
     try:
         device_path = await _device(bus, target.address)
         bus.export(path, profile)
         options = {"Role": Variant("s", "client"), "Name": Variant("s", "appmode")}
-        reply = await _call(
-            bus,
-            "/org/bluez",
-            "org.bluez.ProfileManager1",
-            "RegisterProfile",
-            "osa{sv}",
-            [path, SPP, options],
-        )
-        if reply.message_type == MessageType.ERROR:
-            raise OSError(f"{reply.error_name}: {reply.body[0] if reply.body else ''}")
+        try:
+            await _call(
+                bus,
+                "/org/bluez",
+                "org.bluez.ProfileManager1",
+                "RegisterProfile",
+                "osa{sv}",
+                [path, SPP, options],
+            )
+        except DBusError as exc:
+            raise OSError(f"{exc.type}: {exc.text}") from None
         registered = True
-        reply = await _call(bus, device_path, "org.bluez.Device1", "ConnectProfile", "s", [SPP])
-        if reply.message_type == MessageType.ERROR:
-            why = reply.body[0] if reply.body else reply.error_name
+        try:
+            await _call(bus, device_path, "org.bluez.Device1", "ConnectProfile", "s", [SPP])
+        except DBusError as exc:
+            why = exc.text or exc.type
             raise SerialException(
                 f"cannot connect to {target.address} ({why}): switch the car on and bring "
                 "it in range; a phone still connected to it keeps it: disconnect the phone"
-            )
+            ) from None
         device = device_path
         fd = await asyncio.wait_for(profile.connection, timeout)
     except BaseException:

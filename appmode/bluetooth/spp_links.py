@@ -7,16 +7,30 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import socket
-from collections.abc import Callable
+from collections.abc import AsyncIterator, Callable
 from dataclasses import dataclass, field
 
-from dbus_fast import DBusError, Message, MessageType
+from dbus_fast import DBusError
 from dbus_fast.aio import MessageBus
 
+from appmode.bluetooth.calls import call
 from appmode.bluetooth.devices import Device
 
 Log = Callable[[str], None]
 READ = 4096
+
+
+async def chunks(link: socket.socket) -> AsyncIterator[bytes]:
+    """What a socket brings, as it comes, until its end (or its error)."""
+    loop = asyncio.get_running_loop()
+    while True:
+        try:
+            data = await loop.sock_recv(link, READ)
+        except OSError:
+            return
+        if not data:
+            return
+        yield data
 
 
 async def new_connection(bus: MessageBus, profile: tuple[str, str], device: str) -> socket.socket:
@@ -24,22 +38,25 @@ async def new_connection(bus: MessageBus, profile: tuple[str, str], device: str)
     path) NewConnection for `device`; DBusError if the profile refused it."""
     mine, theirs = socket.socketpair()
     sender, path = profile
-    reply = await bus.call(
-        Message(
-            destination=sender,
-            path=path,
-            interface="org.bluez.Profile1",
-            member="NewConnection",
-            signature="oha{sv}",
-            body=[device, 0, {}],
-            unix_fds=[theirs.fileno()],
+    try:
+        await call(
+            bus,
+            sender,
+            path,
+            "org.bluez.Profile1",
+            "NewConnection",
+            "oha{sv}",
+            [device, 0, {}],
+            [theirs.fileno()],
         )
-    )
-    theirs.close()
-    if reply is None or reply.message_type == MessageType.ERROR:
+    except DBusError as exc:
         mine.close()
-        why = reply.body[0] if reply is not None and reply.body else "no answer"
-        raise DBusError("org.bluez.Error.Failed", f"the profile refused the connection: {why}")
+        why = exc.text or exc.type
+        raise DBusError(
+            "org.bluez.Error.Failed", f"the profile refused the connection: {why}"
+        ) from None
+    finally:
+        theirs.close()
     mine.setblocking(False)
     return mine
 
@@ -78,15 +95,9 @@ class SppLinks:
 
     async def _carry(self, source: socket.socket, sink: socket.socket, device: Device) -> None:
         loop = asyncio.get_running_loop()
-        while True:
-            try:
-                data = await loop.sock_recv(source, READ)
-                if data:
-                    await loop.sock_sendall(sink, data)
-            except OSError:
-                data = b""
-            if not data:
-                break
+        with contextlib.suppress(OSError):  # the other side's end: the link ends
+            async for data in chunks(source):
+                await loop.sock_sendall(sink, data)
         self.disconnect(device)
 
     def disconnect(self, device: Device) -> None:

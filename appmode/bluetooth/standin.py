@@ -26,7 +26,7 @@ from appmode.bluetooth.gatt import Cccd, GattService, UartCharacteristic
 from appmode.bluetooth.module import CONNECTION_INTERVAL, ModuleModel, next_event
 from appmode.bluetooth.peers import Peers
 from appmode.bluetooth.signatures import Nothing
-from appmode.bluetooth.spp_links import new_connection
+from appmode.bluetooth.spp_links import chunks, new_connection
 from appmode.bluetooth.uuids import SPP, UART_SERVICES
 
 Log = Callable[[str], None]
@@ -38,7 +38,6 @@ ADVERTISING = 0.1
 """Seconds between two advertisements heard while discovering."""
 CONTROL = "/org/appmode/standin"
 FAILED = "org.bluez.Error.Failed"
-READ = 4096
 
 
 class Control(ServiceInterface):
@@ -101,9 +100,8 @@ class StandIn:
         reply = await bus.request_name("org.bluez")
         if reply.value != 1:  # PRIMARY_OWNER
             raise OSError(f"org.bluez is already served on {self._address}")
-        loop = asyncio.get_running_loop()
         self._board.setblocking(False)
-        self._spawn(self._from_board(loop))
+        self._spawn(self._from_board())
         self._spawn(self._events())
 
     async def run(self, stop: asyncio.Event, ready: Callable[[], None]) -> None:
@@ -314,11 +312,8 @@ class StandIn:
         with contextlib.suppress(BlockingIOError):
             self._board.send(data)
 
-    async def _from_board(self, loop: asyncio.AbstractEventLoop) -> None:
-        while True:
-            data = await loop.sock_recv(self._board, READ)
-            if not data:
-                return
+    async def _from_board(self) -> None:
+        async for data in chunks(self._board):
             if self.ble.connected and self.characteristic.notifying:
                 self.module.from_uart(data)
             if self._spp_link is not None:
@@ -326,15 +321,8 @@ class StandIn:
                     self._spp_link.send(data)
 
     async def _from_spp(self, link: socket.socket, device: Device) -> None:
-        loop = asyncio.get_running_loop()
         spp = ModuleModel()
-        while True:
-            try:
-                data = await loop.sock_recv(link, READ)
-            except OSError:
-                data = b""
-            if not data:
-                break
+        async for data in chunks(link):
             self._to_board(spp.from_radio(data, time.monotonic()))
         if self._spp_link is link:
             self.disconnect(device)

@@ -7,7 +7,8 @@ import threading
 import pytest
 
 from appmode.bluetooth.addresses import BadAddress, parse_ble, parse_bt
-from appmode.bluetooth.ble_port import RECEIVE_BUFFER, BleSerial
+from appmode.bluetooth.ble_port import BleSerial
+from appmode.bluetooth.inbox import RECEIVE_BUFFER, Inbox
 from appmode.bluetooth.module import INPUT_BUFFER, PAYLOAD, UART_BYTES_PER_S, ModuleModel
 from appmode.bluetooth.uuids import UART_SERVICES, full, uart_service
 
@@ -81,12 +82,13 @@ def test_notifications_are_cut_to_the_payload_a_few_per_connection_event() -> No
 
 def test_what_nobody_reads_is_bounded_the_newest_kept() -> None:
     port = BleSerial.__new__(BleSerial)  # the buffer alone: no radio
-    port._received = bytearray()
     port._ready = threading.Condition()
+    port._received = Inbox(port._ready)
     for i in range(RECEIVE_BUFFER // 10):
         port._notified(None, bytearray(b"%010d" % i) * 2)
     assert len(port._received) == RECEIVE_BUFFER
-    assert port._received.endswith(b"%010d" % (RECEIVE_BUFFER // 10 - 1))
+    kept = port._received.read(2 * RECEIVE_BUFFER, 0, lambda: None)
+    assert len(kept) == RECEIVE_BUFFER and kept.endswith(b"%010d" % (RECEIVE_BUFFER // 10 - 1))
 
 
 def test_a_board_faster_than_the_radio_loses_what_overflows_the_module() -> None:

@@ -14,6 +14,8 @@ import subprocess
 import sys
 import textwrap
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -87,6 +89,27 @@ def car_heard(board: ServedBoard) -> list[str]:
     return [e.data.decode() for e in board.recording().entries if e.direction == ">"]
 
 
+@contextmanager
+def tapping(car: ServedBoard, record: Path) -> Iterator[subprocess.Popen[str]]:
+    """`appmode tap advertise:NAME` between a phone to come and `car`, its port line read;
+    killed at the end if still running."""
+    assert car.ble is not None
+    tap = subprocess.Popen(
+        appmode_cmd("tap", f"advertise:{NAME}", car.ble, "--record", str(record)),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert tap.stdout is not None
+        assert tap.stdout.readline().strip() == f"port: ble://{NAME}"
+        yield tap
+    finally:
+        if tap.poll() is None:
+            tap.kill()
+            tap.communicate()
+
+
 def run_phone(script: Path, how: str = "drive") -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, str(script), NAME, how],
@@ -140,16 +163,7 @@ def test_tap_records_the_phone_and_the_car_and_stops_the_car_when_the_phone_vani
     appmode_ble_board: ServedBoard, phone: Path, tmp_path: Path
 ) -> None:
     record = tmp_path / "tap.transcript"
-    assert appmode_ble_board.ble is not None
-    tap = subprocess.Popen(
-        appmode_cmd("tap", f"advertise:{NAME}", appmode_ble_board.ble, "--record", str(record)),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert tap.stdout is not None
-        assert tap.stdout.readline().strip() == f"port: ble://{NAME}"
+    with tapping(appmode_ble_board, record) as tap:
         driver = subprocess.Popen(
             [sys.executable, str(phone), NAME, "vanish"],
             stdout=subprocess.PIPE,
@@ -164,10 +178,6 @@ def test_tap_records_the_phone_and_the_car_and_stops_the_car_when_the_phone_vani
         driver.kill()  # the phone's app dies mid-drive
         driver.communicate()
         _, err = tap.communicate(timeout=20)
-    finally:
-        if tap.poll() is None:
-            tap.kill()
-            tap.communicate()
     assert tap.returncode == 0, err
     assert re.search(r"the app side left: the phone left the BLE link \(.*\); the board got Z", err)
     # the transcript: both directions, who left, the stop last
@@ -268,25 +278,12 @@ def test_tap_sees_a_phone_that_never_subscribed_leave_and_stops_the_car(
     record = tmp_path / "tap.transcript"
     script = tmp_path / "mute.py"
     script.write_text(MUTE_PHONE)
-    assert appmode_ble_board.ble is not None
-    tap = subprocess.Popen(
-        appmode_cmd("tap", f"advertise:{NAME}", appmode_ble_board.ble, "--record", str(record)),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert tap.stdout is not None
-        tap.stdout.readline()
+    with tapping(appmode_ble_board, record) as tap:
         done = subprocess.run(
             [sys.executable, str(script)], capture_output=True, text=True, timeout=60, check=False
         )
         assert done.returncode == 0, done.stderr
         _, err = tap.communicate(timeout=20)
-    finally:
-        if tap.poll() is None:
-            tap.kill()
-            tap.communicate()
     assert tap.returncode == 0, err
     assert "the app side left: the phone left the BLE link (the phone disconnected)" in err
     assert sent_lines(record) == ["J", "A", "Z"]

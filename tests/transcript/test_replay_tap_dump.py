@@ -146,16 +146,21 @@ def test_replay_errors(tmp_path: Path) -> None:
     assert done.returncode == 2 and "--speed: '0' is not a number in [0.001, 1,000]" in done.stderr
 
 
+def start_tap(board: str, record: Path) -> subprocess.Popen[str]:
+    """`appmode tap pty BOARD`: its first line is the pty's."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "appmode", "tap", "pty", board, "--record", str(record)],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
 def test_tap_forwards_and_records_both_ways(tmp_path: Path) -> None:
     record = tmp_path / "tap.transcript"
     with board_process("--listen", "0", "--quiet", "--record", str(tmp_path / "b.t")) as board:
-        tap = subprocess.Popen(
-            [sys.executable, "-m", "appmode", "tap", "pty", board.url, "--record", str(record)],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        tap = start_tap(board.url, record)
         assert tap.stdout is not None
         path = tap.stdout.readline().split("port: ")[1].strip()
         app = serial.Serial(path, 9600, timeout=0.2)
@@ -185,13 +190,7 @@ def test_tap_forwards_and_records_both_ways(tmp_path: Path) -> None:
 def test_tap_says_in_the_transcript_which_side_left(tmp_path: Path) -> None:
     record = tmp_path / "tap.transcript"
     with board_process("--listen", "0", "--quiet") as board:
-        tap = subprocess.Popen(
-            [sys.executable, "-m", "appmode", "tap", "pty", board.url, "--record", str(record)],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        tap = start_tap(board.url, record)
         assert tap.stdout is not None
         tap.stdout.readline()
         wait_for(lambda: record.exists() and " < {A" in record.read_text())
