@@ -179,7 +179,9 @@ def test_missing_paths_are_one_line_errors() -> None:
 
 
 LIVE_GROUPS = {
-    "UART2 frames and motion": ("uart2/s8_*", "uart2/s9_*"),
+    "UART2 frames and the angle mode": ("uart2/s8_*", "uart2/s9_1_angle*"),
+    "UART2 velocity": ("uart2/s9_1_velocity*",),
+    "UART2 motors and position": ("uart2/s9_2_*", "uart2/s9_3_*"),
     "parameters and UART2 settings": ("s5_*", "uart2/s10_*", "uart2/s11_*", "uart2/s12_*"),
     "frames and telemetry": ("s2_*", "s3_*"),
     "letters omni": ("s4_letters_omni*",),
@@ -187,8 +189,9 @@ LIVE_GROUPS = {
     "letters diff": ("s4_letters_diff.transcript",),
     "letters diff-gyro": ("s4_letters_diff_gyro*",),
 }
-"""The suite in real time, cut into groups of 20–45 s, each run in sequence against a
-board of its own (as `conform --board` runs a suite), all at once: they mostly wait."""
+"""The suite in real time, cut into groups of at most about 20 s (the longest transcript
+is 18.4 s), each run in sequence against a board of its own (as `conform --board` runs a
+suite), all at once: they mostly wait."""
 
 
 def _group(patterns: tuple[str, ...]) -> list[Path]:
@@ -240,7 +243,7 @@ def _live(name: str) -> str | None:
 @pytest.mark.alone
 def test_the_suite_passes_in_real_time_against_board_processes() -> None:
     """Every group at once, each against its own board, after the rest of the suite: the
-    whole suite in the time of its longest group (about 45 s)."""
+    whole suite in the time of its longest group (about 22 s)."""
     with ThreadPoolExecutor(len(LIVE_GROUPS)) as pool:
         failures = [why for why in pool.map(_live, LIVE_GROUPS) if why is not None]
     assert not failures, "\n".join(failures)
