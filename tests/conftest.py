@@ -16,8 +16,8 @@ import pytest
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """`-n auto`: two workers a core. Most tests wait on boards, ptys and processes in
     real time: with three workers on two cores the run kept about one core busy (5 min 2 s
-    of CPU in 5 min 17 s), with four it is done in 4 min 11 s; two runs side by side
-    still pass."""
+    of CPU in 5 min 17 s); with four it is done in 4 min 11 s. Two runs side by side take
+    about 6 min 15 s each."""
     return 2 * (os.cpu_count() or 1)
 
 
