@@ -33,13 +33,32 @@ def machine_names(listen: str) -> list[str]:
         names.add(listen)
         return sorted(names)
     hostname = socket.gethostname()
-    names |= {hostname, f"{hostname}.local"}
+    names |= {hostname, f"{hostname}.local", *lan_addresses(ipv6=listen != "0.0.0.0")}
     try:
         for *_, address in socket.getaddrinfo(hostname, None):
             names.add(str(address[0]).split("%")[0])
     except OSError:
         pass
     return sorted(names)
+
+
+def lan_addresses(ipv6: bool) -> list[str]:
+    """This machine's addresses on its networks, interface by interface (up, not
+    loopback; no link-local IPv6, which a URL cannot use without the phone's zone)."""
+    import psutil  # every platform's interfaces: the standard library lists none
+
+    up = {name for name, stats in psutil.net_if_stats().items() if stats.isup}
+    found = []
+    for name, addresses in psutil.net_if_addrs().items():
+        for entry in addresses if name in up else ():
+            if entry.family not in (socket.AF_INET, socket.AF_INET6):
+                continue
+            if entry.family == socket.AF_INET6 and not ipv6:
+                continue
+            address = ipaddress.ip_address(entry.address.split("%")[0])
+            if not (address.is_loopback or address.is_link_local or address.is_unspecified):
+                found.append(str(address))
+    return found
 
 
 def _san(names: list[str]) -> list[object]:
@@ -152,6 +171,16 @@ def server_context(cert: Path, key: Path) -> ssl.SSLContext:
             "give a PEM certificate and its key"
         ) from None
     return context
+
+
+def grouped(fingerprint: str) -> list[str]:
+    """A fingerprint (AB:CD:…) in lines of 16 bytes, each in two groups of 8, as a person
+    compares it with what a browser shows."""
+    pairs = fingerprint.split(":")
+    return [
+        "  ".join(":".join(pairs[i + j : i + j + 8]) for j in (0, 8) if pairs[i + j : i + j + 8])
+        for i in range(0, len(pairs), 16)
+    ]
 
 
 def fingerprint(cert: Path) -> str:

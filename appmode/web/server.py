@@ -36,6 +36,7 @@ from appmode.web.access import (
     token_matches,
 )
 from appmode.web.bridge import MAX_MESSAGE, Bridge
+from appmode.web.certificate import grouped
 
 HEADER_TIMEOUT = 10.0
 """Seconds a connection may take to send a whole request (aiohttp's keep-alive timeout
@@ -283,6 +284,17 @@ class _OneLine(logging.Handler):
         _say_throttled(f"{record.name} {record.msg}", text)
 
 
+def qr_code(address: str) -> str:
+    """`address` as a QR code of text blocks (two rows a line), for a phone's camera."""
+    import io
+
+    import segno  # QR codes in pure Python: no image library, no terminal of ours
+
+    out = io.StringIO()
+    segno.make(address, error="l").terminal(out=out, compact=True, border=2)
+    return out.getvalue().rstrip("\n")
+
+
 def serve_web(
     session: BaseSession,
     host: str,
@@ -305,10 +317,16 @@ def serve_web(
         print(f"web: {server.address(first)}", flush=True)
         for other in names[1:]:
             print(f"appmode: also at {server.address(other)}", file=sys.stderr)
-        if fingerprint is not None:
+        if first is not None:
             print(
-                f"appmode: the page's certificate is appmode's own (self-signed); the "
-                f"browser asks once: accept it if its SHA-256 fingerprint is {fingerprint}",
+                f"appmode: to open it on a phone, scan:\n{qr_code(server.address(first))}",
+                file=sys.stderr,
+            )
+        if fingerprint is not None:
+            lines = "".join(f"\nappmode:   {line}" for line in grouped(fingerprint))
+            print(
+                "appmode: the page's certificate is appmode's own (self-signed); the "
+                f"browser asks once: accept it if its SHA-256 fingerprint is{lines}",
                 file=sys.stderr,
             )
         if not is_loopback(host):

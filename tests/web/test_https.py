@@ -9,6 +9,7 @@ import re
 import ssl
 import stat
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from cryptography import x509
 from playwright.sync_api import Browser
@@ -49,8 +50,11 @@ def test_a_wildcard_address_is_served_over_https_with_a_checked_fingerprint(
             served, cert = served_fingerprint(web)
             code, err = web.stop()
             assert code == 0, err
-            printed = re.search(r"fingerprint is ([0-9A-F:]{95})", err)
-            assert printed and printed.group(1) == served, err
+            printed = re.search(r"fingerprint is\n((?:appmode:   [0-9A-F: ]+\n){2})", err)
+            assert printed, err
+            lines = printed.group(1).replace("appmode:", "").split()
+            assert [len(group) for group in lines] == [23] * 4, "two lines of 2 x 8 bytes"
+            assert ":".join(lines) == served
             assert "WARNING: the page is served on 0.0.0.0" in err
             names = cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value
             assert "127.0.0.1" in [str(ip) for ip in names.get_values_for_type(x509.IPAddress)]
@@ -58,6 +62,35 @@ def test_a_wildcard_address_is_served_over_https_with_a_checked_fingerprint(
     assert prints[0] == prints[1], "the certificate is kept for the next start"
     key = tmp_path / "data" / "appmode" / "web-key.pem"
     assert stat.S_IMODE(key.stat().st_mode) == 0o600
+
+
+def test_a_wildcard_address_prints_every_lan_address_and_a_qr_code_of_the_first(
+    tmp_path: Path,
+) -> None:
+    import segno
+
+    from appmode.web.certificate import lan_addresses
+
+    with web_process(tmp_path, "--listen", "0.0.0.0:0") as web:
+        code, err = web.stop()
+    assert code == 0, err
+    port = web.origin.rsplit(":", 1)[1]
+    shown = [web.address, *re.findall(r"also at (\S+)", err)]
+    hosts = [str(urlsplit(url).hostname) for url in shown]
+    lan = lan_addresses(ipv6=False)
+    assert set(lan) <= set(hosts), "every address of the machine's networks"
+    assert all(":" not in host for host in hosts), "0.0.0.0 is IPv4 only"
+    if lan:
+        assert hosts[0] in lan, "an address a phone reaches comes first, not a name"
+    assert all(url.endswith(f":{port}/?token={web.token}") for url in shown)
+    art = err.split("scan:\n", 1)[1].split("\nappmode:", 1)[0].splitlines()
+    rows = []  # two rows of modules a line: upper and lower half of each character
+    for line in art:
+        rows.append([c in "█▀" for c in line])
+        rows.append([c in "█▄" for c in line])
+    modules = [[not light for light in row[2:-2]] for row in rows[2:-2]][: len(rows[0]) - 4]
+    expected = segno.make(shown[0], error="l").matrix
+    assert modules == [[bool(m) for m in row] for row in expected], "the QR code is the first URL's"
 
 
 def test_on_a_wildcard_address_the_host_must_be_an_address_or_this_machine(
