@@ -50,8 +50,24 @@ REFRESH = 0.02
 """Seconds between reads of the link (and checks of the heartbeat)."""
 SEND = 0.1
 """How often each page's status is checked, and sent if it changed."""
-ASSETS = ("index.html", "app.js", "app.css")
-TYPES = {".html": "text/html", ".js": "text/javascript", ".css": "text/css"}
+ASSETS = (
+    "index.html",
+    "app.js",
+    "app.css",
+    "offline.html",
+    "app.webmanifest",
+    "icon.svg",
+    "icon-192.png",
+    "icon-512.png",
+)
+TYPES = {
+    ".html": "text/html",
+    ".js": "text/javascript",
+    ".css": "text/css",
+    ".webmanifest": "application/manifest+json",
+    ".svg": "image/svg+xml",
+    ".png": "image/png",
+}
 HEADERS = {
     "Cache-Control": "no-store",
     "X-Content-Type-Options": "nosniff",
@@ -86,6 +102,7 @@ class WebServer:
         self.app = web.Application(middlewares=[self._guard], client_max_size=MAX_MESSAGE)
         self.app.router.add_get("/", self._index)
         self.app.router.add_get("/static/{name}", self._static)
+        self.app.router.add_get("/sw.js", self._worker)
         self.app.router.add_get("/ws", self._websocket)
 
     def address(self, host: str | None = None) -> str:
@@ -161,6 +178,10 @@ class WebServer:
             raise web.HTTPNotFound()
         kind = TYPES[name[name.rindex(".") :]]
         return web.Response(body=_asset(name), content_type=kind)
+
+    async def _worker(self, request: web.Request) -> web.StreamResponse:
+        """The service worker, from the root: its scope is the whole page."""
+        return web.Response(body=_asset("sw.js"), content_type="text/javascript")
 
     async def _websocket(self, request: web.Request) -> web.StreamResponse:
         if not origin_matches(request.headers.get("Origin"), request.host, request.scheme):

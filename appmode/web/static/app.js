@@ -436,3 +436,7 @@ function connect() {
 
 connect();
 setInterval(() => send({ t: "alive" }), HEARTBEAT_MS);
+
+if ("serviceWorker" in navigator) {  // keeps the page's own files for "the server is not reachable"
+  navigator.serviceWorker.register("/sw.js").catch(() => {});  // refused on a certificate the browser distrusts
+}
