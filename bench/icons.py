@@ -8,47 +8,65 @@ import struct
 import sys
 import zlib
 from pathlib import Path
+from typing import NamedTuple
 
+Colour = tuple[int, int, int]
 BLUE, NAVY, WHITE = (0x15, 0x65, 0xC0), (0x0D, 0x2B, 0x52), (0xFF, 0xFF, 0xFF)
-# (kind, geometry, colour), painted in order on a 512 x 512 canvas
-SHAPES = (
-    ("rect", (0, 0, 512, 512, 96), BLUE),
-    ("rect", (176, 140, 160, 90, 24), WHITE),
-    ("rect", (96, 200, 320, 120, 28), WHITE),
-    ("circle", (176, 330, 46), NAVY),
-    ("circle", (336, 330, 46), NAVY),
-    ("circle", (176, 330, 16), WHITE),
-    ("circle", (336, 330, 16), WHITE),
+
+
+class Rect(NamedTuple):
+    x: int
+    y: int
+    w: int
+    h: int
+    r: int
+    colour: Colour
+
+    def svg(self) -> str:
+        return (
+            f'<rect x="{self.x}" y="{self.y}" width="{self.w}" height="{self.h}" '
+            f'rx="{self.r}" fill="{_hex(self.colour)}"/>'
+        )
+
+    def covers(self, x: float, y: float) -> bool:
+        if not (self.x <= x <= self.x + self.w and self.y <= y <= self.y + self.h):
+            return False
+        nx = min(max(x, self.x + self.r), self.x + self.w - self.r)  # nearest inner point
+        ny = min(max(y, self.y + self.r), self.y + self.h - self.r)
+        return (x - nx) ** 2 + (y - ny) ** 2 <= self.r**2
+
+
+class Circle(NamedTuple):
+    cx: int
+    cy: int
+    r: int
+    colour: Colour
+
+    def svg(self) -> str:
+        return f'<circle cx="{self.cx}" cy="{self.cy}" r="{self.r}" fill="{_hex(self.colour)}"/>'
+
+    def covers(self, x: float, y: float) -> bool:
+        return (x - self.cx) ** 2 + (y - self.cy) ** 2 <= self.r**2
+
+
+SHAPES: tuple[Rect | Circle, ...] = (  # painted in order on a 512 x 512 canvas
+    Rect(0, 0, 512, 512, 96, BLUE),
+    Rect(176, 140, 160, 90, 24, WHITE),
+    Rect(96, 200, 320, 120, 28, WHITE),
+    Circle(176, 330, 46, NAVY),
+    Circle(336, 330, 46, NAVY),
+    Circle(176, 330, 16, WHITE),
+    Circle(336, 330, 16, WHITE),
 )
 
 
-def _hex(colour: tuple[int, int, int]) -> str:
-    return "#%02x%02x%02x" % colour
+def _hex(colour: Colour) -> str:
+    return "#" + "".join(f"{c:02x}" for c in colour)
 
 
 def svg() -> str:
-    parts = []
-    for kind, g, colour in SHAPES:
-        if kind == "rect":
-            x, y, w, h, r = g
-            parts.append(f'<rect x="{x}" y="{y}" width="{w}" height="{h}" rx="{r}" fill="{_hex(colour)}"/>')
-        else:
-            cx, cy, r = g
-            parts.append(f'<circle cx="{cx}" cy="{cy}" r="{r}" fill="{_hex(colour)}"/>')
-    body = "".join(parts)
+    body = "".join(shape.svg() for shape in SHAPES)
     return f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 512 512">{body}</svg>\n'
-
-
-def _inside(kind: str, g: tuple[int, ...], x: float, y: float) -> bool:
-    if kind == "circle":
-        cx, cy, r = g
-        return (x - cx) ** 2 + (y - cy) ** 2 <= r * r
-    rx, ry, w, h, r = g
-    if not (rx <= x <= rx + w and ry <= y <= ry + h):
-        return False
-    nx = min(max(x, rx + r), rx + w - r)  # the nearest point of the inner rectangle
-    ny = min(max(y, ry + r), ry + h - r)
-    return (x - nx) ** 2 + (y - ny) ** 2 <= r * r
 
 
 def png(size: int, samples: int = 3) -> bytes:
@@ -63,9 +81,9 @@ def png(size: int, samples: int = 3) -> bytes:
                     x = (px + (sx + 0.5) / samples) * scale
                     y = (py + (sy + 0.5) / samples) * scale
                     found = None
-                    for kind, g, colour in SHAPES:
-                        if _inside(kind, g, x, y):
-                            found = colour
+                    for shape in SHAPES:
+                        if shape.covers(x, y):
+                            found = shape.colour
                     if found is not None:
                         total[0] += found[0]
                         total[1] += found[1]
@@ -78,7 +96,8 @@ def png(size: int, samples: int = 3) -> bytes:
         rows.append(bytes(row))
 
     def chunk(kind: bytes, data: bytes) -> bytes:
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        check = struct.pack(">I", zlib.crc32(kind + data))
+        return struct.pack(">I", len(data)) + kind + data + check
 
     header = struct.pack(">IIBBBBB", size, size, 8, 6, 0, 0, 0)
     return (
