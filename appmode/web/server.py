@@ -170,18 +170,18 @@ class WebServer:
     # ------------------------------------------------------------ routes
 
     async def _index(self, request: web.Request) -> web.StreamResponse:
-        return web.Response(body=_asset("index.html"), content_type="text/html")
+        return _compressed(web.Response(body=_asset("index.html"), content_type="text/html"))
 
     async def _static(self, request: web.Request) -> web.StreamResponse:
         name = request.match_info["name"]
         if name not in ASSETS:
             raise web.HTTPNotFound()
         kind = TYPES[name[name.rindex(".") :]]
-        return web.Response(body=_asset(name), content_type=kind)
+        return _compressed(web.Response(body=_asset(name), content_type=kind))
 
     async def _worker(self, request: web.Request) -> web.StreamResponse:
         """The service worker, from the root: its scope is the whole page."""
-        return web.Response(body=_asset("sw.js"), content_type="text/javascript")
+        return _compressed(web.Response(body=_asset("sw.js"), content_type="text/javascript"))
 
     async def _websocket(self, request: web.Request) -> web.StreamResponse:
         if not origin_matches(request.headers.get("Origin"), request.host, request.scheme):
@@ -288,6 +288,14 @@ def _one_line(loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
     error = context.get("exception")
     message = str(context.get("message"))
     _say_throttled(message, f"{message}{f': {error!r}' if error else ''}")
+
+
+def _compressed(response: web.Response) -> web.Response:
+    """The page's own files, compressed for a browser that takes it (a third of the
+    bytes over a phone's Wi-Fi); none holds a secret (the token is in a cookie)."""
+    if not response.content_type.startswith("image/png"):
+        response.enable_compression()
+    return response
 
 
 def _refused(text: str) -> web.Response:
