@@ -1,0 +1,111 @@
+"""The phone page held to Lighthouse and axe-core: serve `appmode web` on the simulated
+board, run Lighthouse (mobile) on it and axe-core on each tab, light and dark, at a
+phone's size; exit 1 below the targets or on any axe violation. `.ci/run` runs it with
+both from npm:
+
+    npm install --prefix DIR lighthouse@12.2.3 axe-core@4
+    python bench/page_audit.py --lighthouse DIR/node_modules/.bin/lighthouse \\
+        --axe DIR/node_modules/axe-core/axe.min.js
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+TARGETS = {"performance": 95, "accessibility": 100, "best-practices": 100, "seo": 100}
+CHROMIUM = "/usr/bin/chromium"
+TABS = ("drive", "tilt", "params", "waves")
+
+
+def lighthouse(tool: str, url: str) -> list[str]:
+    """Lighthouse's scores, printed; what misses its target."""
+    with tempfile.TemporaryDirectory() as folder:
+        report = Path(folder) / "report.json"
+        subprocess.run(
+            [
+                tool,
+                url,
+                "--quiet",
+                "--chrome-flags=--headless=new --no-sandbox",
+                "--output=json",
+                f"--output-path={report}",
+                f"--only-categories={','.join(TARGETS)}",
+            ],
+            env={**os.environ, "CHROME_PATH": CHROMIUM},
+            check=True,
+            timeout=300,
+        )
+        categories = json.loads(report.read_text())["categories"]
+    missed = []
+    for name, target in TARGETS.items():
+        score = round(categories[name]["score"] * 100)
+        print(f"lighthouse {name}: {score} (target {target})")
+        if score < target:
+            missed.append(f"lighthouse {name} {score} < {target}")
+    return missed
+
+
+def axe(script: str, url: str) -> list[str]:
+    """axe-core's violations on every tab, light and dark, at 360 x 640."""
+    from playwright.sync_api import sync_playwright
+
+    source = Path(script).read_text(encoding="utf-8")
+    found = []
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM)
+        for scheme in ("light", "dark"):
+            context = browser.new_context(
+                viewport={"width": 360, "height": 640},
+                is_mobile=True,
+                has_touch=True,
+                color_scheme=scheme,
+                bypass_csp=True,  # axe is evaluated in the page; the page's CSP is 'self'
+            )
+            page = context.new_page()
+            page.goto(url)
+            page.get_by_text("parameters read").wait_for(timeout=10_000)
+            page.evaluate(source)
+            for tab in TABS:
+                page.locator(f'nav button[data-tab="{tab}"]').click()
+                result = page.evaluate("axe.run(document).then(r => r.violations)")
+                for violation in result:
+                    nodes = len(violation["nodes"])
+                    found.append(f"axe {scheme} {tab}: {violation['id']} ({nodes} nodes)")
+                print(f"axe {scheme} {tab}: {len(result)} violations")
+            context.close()
+        browser.close()
+    return found
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--lighthouse", required=True, help="the lighthouse command")
+    parser.add_argument("--axe", required=True, help="axe.min.js")
+    args = parser.parse_args()
+    web = subprocess.Popen(
+        [sys.executable, "-m", "appmode", "web", "sim://", "--listen", "127.0.0.1:0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    try:
+        assert web.stdout is not None
+        url = web.stdout.readline().removeprefix("web: ").strip()
+        missed = lighthouse(args.lighthouse, url) + axe(args.axe, url)
+    finally:
+        web.send_signal(signal.SIGINT)
+        web.wait(10)
+    for line in missed:
+        print(f"missed: {line}", file=sys.stderr)
+    return 1 if missed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
