@@ -14,11 +14,12 @@ import pytest
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: two workers a core. Most tests wait on boards, ptys and processes in
-    real time: with three workers on two cores the run kept about one core busy (5 min 2 s
-    of CPU in 5 min 17 s); with four it is done in 4 min 11 s. Two runs side by side take
-    about 6 min 15 s each."""
-    return 2 * (os.cpu_count() or 1)
+    """`-n auto`: three workers for two cores. Most tests wait on boards, ptys and
+    processes in real time, so more workers than cores keep the cores busy (5 min 2 s of
+    CPU in a 5 min 17 s run); four made two real-time tests fail on an idle machine (a
+    send 3.5 ms early against a served board; a sim:// recording read late)."""
+    cores = os.cpu_count() or 1
+    return cores + cores // 2
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
