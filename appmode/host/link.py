@@ -63,6 +63,8 @@ class Link(Generic[E]):
         self._opener = opener
         self._port: serial.SerialBase | None = opener(self.url)
         self._writing = threading.RLock()  # the stop guard may write from its thread
+        self._tapping = threading.Lock()
+        self._unheard: list[tuple[float, bytes]] = []  # sends told once reads catch up
         # after opening: an in-process sim:// board booted just now, and its clock is ours
         board_origin = getattr(self._port, "clock_origin", None)
         self._origin = time.monotonic() if board_origin is None else float(board_origin)
@@ -95,6 +97,7 @@ class Link(Generic[E]):
         """What the protocol forgets when the link drops (a decoder's partial bytes)."""
 
     def _lost(self, exc: Exception) -> None:
+        self._tell_all_sent()
         if self._port is not None:
             with contextlib.suppress(serial.SerialException, OSError):
                 self._port.close()
@@ -168,16 +171,57 @@ class Link(Generic[E]):
                 self._lost(exc)
                 raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
             if self.tap is not None:
-                self.tap(self.sent, self._written_at(port), chunk)
+                self._tap_sent(port, chunk)
             self._sent(chunk)
 
-    def _written_at(self, port: serial.SerialBase) -> float:
-        """When the bytes just written left: the time the board took them for a port that
-        keeps the board's clock (sim://: a recording of it replays exactly), else now."""
-        written_at = getattr(port, "written_at", None)
-        if written_at is None:
-            return self.now()
-        return float(written_at) + (float(port.clock_origin) - self._origin)
+    def _tap_sent(self, port: serial.SerialBase, chunk: bytes) -> None:
+        """Tell the tap what was just written. A port that keeps the board's clock
+        (sim://) says when the board took it, and when what was read arrived: the tap
+        hears both in time order (a recording of it replays exactly on virtual time, even
+        when this host read late), so a write waits for the reads to catch up with it."""
+        at = getattr(port, "written_at", None)
+        assert self.tap is not None
+        if at is None or not hasattr(port, "read_runs"):
+            self.tap(self.sent, self.now(), chunk)
+            return
+        with self._tapping:
+            self._unheard.append((float(at) + self._board_offset(port), chunk))
+
+    def _tap_received(self, port: serial.SerialBase, data: bytes) -> None:
+        """Tell the tap what was just read (empty: nothing, but the reads caught up)."""
+        assert self.tap is not None
+        runs = getattr(port, "read_runs", None)
+        if runs is None:
+            if data:
+                self.tap(self.received, self.now(), data)
+            return
+        offset = self._board_offset(port)
+        with self._tapping:
+            start = 0
+            for when, count in runs if data else ():
+                self._tell_sent(when + offset, including=False)  # what came first goes first
+                self.tap(self.received, when + offset, data[start : start + count])
+                start += count
+            until, including = port.heard_until
+            self._tell_sent(until + offset, including)
+
+    def _tell_sent(self, until: float, including: bool) -> None:
+        """Tell the tap the held writes before `until` (and at it, if `including`)."""
+        assert self.tap is not None
+        while self._unheard and (
+            self._unheard[0][0] < until or (including and self._unheard[0][0] == until)
+        ):
+            at, chunk = self._unheard.pop(0)
+            self.tap(self.sent, at, chunk)
+
+    def _tell_all_sent(self) -> None:
+        if self.tap is not None:
+            with self._tapping:
+                self._tell_sent(float("inf"), including=True)
+
+    def _board_offset(self, port: serial.SerialBase) -> float:
+        """A board time of `port` as this session's time."""
+        return float(port.clock_origin) - self._origin
 
     def _pace(self, size: int) -> None:
         """Hand the OS no more than a chunk ahead of the line's rate: what it holds would
@@ -209,8 +253,8 @@ class Link(Generic[E]):
             return b""
         if data:
             self._heard, self.refused, self.refusals = True, None, 0
-            if self.tap is not None:
-                self.tap(self.received, self.now(), data)
+        if self.tap is not None:
+            self._tap_received(self._port, data)
         return data
 
     def _read_once(self, block: bool) -> list[E | LinkStatus]:
@@ -293,6 +337,7 @@ class Link(Generic[E]):
                     self._port.flush()
                 self._port.close()
                 self._port = None
+            self._tell_all_sent()
         return stop
 
     def _before_stop(self) -> None:

@@ -17,6 +17,7 @@ import math
 import random
 import threading
 import time
+from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
@@ -48,6 +49,12 @@ USAGE = (
     "[&pace=1|0][&baud=9600]"
     "[&faults=drop:0.01,corrupt:0.01,…][&port=app|uart2][&share=NAME]"
 )
+
+
+def _on_grid(seconds: float) -> float:
+    """A board time on the grid of a transcript's times (0.1 ms, floored)."""
+    grid: int = 10**TIME_DIGITS
+    return math.floor(seconds * grid) / grid
 
 
 @dataclass
@@ -98,9 +105,13 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         self._side = APP
         self._faults: tuple[FaultyLine, FaultyLine] | None = None
         self._rx = bytearray()
+        self._rx_times: deque[list[float]] = deque()  # [board time, count] runs of _rx
+        self._pumped = 0.0
         self._origin = 0.0
         self.written_at = 0.0
         """Board time at which the last write went on the line (`board_time`)."""
+        self.read_runs: list[tuple[float, int]] = []
+        """The bytes the last read returned, as runs of (board time they arrived, count)."""
         self.board: Board | None = None
         super().__init__(*args, **kwargs)
 
@@ -166,7 +177,7 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         self._shared, self._share_name, self._side = shared, name, side
         self._wire = shared.wire
         self.board = shared.wire.board
-        self._rx.clear()
+        self._clear_rx()
         self._origin = shared.origin
         self.is_open = True
 
@@ -199,8 +210,16 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         """The board's time now, on the grid of a transcript's times (0.1 ms, floored):
         what a recording stamps a write with is the time the board took it, so a
         recording of a simulated session replays exactly on virtual time."""
-        grid: int = 10**TIME_DIGITS
-        return math.floor(self._now() * grid) / grid
+        return _on_grid(self._now())
+
+    @property
+    def heard_until(self) -> tuple[float, bool]:
+        """Up to which board time every byte that arrived has been read: (time, whether
+        a byte at that very time has been read too). Writes before it may be told after
+        what was read, in time order."""
+        if self._rx_times:
+            return _on_grid(self._rx_times[0][0]), False
+        return _on_grid(self._pumped), True
 
     def _pump(self) -> Wire:
         wire, shared = self._wire, self._shared
@@ -210,13 +229,28 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         with shared.lock:
             now = self._now()
             if self._faults is None:
-                self._rx += wire.pump(now, side)
-                return wire
-            to_board, to_host = self._faults
-            wire.write(to_board.take(now), now, side)
-            to_host.push(wire.pump(now, side), now)
-            self._rx += to_host.take(now)
+                for when, chunk in wire.pump_timed(now, side):
+                    self._arrived(when, chunk)
+            else:
+                to_board, to_host = self._faults
+                wire.write(to_board.take(now), now, side)
+                to_host.push(wire.pump(now, side), now)
+                self._arrived(now, to_host.take(now))  # a faulty line's: when taken
+            self._pumped = now
         return wire
+
+    def _arrived(self, when: float, chunk: bytes) -> None:
+        if not chunk:
+            return
+        self._rx += chunk
+        if self._rx_times and self._rx_times[-1][0] == when:
+            self._rx_times[-1][1] += len(chunk)
+        else:
+            self._rx_times.append([when, len(chunk)])
+
+    def _clear_rx(self) -> None:
+        self._rx.clear()
+        self._rx_times.clear()
 
     def _next_wakeup(self, wire: Wire) -> float:
         assert self._shared is not None
@@ -252,6 +286,16 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             wire = self._pump()
         data = bytes(self._rx[:size])
         del self._rx[:size]
+        self.read_runs = []
+        left = len(data)
+        while left:  # the arrival times of what was read go with it
+            run = self._rx_times[0]
+            taken = min(left, int(run[1]))
+            self.read_runs.append((_on_grid(run[0]), taken))
+            run[1] -= taken
+            left -= taken
+            if not run[1]:
+                self._rx_times.popleft()
         return data
 
     def write(self, data: bytes) -> int:
@@ -279,7 +323,7 @@ class SimSerial(SerialBase):  # type: ignore[misc]
 
     def reset_input_buffer(self) -> None:
         self._pump()
-        self._rx.clear()
+        self._clear_rx()
 
     def reset_output_buffer(self) -> None:
         """Bytes already on the simulated line cannot be called back."""

@@ -259,19 +259,26 @@ def test_a_real_board_is_driven_only_when_the_user_agrees() -> None:
 
 
 class _LateSimSerial(SimSerial):
-    """A sim:// port whose writes return 7 ms after the board took the bytes: a host
-    preempted between its write and its clock, as on a loaded machine."""
+    """A sim:// port whose writes return 7 ms after the board took the bytes, and whose
+    reads start 23 ms late: a host preempted, as on a loaded machine."""
 
     def write(self, data: bytes) -> int:
         written = super().write(data)
         time.sleep(0.007)
         return written
 
+    def read(self, size: int = 1) -> bytes:
+        time.sleep(0.023)
+        return super().read(size)
+
 
 def test_a_recording_of_a_simulated_session_has_the_times_the_board_took_its_bytes() -> None:
     """A simulated session's recording replays exactly on virtual time even when the host
     is slow: each `>` line has the time the board took its bytes, not the host's time
-    after the write returned (under load, that crossed the board's 10 ms ticks)."""
+    after the write returned (under load, that crossed the board's 10 ms ticks); each `<`
+    line the time its first byte arrived, not when the host got round to reading it; and
+    the lines are in time order (under load, a record read after the next `{Q:P}` was
+    recorded after it, and the replay, where it came first, failed)."""
     took: list[tuple[float, bytes]] = []
     out = io.StringIO()
     recorder = Recorder(out, 0.0, ("board drive=mecanum",))
@@ -285,7 +292,7 @@ def test_a_recording_of_a_simulated_session_has_the_times_the_board_took_its_byt
         return port
 
     with Host("sim://?drive=mecanum", tap=recorder, opener=opener) as host:
-        for letters in (b"J", b"A", b"B", b"G", b"H", b"Z"):
+        for letters in (b"J", b"{Q:P}", b"A", b"B", b"{Q:P}", b"G", b"H", b"Z"):
             host.send(letters)
             host.poll(0.137)
     recorder.close()
@@ -293,5 +300,9 @@ def test_a_recording_of_a_simulated_session_has_the_times_the_board_took_its_byt
     sent = [(entry.time, entry.data) for entry in transcript.entries if entry.direction == ">"]
     assert [data for _, data in sent] == [data for _, data in took]
     assert [when for when, _ in sent] == [when for when, _ in took]
+    times = [entry.time for entry in transcript.entries]
+    assert times == sorted(times), "the recording is in time order"
+    first = next(entry for entry in transcript.entries if entry.direction == "<")
+    assert first.time < 0.012, "a record's time is its arrival, not its reading"
     result = run_virtual(transcript)
     assert result.passed, result.failure
