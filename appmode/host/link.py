@@ -40,6 +40,11 @@ class LinkLost(AppmodeError):
     """The link is down; the host is trying to get it back."""
 
 
+UNHEARD = 256
+"""Writes held for the reads to catch up with them at most; past that a host that never
+reads has them told at once (memory stays bounded; its recording's order is the writes')."""
+
+
 class Link(Generic[E]):
     """One open port and its session clock; `sent`/`received` name the tap directions."""
 
@@ -184,8 +189,13 @@ class Link(Generic[E]):
         if at is None or not hasattr(port, "read_runs"):
             self.tap(self.sent, self.now(), chunk)
             return
+        offset = self._board_offset(port)
         with self._tapping:
-            self._unheard.append((float(at) + self._board_offset(port), chunk))
+            self._unheard.append((float(at) + offset, chunk))
+            until, including = port.heard_until  # nothing unread came before it: now
+            if len(self._unheard) > UNHEARD:  # a host that never reads: told as sent
+                until, including = float("inf"), True
+            self._tell_sent(until + offset, including)
 
     def _tap_received(self, port: serial.SerialBase, data: bytes) -> None:
         """Tell the tap what was just read (empty: nothing, but the reads caught up)."""

@@ -217,9 +217,10 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         """Up to which board time every byte that arrived has been read: (time, whether
         a byte at that very time has been read too). Writes before it may be told after
         what was read, in time order."""
-        if self._rx_times:
+        try:  # the reader's thread may take the last run meanwhile
             return _on_grid(self._rx_times[0][0]), False
-        return _on_grid(self._pumped), True
+        except IndexError:
+            return _on_grid(self._pumped), True
 
     def _pump(self) -> Wire:
         wire, shared = self._wire, self._shared
@@ -306,7 +307,8 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             wire = self._pump()
         assert self._shared is not None
         with self._shared.lock:
-            self.written_at = now = self.board_time()
+            self._pump()  # what arrived before the write is in hand (`heard_until`)
+            self.written_at = now = _on_grid(self._pumped)
             if self._faults is None:
                 wire.write(payload, now, self._side)
             else:

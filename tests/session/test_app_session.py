@@ -144,6 +144,9 @@ def test_a_recording_failing_midway_stops_with_a_message_and_driving_goes_on() -
         session.recorder = Recorder(_FailingStream())
         session.start()
         session.run("drive A")
+        deadline = time.monotonic() + 2.0
+        while session.recorder is not None and time.monotonic() < deadline:
+            session.tick()  # a write is recorded once the reads have caught up with it
         assert session.recorder is None
         assert any(
             "cannot write transcript full.transcript: No space left on device; recording "
