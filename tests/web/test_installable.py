@@ -65,3 +65,33 @@ def test_the_page_is_tidy_installable_and_says_when_the_server_is_gone(
     page.reload()  # the server has gone
     assert "The server is not reachable" in page.locator("h1").inner_text()
     context.close()
+
+
+def test_every_control_is_a_finger_s_target_on_every_tab(
+    browser: Browser,
+    tmp_path: Path,
+) -> None:
+    """Issue 51: the tabs, page and speed buttons, Run and each parameter's Set and input
+    were 21–40 px high; every control a finger may touch is at least 48 × 48 CSS px."""
+    context = browser.new_context(
+        viewport={"width": 360, "height": 640}, has_touch=True, is_mobile=True
+    )
+    page = context.new_page()
+    small: list[str] = []
+    with web_process(tmp_path) as web:
+        page.goto(web.address)
+        page.get_by_text("parameters read").wait_for(timeout=10_000)
+        for tab in ("drive", "tilt", "params", "waves"):
+            page.locator(f'nav button[data-tab="{tab}"]').click()
+            found = page.evaluate(
+                """() => [...document.querySelectorAll('button, input')]
+                    .filter(e => e.offsetParent !== null)
+                    .map(e => [e, e.getBoundingClientRect()])
+                    .filter(([, r]) => r.width < 48 || r.height < 48)
+                    .map(([e, r]) => [e.id || e.getAttribute('aria-label') || e.textContent,
+                                      Math.round(r.width), Math.round(r.height)])"""
+            )
+            small += [f"{tab}: {name.strip()} {w}x{h}" for name, w, h in found]
+        assert page.locator("#values input").count() >= 9, "the parameters' inputs were there"
+    context.close()
+    assert not small, small
