@@ -102,7 +102,6 @@ class Link(Generic[E]):
         """What the protocol forgets when the link drops (a decoder's partial bytes)."""
 
     def _lost(self, exc: Exception) -> None:
-        self._tell_all_sent()
         if self._port is not None:
             with contextlib.suppress(serial.SerialException, OSError):
                 self._port.close()
@@ -118,6 +117,7 @@ class Link(Generic[E]):
             exc = OSError(self.refused)
         if self._proven:  # a reopened port that never showed the board: already said
             self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
+        self._tell_all_sent()  # last: a recording that fails here cannot undo the above
 
     def _reconnect(self) -> None:
         if self.now() - self._lost_at < RETRY:
@@ -347,7 +347,8 @@ class Link(Generic[E]):
                     self._port.flush()
                 self._port.close()
                 self._port = None
-            self._tell_all_sent()
+            with contextlib.suppress(AppmodeError):  # only its recording failed, as above
+                self._tell_all_sent()
         return stop
 
     def _before_stop(self) -> None:

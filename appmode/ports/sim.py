@@ -109,7 +109,9 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         self._pumped = 0.0
         self._origin = 0.0
         self.written_at = 0.0
-        """Board time at which the last write went on the line (`board_time`)."""
+        """Board time at which the last write went on the line, on the grid of a
+        transcript's times (0.1 ms, floored): a recording of a simulated session stamps
+        a write with it, and so replays exactly on virtual time."""
         self.read_runs: list[tuple[float, int]] = []
         """The bytes the last read returned, as runs of (board time they arrived, count)."""
         self.board: Board | None = None
@@ -205,12 +207,6 @@ class SimSerial(SerialBase):  # type: ignore[misc]
     def clock_origin(self) -> float:
         """`time.monotonic()` at the board's power-up: its clock's zero."""
         return float(self._origin)
-
-    def board_time(self) -> float:
-        """The board's time now, on the grid of a transcript's times (0.1 ms, floored):
-        what a recording stamps a write with is the time the board took it, so a
-        recording of a simulated session replays exactly on virtual time."""
-        return _on_grid(self._now())
 
     @property
     def heard_until(self) -> tuple[float, bool]:
