@@ -45,6 +45,7 @@ PARAMS: tuple[Param, ...] = (
 )
 PARAM_COUNT = len(PARAMS)
 BY_NAME: dict[str, Param] = {p.name: p for p in PARAMS}
+NAMES: tuple[str, ...] = tuple(BY_NAME)
 DEFAULTS: tuple[int, ...] = tuple(p.default for p in PARAMS)
 MAX_SPEED = BY_NAME["max_speed"].index
 SYSTEM_MODE = BY_NAME["system_mode"].index

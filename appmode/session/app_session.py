@@ -29,12 +29,14 @@ from appmode.protocol.directions import (
     letter_name,
 )
 from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.session import instruments
 from appmode.session.app_commands import COMMANDS
 from appmode.session.base import (
     SPEED_KEYS,
     BaseSession,
 )
 from appmode.session.hold import HoldToDrive
+from appmode.session.instruments import Instruments
 from appmode.session.status import GLYPHS, Row, Span, hold_mode, link_rows, telemetry
 
 KEYS_HELP = (
@@ -223,6 +225,33 @@ class Session(BaseSession):
             pairs = zip(params.PARAMS, record.values, strict=True)
             rows.append(Row("params", pairs=tuple(f"{p.name} {value}" for p, value in pairs)))
         return rows
+
+    def instruments(self) -> Instruments:
+        host, state = self.host, self.host.state
+        now = host.now()
+        table = [(p.name, p.minimum, p.maximum) for p in params.PARAMS]
+        now_values = () if state.params is None else state.params.values
+        read = dict(zip(params.NAMES, now_values, strict=False))
+        unsaved = [
+            name
+            for name, old, new in zip(params.NAMES, self.baseline or (), now_values, strict=False)
+            if old != new
+        ]
+        values = instruments.values(table, read, unsaved)
+        return Instruments(
+            link=instruments.link(host.connected, state.stats, now),
+            telemetry=instruments.telemetry(state, now),
+            app_link=None,
+            in_force="stopped" if not self.moving else letter_name(self.page, self.in_force),
+            moving=self.moving,
+            page=PAGE_NAMES[self.page_letter],
+            speed=values[params.MAX_SPEED],
+            values=values,
+            values_read=state.params is not None,
+            wheels=None,
+            wheels_age=None,
+            driver=None,
+        )
 
     def grid_cells(self) -> list[list[str]]:
         letters = grid_for(self.page)

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from appmode.host.client import Host
     from appmode.host.control_client import ControlHost
     from appmode.host.state import HostState
+    from appmode.session.instruments import Instruments
     from appmode.session.status import Row
 
 SPEED_STEP = 100
@@ -263,6 +264,10 @@ class BaseSession(ABC):
     @abstractmethod
     def status_rows(self) -> list[Row]:
         """What the session shows now, row by row (the key grid apart)."""
+
+    @abstractmethod
+    def instruments(self) -> Instruments:
+        """What the session shows now, as values for a page's instruments."""
 
     @abstractmethod
     def grid_cells(self) -> list[list[str]]:

@@ -69,20 +69,25 @@ def control_rows(session: ControlSession) -> list[Row]:
     return rows
 
 
-def _in_force(session: ControlSession) -> list[Row]:
-    """What drives the car, then the keys' settings (on a row of their own if they do
-    not fit)."""
+def in_force_text(session: ControlSession) -> str:
+    """What drives the car, in words: a turn, a key's motion, a frame sent, or "stopped"."""
     state = session.host.state
     if session.rotation is not None:
         left = state.values.get("pending_angle")
         to_go = "" if left is None else f", {left / 10:g}° to go"
-        what: Span = ("on", f" turning {session.rotation[1]:g}°{to_go} ")
-    elif session.in_force != STOP:
-        what = ("on", f" {session.in_force} ")
-    elif state.in_force is not None:
-        what = ("on", f" {describe(state.in_force)} ")
-    else:
-        what = ("", " stopped")
+        return f"turning {session.rotation[1]:g}°{to_go}"
+    if session.in_force != STOP:
+        return session.in_force
+    if state.in_force is not None:
+        return describe(state.in_force)
+    return "stopped"
+
+
+def _in_force(session: ControlSession) -> list[Row]:
+    """What drives the car, then the keys' settings (on a row of their own if they do
+    not fit)."""
+    text = in_force_text(session)
+    what: Span = ("", " stopped") if text == "stopped" else ("on", f" {text} ")
     keys = f"speed {session.speed} · r/R {session.angle:g}° · {hold_mode(session.driving)}"
     room = WIDTH - len(" in force ") - len(what[1]) - 3
     if len(keys) <= room:

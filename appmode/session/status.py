@@ -14,6 +14,7 @@ from typing import Literal
 from appmode.host.state import HostState, LinkStats
 from appmode.protocol import app
 from appmode.session.hold import HoldToDrive
+from appmode.session.instruments import STALE, link
 from appmode.text import counted
 
 Tone = Literal["", "label", "on", "ok", "warn", "alert", "late", "low", "dim"]
@@ -23,11 +24,6 @@ Span = tuple[Tone, str]
 
 GLYPHS = (("↖", "↑", "↗"), ("←", "■", "→"), ("↙", "↓", "↘"))
 """The 3×3 grid's arrows: row 0 is the front."""
-STALE = 0.5
-"""Seconds without a record after which a reading shows how long it has been."""
-SILENT = 2.0
-"""Seconds after opening with nothing received after which the link row says what to
-check."""
 SILENT_HINT = "is the car on (and paired)? appmode doctor finds its port and baud rate"
 BAR = 20
 WIDTH = 80
@@ -68,19 +64,20 @@ def link_spans(
 ) -> tuple[Span, ...] | None:
     """Whether the link is up: counters (bytes unless `brief`), errors, how fresh what it
     brings is; None while the port is open and nothing has come."""
-    age = stats.since_last(now)
-    if not connected:
+    state = link(connected, stats, now)
+    if state.state == "lost":
         return (("alert", " LINK LOST — retrying; keys do nothing "),)
-    if age is None:
+    if state.age is None:
         return None
+    age = state.age
     last = f"{noun} live" if age < STALE else f"last {noun[:-1]} {age:.1f} s ago"
-    recent = stats.recent_errors(now)
-    if recent:
-        first: Span = ("warn", f" link DEGRADED: {counted(recent, 'error')} in 5 s ")
+    if state.state == "degraded":
+        first: Span = ("warn", f" link DEGRADED: {counted(state.recent_errors, 'error')} in 5 s ")
     else:
-        first = ("late" if age > 1.0 else "ok", " link up")
-    sizes = "" if brief else f"in {_size(stats.bytes_in)} · out {_size(stats.bytes_out)} · "
-    return first, ("", f"  {stats.rate(now):3.0f} {noun}/s · {sizes}errors {stats.errors} · {last}")
+        first = ("late" if state.state == "late" else "ok", " link up")
+    sizes = "" if brief else f"in {_size(state.bytes_in)} · out {_size(state.bytes_out)} · "
+    rate = f"  {state.rate:3.0f} {noun}/s · {sizes}errors {state.errors} · {last}"
+    return first, ("", rate)
 
 
 def link_rows(
@@ -97,7 +94,7 @@ def link_rows(
     spans = link_spans(connected, stats, now, noun, brief)
     if spans is not None:
         return [Row(label, spans)]
-    if now <= SILENT:
+    if link(connected, stats, now).state == "opening":
         return [Row(label, (("", " port open, nothing received "),))]
     return [
         Row(label, (("alert", " port open, nothing received "),)),

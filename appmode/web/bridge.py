@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import time
+from dataclasses import asdict
 from typing import Any
 
 from appmode.errors import AppmodeError
@@ -189,6 +190,7 @@ class Bridge:
             "role": self.role(page),
             "pages": len(self.pages),
             "rows": rows,
+            "instruments": _rounded(asdict(session.instruments())),
             "cells": session.cell_names(),
             "extra": list(session.hold_keys.values()),
             "lit": session.lit_cell(),
@@ -209,14 +211,33 @@ def _traces(state: HostState | None, now: float) -> dict[str, Any] | None:
     attitude = [(now - t, app.record_fields(a)[1]) for t, a in state.attitudes.points]
     labels = state.layout.labels
     series = [
-        {"label": labels[i], "points": [[round(ago, 3), values[i]] for ago, values in velocity]}
+        {
+            "label": labels[i],
+            "unit": "velocity unit",
+            "points": [[round(ago, 3), values[i]] for ago, values in velocity],
+        }
         for i in state.layout.motion
     ]
     series += [
-        {"label": name, "points": [[round(ago, 3), values[i]] for ago, values in attitude]}
-        for i, name in enumerate(("pitch", "roll", "yaw", "battery"))
+        {
+            "label": name,
+            "unit": unit,
+            "points": [[round(ago, 3), values[i]] for ago, values in attitude],
+        }
+        for i, (name, unit) in enumerate(app.ATTITUDE_UNITS.items())
     ]
     return {"seconds": TRACE_SECONDS, "series": series}
+
+
+def _rounded(value: Any) -> Any:
+    """Floats to 2 places, all the way down (ages and rates need no more on a page)."""
+    if isinstance(value, float):
+        return round(value, 2)
+    if isinstance(value, dict):
+        return {key: _rounded(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_rounded(item) for item in value]
+    return value
 
 
 def _unit(value: object) -> bool:

@@ -28,11 +28,14 @@ def browser() -> Iterator[Browser]:
             browser.close()
 
 
-def phone(browser: Browser, web: WebProcess) -> Page:
+def phone(browser: Browser, web: WebProcess, control: str = "pad") -> Page:
+    """A phone's page, its driving control chosen as a user's choice is remembered: the
+    3×3 pad (what these tests hold) or the joystick (the page's first choice)."""
     context = browser.new_context(
         viewport={"width": 360, "height": 640}, has_touch=True, is_mobile=True
     )
     page = context.new_page()
+    page.add_init_script(f"localStorage.setItem('appmode-control', '{control}')")
     page.goto(web.address)
     page.get_by_text("parameters read").wait_for(timeout=10_000)
     return page

@@ -128,9 +128,32 @@ $("command").addEventListener("submit", (event) => {
   $("line").value = "";
 });
 
-// ---------------------------------------------------------------- the analog pad (UART2)
+// ---------------------------------------------------------------- the joystick
 
+// On the APP port the stick is the app's direction page: eight sectors, a dead zone in
+// the middle, the sector under the finger held as a key is. On UART2 it is analog: the
+// farther from the centre, the faster. Either way, letting go stops the car.
+const STICK_DEAD_ZONE = 0.28; // of the radius
 const stick = { id: null, x: 0, y: 0, beat: null };
+const analog = () => Boolean(status && status.commands.includes("velocity"));
+
+function drawSectors() {
+  const wedge = (i) => {
+    const point = (degrees, r) => {
+      const a = (degrees * Math.PI) / 180;
+      return `${(r * Math.cos(a)).toFixed(1)} ${(-r * Math.sin(a)).toFixed(1)}`;
+    };
+    const [from, to] = [i * 45 - 22.5, i * 45 + 22.5];
+    return `M${point(from, 28)} L${point(from, 98)} A98 98 0 0 0 ${point(to, 98)} L${point(to, 28)} A28 28 0 0 1 ${point(from, 28)}Z`;
+  };
+  $("sectors").replaceChildren(...SECTORS.map((name, i) => {
+    const path = document.createElementNS("http://www.w3.org/2000/svg", "path");
+    path.setAttribute("d", wedge(i));
+    path.dataset.name = name;
+    return path;
+  }));
+}
+drawSectors();
 
 function stickAt(event) {
   const box = $("stick").getBoundingClientRect();
@@ -142,6 +165,14 @@ function stickAt(event) {
   const round = (v) => Math.round(v * 20) / 20;
   [x, y] = [round(x), round(y)];
   $("knob").style.transform = `translate(${x * radius}px, ${-y * radius}px)`;
+  if (!analog()) {
+    const name = Math.hypot(x, y) < STICK_DEAD_ZONE ? null : sector(x, y);
+    document.querySelectorAll("#sectors path").forEach((path) => {
+      path.classList.toggle("lit", path.dataset.name === name);
+    });
+    if (name === null) release("joystick"); else press("joystick", name);
+    return;
+  }
   if (x !== stick.x || y !== stick.y || stick.beat === null) {
     stick.x = x;
     stick.y = y;
@@ -155,7 +186,9 @@ $("stick").addEventListener("pointerdown", (event) => {
   stick.id = event.pointerId;
   stick.beat = null;
   stickAt(event);
-  stick.beat = setInterval(() => send({ t: "stick", x: stick.x, y: stick.y }), HEARTBEAT_MS);
+  if (analog()) {
+    stick.beat = setInterval(() => send({ t: "stick", x: stick.x, y: stick.y }), HEARTBEAT_MS);
+  }
 });
 $("stick").addEventListener("pointermove", (event) => {
   if (event.pointerId === stick.id) stickAt(event);
@@ -164,13 +197,36 @@ for (const name of ["pointerup", "pointercancel", "lostpointercapture"]) {
   $("stick").addEventListener(name, (event) => {
     if (event.pointerId !== stick.id) return;
     stick.id = null;
-    clearInterval(stick.beat);
-    stick.beat = null;
     $("knob").style.transform = "";
-    send({ t: "release" });
+    document.querySelectorAll("#sectors path").forEach((path) => path.classList.remove("lit"));
+    if (stick.beat !== null) {
+      clearInterval(stick.beat);
+      stick.beat = null;
+      send({ t: "release" });
+    } else {
+      release("joystick");
+    }
   });
 }
+$("stick").addEventListener("contextmenu", (event) => event.preventDefault());
 $("rotate").addEventListener("click", () => command(`rotate ${$("angle").value.trim()}`));
+
+let usePad = localStorage.getItem("appmode-control") === "pad";
+$("use-pad").addEventListener("click", () => {
+  usePad = !usePad;
+  localStorage.setItem("appmode-control", usePad ? "pad" : "stick");
+  if (status) showControl(status);
+});
+
+function showControl(message) {
+  const buttonPage = message.instruments.page === "button";
+  const pad = usePad || buttonPage;
+  $("pad").hidden = !pad;
+  $("stick").hidden = pad;
+  $("stick").classList.toggle("analog", analog());
+  $("use-pad").hidden = buttonPage;
+  $("use-pad").setAttribute("aria-pressed", String(usePad));
+}
 
 // ---------------------------------------------------------------- pages of the page
 
@@ -306,81 +362,279 @@ function showPad(cells, lit, extra) {
       const button = document.createElement("button");
       button.type = "button";
       button.setAttribute("aria-label", name);
-      button.textContent = `${GLYPHS[name] || ""} ${name}`;
+      button.textContent = GLYPHS[name] || name;
+      button.title = name;
       holdable(button, () => name);
       return button;
     }));
   }
 }
 
-function showValues(rows) {
-  const row = rows.find((r) => r.label === "params" || r.label === "settings");
-  const body = document.querySelector("#values tbody");
-  if (!row || !row.pairs.length) {
-    if (!body.children.length) {
-      body.innerHTML = "<tr><td>Not read yet: Read asks the board.</td></tr>";
+// ---------------------------------------------------------------- instruments
+
+const LINK_WORDS = {
+  up: "link up", late: "link late", degraded: "link degraded", lost: "LINK LOST",
+  opening: "port open", silent: "port silent",
+};
+
+function linkText(link, noun) {
+  if (link.state === "lost") return "LINK LOST";
+  if (link.age === null) return LINK_WORDS[link.state];
+  const errors = link.recent_errors ? ` · ${link.recent_errors} errors in 5 s` : "";
+  const late = link.state === "late" ? ` · ${link.age.toFixed(1)} s ago` : "";
+  return `${LINK_WORDS[link.state]} · ${Math.round(link.rate)} ${noun}/s${errors}${late}`;
+}
+
+function showInstruments(ins) {
+  const noun = analog() ? "messages" : "records";
+  $("link").textContent = linkText(ins.link, noun);
+  $("link").className = `chip ${ins.link.state}`;
+  $("in-force").textContent = ins.in_force;
+  $("force-tile").classList.toggle("moving", ins.moving);
+  $("page-name").textContent = ins.page ? `${ins.page} page` : "";
+  $("speed-name").textContent = ins.speed.name;
+  $("speed").textContent = ins.speed.value === null ? "—" : String(ins.speed.value);
+  const t = ins.telemetry;
+  const fresh = (age) => age !== null && age <= 0.5;
+  $("measured").textContent = t && t.speed !== null ? `now ${Math.round(t.speed)}` : "";
+  $("dials").hidden = !t;
+  $("battery-text").textContent = "— (no APP port)";
+  if (t) {
+    $("battery").value = t.battery === null ? 0 : Math.max(0, Math.min(100, t.battery));
+    $("battery-text").textContent = t.battery === null ? "—" : `${t.battery} %`;
+    $("battery-tile").classList.toggle("stale", !fresh(t.attitude_age));
+    $("dials").classList.toggle("stale", !fresh(t.attitude_age));
+    if (t.yaw !== null) {
+      $("needle").setAttribute("transform", `rotate(${t.yaw})`);
+      $("heading").setAttribute("aria-label", `heading ${t.yaw}°`);
+      const clamp = (v) => Math.max(-30, Math.min(30, v));
+      const [bx, by] = [clamp(t.roll), clamp(-t.pitch)];
+      $("bubble").setAttribute("cx", String(bx));
+      $("bubble").setAttribute("cy", String(by));
+      $("attitude").setAttribute("aria-label", `pitch ${t.pitch}°, roll ${t.roll}°`);
+      $("yaw").textContent = `${t.yaw}°`;
+      $("tilt-values").textContent = `pitch ${t.pitch}° roll ${t.roll}°`;
     }
+    $("motion").textContent = t.motion ? t.motion.map(([name, v]) => `${name} ${v}`).join("  ") : "";
+  }
+  $("driver-tile").hidden = ins.driver === null;
+  $("battery-tile").classList.toggle("wide", ins.driver === null);
+  $("driver").textContent = ins.driver === null ? "" : ins.driver;
+  $("wheels-tile").hidden = ins.driver === null;
+  showWheels(ins.wheels, ins.wheels_age, ins.speed.value);
+  showParams(ins.values, ins.values_read);
+}
+
+function showWheels(wheels, age, speed) {
+  const box = $("wheels");
+  if (!wheels) {
+    box.textContent = "— (the encoder report is off, or none came yet)";
     return;
   }
-  const pairs = row.pairs.map((pair) => [pair.slice(0, pair.lastIndexOf(" ")), pair.slice(pair.lastIndexOf(" ") + 1)]);
-  if (body.dataset.names !== pairs.map((p) => p[0]).join()) {
-    body.dataset.names = pairs.map((p) => p[0]).join();
-    body.replaceChildren(...pairs.map(([name]) => {
-      const tr = document.createElement("tr");
-      tr.innerHTML = "<th></th><td class=value></td><td><input inputmode=numeric size=8></td><td><button type=button>Set</button></td>";
-      tr.querySelector("th").textContent = name;
-      const input = tr.querySelector("input");
-      input.setAttribute("aria-label", `new ${name}`);
-      tr.querySelector("button").setAttribute("aria-label", `set ${name}`);
-      tr.querySelector("button").addEventListener("click", () => {
-        if (input.value.trim()) command(`set ${name} ${input.value.trim()}`);
-        input.value = "";
-      });
-      return tr;
-    }));
+  const top = Math.max(1, speed || 0, ...wheels.flatMap((w) => [Math.abs(w.target), Math.abs(w.actual)]));
+  const bar = (kind, v) => {
+    const part = document.createElement("span");
+    part.className = kind;
+    const width = (Math.abs(v) / top) * 50;
+    part.style.width = `${width}%`;
+    if (v < 0) part.style.left = `${50 - width}%`;
+    return part;
+  };
+  box.classList.toggle("stale", age === null || age > 0.5);
+  box.replaceChildren(...wheels.map((w) => {
+    const row = document.createElement("div");
+    row.className = "wheel";
+    const bars = document.createElement("div");
+    bars.className = "bars";
+    bars.append(bar("target", w.target), bar("actual", w.actual));
+    bars.setAttribute("role", "img");
+    bars.setAttribute("aria-label", `wheel ${w.name}: target ${w.target}, actual ${w.actual}`);
+    const [name, numbers] = [document.createElement("span"), document.createElement("span")];
+    name.textContent = w.name.toUpperCase();
+    numbers.textContent = `${w.target}/${w.actual}`;
+    row.append(name, bars, numbers);
+    return row;
+  }));
+}
+
+// ---------------------------------------------------------------- parameters
+
+const SLIDER_STEPS = 1000;
+
+function toSlider(value, low, high) { // wide ranges are logarithmic: fine near 0, reaching the top
+  if (high - low <= SLIDER_STEPS) return value;
+  return Math.round((Math.log1p(value - low) / Math.log1p(high - low)) * SLIDER_STEPS);
+}
+
+function fromSlider(position, low, high) {
+  if (high - low <= SLIDER_STEPS) return position;
+  return low + Math.round(Math.expm1((position / SLIDER_STEPS) * Math.log1p(high - low)));
+}
+
+function showParams(values, read) {
+  const box = $("values");
+  if (!read && !box.children.length) {
+    box.textContent = "Not read yet: Read asks the board.";
   }
-  pairs.forEach(([, value], i) => { body.children[i].querySelector(".value").textContent = value; });
+  if (!read) return;
+  if (box.dataset.names !== values.map((v) => v.name).join()) {
+    box.dataset.names = values.map((v) => v.name).join();
+    box.replaceChildren(...values.map((v) => paramRow(v)));
+  }
+  values.forEach((v, i) => {
+    const row = box.children[i];
+    row.classList.toggle("unsaved", v.unsaved);
+    row.querySelector(".value").textContent = v.value === null ? "?" : String(v.value);
+    const slider = row.querySelector("input[type=range]");
+    if (v.value !== null && document.activeElement !== slider && !slider.dataset.moved) {
+      slider.value = String(toSlider(v.value, v.minimum, v.maximum));
+    }
+  });
+  const unsaved = values.filter((v) => v.unsaved).map((v) => v.name);
+  $("unsaved").hidden = !unsaved.length;
+  $("unsaved").textContent = `Not saved to flash: ${unsaved.join(", ")}`;
+}
+
+function paramRow(v) {
+  const row = document.createElement("div");
+  row.className = "param";
+  row.innerHTML = '<div class="head"><span class="name"></span><span class="value"></span></div>'
+    + '<div class="edit"><input type="range"><input type="number" inputmode="numeric">'
+    + '<button type="button">Set</button></div>';
+  row.querySelector(".name").textContent = `${v.name} (${v.minimum}–${v.maximum})`;
+  const [slider, input] = row.querySelectorAll("input");
+  const wide = v.maximum - v.minimum > SLIDER_STEPS;
+  Object.assign(slider, { min: wide ? 0 : v.minimum, max: wide ? SLIDER_STEPS : v.maximum, step: 1 });
+  Object.assign(input, { min: v.minimum, max: v.maximum, step: 1 });
+  slider.setAttribute("aria-label", `${v.name} slider`);
+  input.setAttribute("aria-label", `new ${v.name}`);
+  slider.addEventListener("input", () => {
+    slider.dataset.moved = "1";
+    input.value = String(fromSlider(Number(slider.value), v.minimum, v.maximum));
+  });
+  const button = row.querySelector("button");
+  button.setAttribute("aria-label", `set ${v.name}`);
+  button.addEventListener("click", () => {
+    if (input.value.trim()) command(`set ${v.name} ${input.value.trim()}`);
+    input.value = "";
+    delete slider.dataset.moved;
+  });
+  return row;
+}
+
+// ---------------------------------------------------------------- waveforms
+
+const hiddenChannels = new Set();
+let paused = false;
+let lastTraces = null;
+
+$("pause").addEventListener("click", () => {
+  paused = !paused;
+  $("pause").setAttribute("aria-pressed", String(paused));
+  $("pause").textContent = paused ? "Resume" : "Pause";
+});
+
+function showChannels(traces) {
+  const box = $("channels");
+  const names = traces.series.map((s) => s.label).join();
+  if (box.dataset.names === names) return;
+  box.dataset.names = names;
+  box.replaceChildren(...traces.series.map((series, i) => {
+    const button = document.createElement("button");
+    button.type = "button";
+    button.textContent = series.label;
+    button.style.borderBottom = `4px solid ${channelColour(i)}`;
+    button.setAttribute("aria-pressed", String(!hiddenChannels.has(series.label)));
+    button.addEventListener("click", () => {
+      if (hiddenChannels.has(series.label)) hiddenChannels.delete(series.label);
+      else hiddenChannels.add(series.label);
+      button.setAttribute("aria-pressed", String(!hiddenChannels.has(series.label)));
+      drawWaves(lastTraces);
+    });
+    return button;
+  }));
+}
+
+function channelColour(i) { return `hsl(${(i * 67) % 360}, 75%, 42%)`; }
+
+function niceStep(span, count) { // 1, 2 or 5 × a power of ten: about `count` ticks
+  const raw = span / count;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  return [1, 2, 5, 10].map((m) => m * power).find((step) => step >= raw);
 }
 
 function showWaves(traces) {
+  if (!traces || $("waves").hidden) return;
+  showChannels(traces);
+  if (paused) return;
+  lastTraces = traces;
+  drawWaves(traces);
+}
+
+function drawWaves(traces) {
+  if (!traces) return;
   const canvas = $("chart");
-  if (!traces || canvas.closest(".tab").hidden) return;
+  const ratio = window.devicePixelRatio || 1;
+  const [width, height] = [canvas.clientWidth, canvas.clientHeight];
+  if (canvas.width !== Math.round(width * ratio)) canvas.width = Math.round(width * ratio);
+  if (canvas.height !== Math.round(height * ratio)) canvas.height = Math.round(height * ratio);
   const ctx = canvas.getContext("2d");
-  const styles = getComputedStyle(document.body);
-  const { width, height } = canvas;
+  ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
   ctx.clearRect(0, 0, width, height);
-  const strip = height / traces.series.length;
-  ctx.font = "14px monospace";
-  traces.series.forEach((series, i) => {
-    const top = i * strip;
-    const values = series.points.map((p) => p[1]);
-    const low = Math.min(...values, 0);
-    const high = Math.max(...values, 1);
-    ctx.strokeStyle = "#888";
+  const ink = getComputedStyle(document.body).color;
+  ctx.font = "12px system-ui, sans-serif";
+  const shown = traces.series.map((series, i) => [series, i]).filter(([s]) => !hiddenChannels.has(s.label));
+  const [left, right, axis] = [44, 6, 18]; // room for the scale, the edge, the time axis
+  const plotWidth = width - left - right;
+  const strip = (height - axis) / Math.max(1, shown.length);
+  const xAt = (ago) => left + plotWidth * (1 - ago / traces.seconds);
+  ctx.strokeStyle = "rgba(128, 128, 128, 0.35)";
+  ctx.fillStyle = ink;
+  ctx.textAlign = "center";
+  for (let ago = 0; ago <= traces.seconds; ago += 2) { // the time axis: a tick every 2 s
     ctx.beginPath();
-    ctx.moveTo(0, top + strip);
-    ctx.lineTo(width, top + strip);
+    ctx.moveTo(xAt(ago), 0);
+    ctx.lineTo(xAt(ago), height - axis);
     ctx.stroke();
-    ctx.strokeStyle = `hsl(${i * 50}, 70%, 45%)`;
+    ctx.fillText(ago ? `−${ago} s` : "now", Math.min(xAt(ago), width - 16), height - 4);
+  }
+  shown.forEach(([series, i], row) => {
+    const top = row * strip;
+    const values = series.points.map((p) => p[1]);
+    let [low, high] = values.length ? [Math.min(...values), Math.max(...values)] : [0, 1];
+    if (high - low < 1) { low -= 1; high += 1; }
+    const step = niceStep(high - low, Math.max(1, Math.floor(strip / 28)));
+    [low, high] = [Math.floor(low / step) * step, Math.ceil(high / step) * step];
+    const yAt = (v) => top + strip - 3 - ((v - low) / (high - low)) * (strip - 16);
+    ctx.textAlign = "right";
+    ctx.fillStyle = ink;
+    for (let v = low; v <= high + step / 2; v += step) { // the scale, fitting the data
+      ctx.strokeStyle = "rgba(128, 128, 128, 0.35)";
+      ctx.beginPath();
+      ctx.moveTo(left, yAt(v));
+      ctx.lineTo(width - right, yAt(v));
+      ctx.stroke();
+      ctx.fillText(String(Math.round(v * 100) / 100), left - 4, yAt(v) + 4);
+    }
+    ctx.strokeStyle = channelColour(i);
     ctx.lineWidth = 2;
     ctx.beginPath();
     series.points.forEach(([ago, value], j) => {
-      const x = width * (1 - ago / traces.seconds);
-      const y = top + strip - 4 - ((value - low) / (high - low || 1)) * (strip - 8);
-      if (j === 0) ctx.moveTo(x, y); else ctx.lineTo(x, y);
+      if (j === 0) ctx.moveTo(xAt(ago), yAt(value)); else ctx.lineTo(xAt(ago), yAt(value));
     });
     ctx.stroke();
     ctx.lineWidth = 1;
-    ctx.fillStyle = styles.color;
+    ctx.textAlign = "left";
+    ctx.fillStyle = channelColour(i);
     const last = values.length ? values[values.length - 1] : "—";
-    ctx.fillText(`${series.label} ${last}`, 4, top + 16);
+    ctx.fillText(`${series.label} ${last} ${series.unit}`, left + 4, top + 12);
   });
 }
 
 function showStatus(message) {
   status = message;
   $("title").textContent = message.title.replace("appmode drive", "appmode web");
-  $("badge").textContent = message.simulated ? "SIMULATED BOARD" : "REAL BOARD";
+  $("badge").textContent = message.simulated ? "SIMULATED" : "REAL BOARD";
   $("badge").className = `badge ${message.simulated ? "simulated" : "real"}`;
   $("url").textContent = message.url;
   const driving = message.role === "driver";
@@ -389,11 +643,18 @@ function showStatus(message) {
     : `This page watches (${message.pages} pages open): another page drives.`;
   $("take").hidden = driving;
   document.body.classList.toggle("watching", !driving);
+  const page = message.instruments.page;
   $("pages").hidden = !message.commands.includes("page");
-  $("analog").hidden = !message.commands.includes("velocity");
+  document.querySelectorAll("#pages button").forEach((button) => {
+    const on = button.dataset.page === "button" ? page === "button" : page !== "button";
+    button.setAttribute("aria-pressed", String(on));
+  });
+  $("turn").hidden = !message.commands.includes("rotate");
+  document.body.classList.toggle("uart2", analog());
+  showControl(message);
   showRows(message.rows);
   showPad(message.cells, message.lit, message.extra);
-  showValues(message.rows);
+  showInstruments(message.instruments);
   showWaves(message.traces);
   $("messages").replaceChildren(...message.messages.map((text) => {
     const line = document.createElement("div");

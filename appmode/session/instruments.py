@@ -1,0 +1,146 @@
+"""What a session shows, as values for instruments (a gauge, a dial, a slider) rather than
+text: the page's components read these; the console's rows (`status.py`) are built from
+the same link state and freshness rules, so both views say the same thing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+from appmode.host.state import HostState, LinkStats
+from appmode.protocol import app
+
+LinkState = Literal["up", "late", "degraded", "lost", "opening", "silent"]
+"""Up and fresh; up but the last record is over LATE old; errors in the last 5 s; the
+link lost; open with nothing received yet; open and silent past SILENT."""
+STALE = 0.5
+"""Seconds without a record after which a reading shows how long it has been."""
+LATE = 1.0
+"""Seconds without a record after which the link itself is late."""
+SILENT = 2.0
+"""Seconds after opening with nothing received after which the link is called silent
+(and the view says what to check)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Link:
+    """How a link is: its state, records a second, errors (all and in the last 5 s) and
+    the age of its last record (None: nothing came)."""
+
+    state: LinkState
+    rate: float
+    errors: int
+    recent_errors: int
+    age: float | None
+    bytes_in: int
+    bytes_out: int
+
+
+def link(connected: bool, stats: LinkStats, now: float) -> Link:
+    """The link's state from its counters: the one rule every view follows."""
+    age = stats.since_last(now)
+    recent = stats.recent_errors(now)
+    state: LinkState
+    if not connected:
+        state = "lost"
+    elif age is None:
+        state = "opening" if now <= SILENT else "silent"
+    elif recent:
+        state = "degraded"
+    else:
+        state = "late" if age > LATE else "up"
+    return Link(state, stats.rate(now), stats.errors, recent, age, stats.bytes_in, stats.bytes_out)
+
+
+@dataclass(frozen=True, slots=True)
+class Telemetry:
+    """The A and B records as numbers: the motion fields by their labels, attitude in
+    degrees, battery in percent; each None until its record came, and with its age."""
+
+    motion: tuple[tuple[str, int], ...] | None
+    speed: float | None
+    """The largest speed the motion fields show, in the board's velocity unit."""
+    motion_age: float | None
+    pitch: int | None
+    roll: int | None
+    yaw: int | None
+    battery: int | None
+    attitude_age: float | None
+
+
+def telemetry(state: HostState, now: float) -> Telemetry:
+    v, a = state.velocity, state.attitude
+    motion, speed = None, None
+    if v is not None:
+        values, labels = app.record_fields(v)[1], state.layout.labels
+        motion = tuple((labels[i], values[i]) for i in state.layout.motion)
+        speed = state.layout.speed(values)
+    return Telemetry(
+        motion,
+        speed,
+        state.velocities.age(now),
+        None if a is None else a.pitch,
+        None if a is None else a.roll,
+        None if a is None else a.yaw,
+        None if a is None else a.battery,
+        state.attitudes.age(now),
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class Value:
+    """A value a user sets (a parameter, a setting, the keys' speed): its name, what it
+    is now (None: not read), its range, and whether it changed since it was last saved."""
+
+    name: str
+    value: int | None
+    minimum: int
+    maximum: int
+    unsaved: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class Wheel:
+    """One wheel of the control port's encoder report: target and actual speed."""
+
+    name: str
+    target: int
+    actual: int
+
+
+@dataclass(frozen=True, slots=True)
+class Instruments:
+    """Everything a page draws besides the key grid."""
+
+    link: Link
+    telemetry: Telemetry | None
+    """The APP port's records (None: the session has no APP port)."""
+    app_link: Link | None
+    """The APP port's link when the session also holds the control port."""
+    in_force: str
+    """What drives the car, in words ("stopped" when nothing does)."""
+    moving: bool
+    page: str | None
+    """The app page the board is on (joystick, gravity, button), or None (UART2)."""
+    speed: Value
+    """What the speed keys change: max_speed on the APP port, the keys' speed on UART2."""
+    values: tuple[Value, ...]
+    """The parameters (or settings) in the table's order."""
+    values_read: bool
+    wheels: tuple[Wheel, ...] | None
+    """The encoder report, on the control port (None: off or not come)."""
+    wheels_age: float | None
+    driver: str | None
+    """Who drives, on the control port: "UART2" once it took over, else "APP port"."""
+
+
+def values(
+    table: Sequence[tuple[str, int, int]], now: dict[str, int], unsaved: Collection[str]
+) -> tuple[Value, ...]:
+    """Each (name, minimum, maximum) of a table with its value now (None: not read) and
+    whether it is among the unsaved."""
+    return tuple(
+        Value(name, now.get(name), low, high, name in unsaved) for name, low, high in table
+    )
