@@ -42,7 +42,14 @@ def lighthouse(tool: str, url: str) -> list[str]:
             check=True,
             timeout=300,
         )
-        categories = json.loads(report.read_text())["categories"]
+        result = json.loads(report.read_text())
+    categories, audits = result["categories"], result["audits"]
+    metrics = ("first-contentful-paint", "largest-contentful-paint", "total-blocking-time")
+    shown = [
+        f"{audits[m]['title']} {audits[m]['displayValue']}"
+        for m in (*metrics, "cumulative-layout-shift", "speed-index")
+    ]
+    print("lighthouse metrics: " + ", ".join(shown))
     missed = []
     for name, target in TARGETS.items():
         score = round(categories[name]["score"] * 100)

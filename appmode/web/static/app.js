@@ -226,6 +226,12 @@ function showControl(message) {
   $("stick").classList.toggle("analog", analog());
   $("use-pad").hidden = buttonPage;
   $("use-pad").setAttribute("aria-pressed", String(usePad));
+  if (stick.id === null) { // driven another way (a key, the gamepad, tilt): the sector lights
+    const lit = message.lit && message.cells[message.lit[0]][message.lit[1]];
+    document.querySelectorAll("#sectors path").forEach((path) => {
+      path.classList.toggle("lit", path.dataset.name === lit);
+    });
+  }
 }
 
 // ---------------------------------------------------------------- pages of the page
