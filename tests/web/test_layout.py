@@ -68,8 +68,8 @@ def small_targets(page: Page) -> list[str]:
     """The Drive view's visible buttons and inputs under FINGER px either way."""
     found: list[str] = page.evaluate(
         """(finger) => [...document.querySelectorAll(
-            'header button, nav button, #drive button, #drive input, #command button, #command input')]
-          .filter((e) => e.getClientRects().length)
+            'header button, nav button, #drive button, #drive input, #command *')]
+          .filter((e) => /^(BUTTON|INPUT)$/.test(e.tagName) && e.getClientRects().length)
           .map((e) => [e, e.getBoundingClientRect()])
           .filter(([, r]) => r.width < finger - 0.5 || r.height < finger - 0.5)
           .map(([e, r]) => `${e.id || e.getAttribute('aria-label') || e.textContent}`
