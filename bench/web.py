@@ -4,7 +4,7 @@ what the page weighs.
 
 The latency bench is its own board: it opens a pty pair, gives `appmode web` the slave
 and reads the master, so each byte is timed where the board would read it.
-`--screenshots DIR` saves the page at 360×640 and 1280×800 (docs/ keeps them).
+`--screenshots DIR` saves the page at 360×640, 640×360 and 1280×800 (docs/ keeps them).
 """
 
 from __future__ import annotations
@@ -38,8 +38,15 @@ def web(url: str, *args: str) -> AbstractContextManager[tuple[subprocess.Popen[s
 def open_page(browser: Browser, address: str, width: int = 360, height: int = 640) -> Page:
     page = browser.new_page(viewport={"width": width, "height": height})
     page.goto(address)
-    page.locator("#status .row").first.wait_for(timeout=10_000)
+    page.locator("#badge.simulated, #badge.real").wait_for(timeout=10_000)  # a status came
     return page
+
+
+def forward(page: Page) -> tuple[float, float]:
+    """Where a finger pushes the joystick forward (the page's first control)."""
+    box = page.locator("#stick").bounding_box()
+    assert box is not None
+    return box["x"] + box["width"] / 2, box["y"] + box["height"] * 0.15
 
 
 def read_until(fd: int, wanted: bytes, timeout: float = 2.0) -> float:
@@ -55,16 +62,15 @@ def read_until(fd: int, wanted: bytes, timeout: float = 2.0) -> float:
 
 
 def latency(browser: Browser, presses: int) -> list[float]:
-    """Seconds from the pointer going down on ↑ to the `A` reaching the board."""
+    """Seconds from the pointer going down on the joystick's ↑ to the `A` reaching the
+    board."""
     master, slave = pty.openpty()
     tty.setraw(slave)
     tty.setraw(master)
     took = []
     with web(os.ttyname(slave)) as (_, address):
         page = open_page(browser, address)
-        box = page.get_by_role("button", name="forward", exact=True).bounding_box()
-        assert box is not None
-        page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+        page.mouse.move(*forward(page))
         time.sleep(0.5)
         os.read(master, 4096)  # the session's start
         for _ in range(presses):
@@ -108,15 +114,21 @@ def weight_and_paint(browser: Browser) -> tuple[int, float]:
     return size, float(paint)
 
 
+SHOTS = (
+    (360, 640, "web-phone.png"),
+    (640, 360, "web-landscape.png"),
+    (1280, 800, "web-desktop.png"),
+)
+"""The screenshots docs/ keeps: a phone upright and on its side, a desktop."""
+
+
 def screenshots(browser: Browser, folder: Path) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     with web("sim://") as (_, address):
-        for width, height, name in ((360, 640, "web-phone.png"), (1280, 800, "web-desktop.png")):
+        for width, height, name in SHOTS:
             page = open_page(browser, address, width, height)
             page.get_by_text("parameters read").wait_for(timeout=10_000)
-            box = page.get_by_role("button", name="forward", exact=True).bounding_box()
-            assert box is not None
-            page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+            page.mouse.move(*forward(page))
             page.mouse.down()
             time.sleep(1.0)  # the car under way, its velocity shown
             page.screenshot(path=str(folder / name))
@@ -137,7 +149,7 @@ def rows(quick: bool) -> list[Row]:
             browser.close()
     return [
         Row(
-            "web: pointer-down on ↑ to A on the board",
+            "web: pointer-down on the joystick's ↑ to A on the board",
             f"p50 {percentile(took, 50):.1f} ms, p99 {percentile(took, 99):.1f} ms "
             f"(n={len(took)}, Chromium)",
             "p99 < 30 ms",

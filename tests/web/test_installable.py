@@ -42,12 +42,12 @@ def test_the_page_is_tidy_installable_and_says_when_the_server_is_gone(
                 icon: document.querySelector('link[rel=icon]').href,
                 manifest: document.querySelector('link[rel=manifest]').href,
                 dark: matchMedia('(prefers-color-scheme: dark)').matches,
-                pad: getComputedStyle(document.querySelector('#pad button')).backgroundColor,
+                pad: getComputedStyle(document.querySelector("#stick")).backgroundColor,
             })"""
         )
         assert "user-scalable" not in head["viewport"] and "maximum-scale" not in head["viewport"]
         assert len(head["description"]) > 50 and head["theme"].startswith("#")
-        assert head["dark"] and head["pad"] == "rgb(42, 42, 42)", "dark mode follows the system"
+        assert head["dark"] and head["pad"] == "rgb(38, 38, 38)", "dark mode follows the system"
         manifest = page.evaluate(f"fetch({json.dumps(head['manifest'])}).then(r => r.json())")
         assert manifest["start_url"] == "/" and manifest["display"] == "standalone"
         for icon in manifest["icons"]:
