@@ -147,7 +147,7 @@ def test_the_joystick_drives_by_sector_stops_in_its_dead_zone_and_on_release(
         assert not page.locator("#stick").is_visible()
 
 
-def test_the_instruments_show_the_car_and_the_speed_keys_show_their_value(
+def test_the_instruments_show_the_car_the_speed_keys_their_value_and_a_lost_link(
     browser: Browser, tmp_path: Path
 ) -> None:
     with web_process(tmp_path) as web:
@@ -171,6 +171,11 @@ def test_the_instruments_show_the_car_and_the_speed_keys_show_their_value(
         page.mouse.up()
         wait_sent(web, "Z")
         text_is(page, "#in-force", "stopped")
+        web.board.proc.kill()  # the board gone: the chip says so, the readings dim
+        text_is(page, "#link", "LINK LOST")
+        assert page.locator("#link").get_attribute("class") == "chip lost"
+        until(page, "() => document.getElementById('dials').classList.contains('stale')")
+        assert "stale" in (page.locator("#battery-tile").get_attribute("class") or "")
 
 
 def test_over_uart2_the_wheels_show_as_bars_and_who_drives(

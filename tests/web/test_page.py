@@ -164,6 +164,7 @@ def test_tilting_drives_past_the_dead_zone_and_level_stops(
         tilt(40, 0)  # level again: stop
         wait_sent(web, "Z")
         assert "I" in web.sent(), "tilt drives on the gravity page, as the app does"
+        assert page.locator("#tilt-page").inner_text() == "gravity"
         page.screenshot(path=str(tmp_path / "tilt.png"))
 
 

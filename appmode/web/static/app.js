@@ -398,6 +398,8 @@ function showInstruments(ins) {
   $("in-force").textContent = ins.in_force;
   $("force-tile").classList.toggle("moving", ins.moving);
   $("page-name").textContent = ins.page ? `${ins.page} page` : "";
+  $("tilt-page").textContent = ins.page || "";
+  $("tilt-page-line").hidden = !ins.page;
   $("speed-name").textContent = ins.speed.name;
   $("speed").textContent = ins.speed.value === null ? "—" : String(ins.speed.value);
   const t = ins.telemetry;
