@@ -1,7 +1,7 @@
 """The phone page held to Lighthouse and axe-core: serve `appmode web` on the simulated
-board, run Lighthouse (mobile) on it and axe-core on each tab, light and dark, at a
-phone's size; exit 1 below the targets or on any axe violation. `.ci/run` runs it with
-both from npm:
+board, run Lighthouse (mobile) on it and axe-core on each tab, light and dark, on the
+APP port and over UART2, at a phone's size; exit 1 below the targets or on any axe
+violation. `.ci/run` runs it with both from npm:
 
     npm install --prefix DIR lighthouse@12.2.3 axe-core@4
     python bench/page_audit.py --lighthouse DIR/node_modules/.bin/lighthouse \\
@@ -59,8 +59,9 @@ def lighthouse(tool: str, url: str) -> list[str]:
     return missed
 
 
-def axe(script: str, url: str) -> list[str]:
-    """axe-core's violations on every tab, light and dark, at 360 x 640."""
+def axe(script: str, url: str, port: str) -> list[str]:
+    """axe-core's violations on every tab, light and dark, at 360 x 640, on the page of
+    `port` (app or uart2)."""
     from playwright.sync_api import sync_playwright
 
     source = Path(script).read_text(encoding="utf-8")
@@ -77,15 +78,16 @@ def axe(script: str, url: str) -> list[str]:
             )
             page = context.new_page()
             page.goto(url)
-            page.get_by_text("parameters read").wait_for(timeout=10_000)
+            ready = "settings read" if port == "uart2" else "parameters read"
+            page.get_by_text(ready).wait_for(timeout=10_000)
             page.evaluate(source)
             for tab in TABS:
                 page.locator(f'nav button[data-tab="{tab}"]').click()
                 result = page.evaluate("axe.run(document).then(r => r.violations)")
                 for violation in result:
                     nodes = len(violation["nodes"])
-                    found.append(f"axe {scheme} {tab}: {violation['id']} ({nodes} nodes)")
-                print(f"axe {scheme} {tab}: {len(result)} violations")
+                    found.append(f"axe {port} {scheme} {tab}: {violation['id']} ({nodes} nodes)")
+                print(f"axe {port} {scheme} {tab}: {len(result)} violations")
             context.close()
         browser.close()
     return found
@@ -96,19 +98,24 @@ def main() -> int:
     parser.add_argument("--lighthouse", required=True, help="the lighthouse command")
     parser.add_argument("--axe", required=True, help="axe.min.js")
     args = parser.parse_args()
-    web = subprocess.Popen(
-        [sys.executable, "-m", "appmode", "web", "sim://", "--listen", "127.0.0.1:0"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        text=True,
-    )
-    try:
-        assert web.stdout is not None
-        url = web.stdout.readline().removeprefix("web: ").strip()
-        missed = lighthouse(args.lighthouse, url) + axe(args.axe, url)
-    finally:
-        web.send_signal(signal.SIGINT)
-        web.wait(10)
+    missed = []
+    for port in ("app", "uart2"):
+        web = subprocess.Popen(
+            [sys.executable, "-m", "appmode", "web", "sim://", "--listen", "127.0.0.1:0"]
+            + (["--uart2"] if port == "uart2" else []),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+        try:
+            assert web.stdout is not None
+            url = web.stdout.readline().removeprefix("web: ").strip()
+            if port == "app":
+                missed += lighthouse(args.lighthouse, url)
+            missed += axe(args.axe, url, port)
+        finally:
+            web.send_signal(signal.SIGINT)
+            web.wait(10)
     for line in missed:
         print(f"missed: {line}", file=sys.stderr)
     return 1 if missed else 0

@@ -241,7 +241,6 @@ class Session(BaseSession):
         return Instruments(
             link=instruments.link(host.connected, state.stats, now),
             telemetry=instruments.telemetry(state, now),
-            app_link=None,
             in_force="stopped" if not self.moving else letter_name(self.page, self.in_force),
             moving=self.moving,
             page=PAGE_NAMES[self.page_letter],

@@ -27,18 +27,17 @@ from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.layouts import VELOCITY, ALayout
 from appmode.protocol.params import DriveType
-from appmode.session import instruments
 from appmode.session.base import SPEED_KEYS, BaseSession
 from appmode.session.control_commands import COMMANDS, SETTING_NAMES
 from appmode.session.control_status import (
     STOP,
     control_grid,
+    control_instruments,
     control_lit,
     control_rows,
-    in_force_text,
 )
 from appmode.session.hold import HoldToDrive
-from appmode.session.instruments import Instruments, Value, Wheel
+from appmode.session.instruments import Instruments
 from appmode.session.status import Row
 
 DEFAULT_SPEED = 300
@@ -361,10 +360,10 @@ class ControlSession(BaseSession):
         if self.baseline is None:
             return None
         now = self._comparable(self.host.state.values)
-        changed = [f"{name} {self.baseline[name]} → {now[name]}" for name in self._unsaved()]
+        changed = [f"{name} {self.baseline[name]} → {now[name]}" for name in self.unsaved()]
         return f"not saved: {', '.join(changed)}" if changed else None
 
-    def _unsaved(self) -> list[str]:
+    def unsaved(self) -> list[str]:
         """The settings changed since they were read or saved."""
         if self.baseline is None:
             return []
@@ -376,32 +375,7 @@ class ControlSession(BaseSession):
         ]
 
     def instruments(self) -> Instruments:
-        host, state = self.host, self.host.state
-        now = host.now()
-        table = [(s.name, 0, s.maximum) for s in settings.SETTINGS]
-        values = instruments.values(table, state.values, self._unsaved())
-        report = state.report
-        wheels = None
-        if report is not None:
-            pairs = zip(settings.WHEELS, report.targets, report.actuals, strict=False)
-            wheels = tuple(Wheel(name, target, actual) for name, target, actual in pairs)
-        app = self.app
-        return Instruments(
-            link=instruments.link(host.connected, state.stats, now),
-            telemetry=None if app is None else instruments.telemetry(app.state, app.now()),
-            app_link=None
-            if app is None
-            else instruments.link(app.connected, app.state.stats, app.now()),
-            in_force=in_force_text(self),
-            moving=self.moving,
-            page=None,
-            speed=Value("speed", self.speed, 0, self._top_speed()),
-            values=values,
-            values_read=any(value.value is not None for value in values),
-            wheels=wheels,
-            wheels_age=None if state.report_at is None else now - state.report_at,
-            driver="UART2" if state.took_over_at is not None else "APP port",
-        )
+        return control_instruments(self)
 
     @staticmethod
     def _comparable(values: dict[str, int]) -> dict[str, int]:
@@ -423,7 +397,7 @@ class ControlSession(BaseSession):
             if args[0][0] in "+-"
             else number
         )
-        top = self._top_speed()
+        top = self.top_speed()
         self.speed = min(top, max(0, wanted))
         unit = (
             "‰ duty"
@@ -432,7 +406,7 @@ class ControlSession(BaseSession):
         )
         self.say(f"speed {self.speed}{unit}")
 
-    def _top_speed(self) -> int:
+    def top_speed(self) -> int:
         """The largest speed: a duty's ‰ on a differential car, else the frame's limit."""
         differential = self.drive is not None and self.drive.differential
         return control.MAX_DUTY if differential else control.U16

@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING
 
 from appmode.protocol import settings
 from appmode.protocol.control_view import describe
+from appmode.session import instruments
+from appmode.session.instruments import Instruments, Value, Wheel
 from appmode.session.status import (
     GLYPHS,
     WIDTH,
@@ -93,6 +95,33 @@ def _in_force(session: ControlSession) -> list[Row]:
     if len(keys) <= room:
         return [Row("in force", (what, ("", f"   {keys}")))]
     return [Row("in force", (what,)), Row("", (("", f"{' ' * 10}{keys}"),))]
+
+
+def control_instruments(session: ControlSession) -> Instruments:
+    """What the page's instruments show over the control port."""
+    host, state = session.host, session.host.state
+    now = host.now()
+    table = [(s.name, 0, s.maximum) for s in settings.SETTINGS]
+    values = instruments.values(table, state.values, session.unsaved())
+    report = state.report
+    wheels = None
+    if report is not None:
+        pairs = zip(settings.WHEELS, report.targets, report.actuals, strict=False)
+        wheels = tuple(Wheel(name, target, actual) for name, target, actual in pairs)
+    app = session.app
+    return Instruments(
+        link=instruments.link(host.connected, state.stats, now),
+        telemetry=None if app is None else instruments.telemetry(app.state, app.now()),
+        in_force=in_force_text(session),
+        moving=session.moving,
+        page=None,
+        speed=Value("speed", session.speed, 0, session.top_speed()),
+        values=values,
+        values_read=any(value.value is not None for value in values),
+        wheels=wheels,
+        wheels_age=None if state.report_at is None else now - state.report_at,
+        driver="UART2" if state.took_over_at is not None else "APP port",
+    )
 
 
 def control_grid(session: ControlSession) -> list[list[str]]:

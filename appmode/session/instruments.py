@@ -117,8 +117,6 @@ class Instruments:
     link: Link
     telemetry: Telemetry | None
     """The APP port's records (None: the session has no APP port)."""
-    app_link: Link | None
-    """The APP port's link when the session also holds the control port."""
     in_force: str
     """What drives the car, in words ("stopped" when nothing does)."""
     moving: bool

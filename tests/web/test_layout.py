@@ -176,6 +176,7 @@ def test_the_instruments_show_the_car_the_speed_keys_their_value_and_a_lost_link
         assert page.locator("#link").get_attribute("class") == "chip lost"
         until(page, "() => document.getElementById('dials').classList.contains('stale')")
         assert "stale" in (page.locator("#battery-tile").get_attribute("class") or "")
+        assert "stale" in (page.locator("#motion").get_attribute("class") or "")
 
 
 def test_over_uart2_the_wheels_show_as_bars_and_who_drives(

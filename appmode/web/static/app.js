@@ -424,6 +424,8 @@ function showInstruments(ins) {
       $("tilt-values").textContent = `pitch ${t.pitch}° roll ${t.roll}°`;
     }
     $("motion").textContent = t.motion ? t.motion.map(([name, v]) => `${name} ${v}`).join("  ") : "";
+    $("motion").classList.toggle("stale", !fresh(t.motion_age));
+    $("measured").classList.toggle("stale", !fresh(t.motion_age));
   }
   $("driver-tile").hidden = ins.driver === null;
   $("battery-tile").classList.toggle("wide", ins.driver === null);
