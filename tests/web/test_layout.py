@@ -205,6 +205,9 @@ def test_over_uart2_the_wheels_show_as_bars_and_who_drives(
             " /target 0,/.test(b.getAttribute('aria-label')))",
         )
         assert web.frames()[-1] == "FF FE 01 00 00 00 00 00 00 00"
+        page.get_by_role("button", name="Waves").click()  # no APP port: nothing to draw
+        page.get_by_text("No records to draw").wait_for()
+        assert not page.locator("#chart").is_visible()
 
 
 def test_params_are_sliders_with_exact_entry_and_unsaved_values_are_marked(

@@ -665,6 +665,8 @@ function showStatus(message) {
   showRows(message.rows);
   showPad(message.cells, message.lit, message.extra);
   showInstruments(message.instruments);
+  $("waves-note").hidden = message.instruments.telemetry !== null;
+  $("chart").hidden = message.instruments.telemetry === null;
   showWaves(message.traces);
   $("messages").replaceChildren(...message.messages.map((text) => {
     const line = document.createElement("div");
