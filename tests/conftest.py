@@ -14,12 +14,15 @@ import pytest
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers for two cores. Most tests wait on boards, ptys and
-    processes in real time, so more workers than cores keep the cores busy (5 min 2 s of
-    CPU in a 5 min 17 s run); four made two real-time tests fail on an idle machine (a
-    send 3.5 ms early against a served board; a sim:// recording read late)."""
+    """`-n auto`: four workers for two cores. Most tests wait on boards, ptys and
+    processes in real time, so more workers than cores keep the cores busy (4 min 50 s
+    of CPU in a 4 min 6 s run; three workers took 5 min 10 s). Four once made real-time
+    tests fail: each cause is gone (a test's symlink kept leading to a dead board's
+    /dev/pts/N, which another worker's board then got; a send's earliness measured
+    against a median that carries the load's latency; a sim:// recording out of time
+    order)."""
     cores = os.cpu_count() or 1
-    return cores + cores // 2
+    return 2 * cores
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

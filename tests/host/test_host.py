@@ -153,8 +153,8 @@ def test_a_path_that_opens_again_without_a_board_is_not_back(tmp_path: Path) -> 
             master, slave = pty.openpty()  # another program's pty
             try:
                 board.kill()
+                link.unlink()  # at once: /dev/pts/N may be a new board's soon (a test beside)
                 statuses = [e for e in host.events(0.6) if isinstance(e, LinkStatus)]
-                link.unlink()
                 link.symlink_to(os.ttyname(slave))
                 statuses += [e for e in host.events(1.5) if isinstance(e, LinkStatus)]
                 assert not host.connected and host.link is not None, "open, not proven"
