@@ -77,10 +77,12 @@ def test_holding_up_drives_and_letting_go_stops(
 def test_a_single_tap_stops_after_the_first_timeout(
     tmp_path: Path, quit_key: tuple[str, float]
 ) -> None:
-    _, record, typed = run_console(tmp_path, [(UP, 1.0), quit_key], first_timeout=0.4)
+    _, record, typed = run_console(tmp_path, [(UP, 2.0), quit_key], first_timeout=0.4)
     lines = sent(record)
     z_time = next(t for t, p in lines if p == "Z" and t > typed[0])
-    assert 0.38 <= z_time - typed[0] <= 0.6
+    # at its first timeout, not a repeat's (0.15 s) nor the quit's (2 s): on a machine
+    # running a second suite beside this one the stop came 0.36 s late
+    assert 0.38 <= z_time - typed[0] <= 1.0
 
 
 def test_grid_keys_follow_the_page(tmp_path: Path, quit_key: tuple[str, float]) -> None:
