@@ -22,6 +22,7 @@ COMMANDS: dict[str, str] = {
     "scan": "list nearby Bluetooth modules (BLE and paired classic) and their URLs",
     "doctor": "find the car: check each serial port and say how to drive it or what to fix",
     "protocol": "print the protocol reference, or one of its sections",
+    "profile": "list the firmware profiles, show one, check your own profile file",
     "completion": "print the shell's completion script (bash, zsh, fish)",
 }
 """Each command's one-line help; its module has `register(sub)` (its arguments) and
@@ -53,6 +54,11 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "replay": (
         "appmode replay car.transcript --to /dev/ttyUSB0",
         "appmode replay car.transcript --to pty --side board",
+    ),
+    "profile": (
+        "appmode profile list",
+        "appmode profile show balance",
+        "appmode profile check my-car.toml",
     ),
     "tap": (
         "appmode tap pty /dev/ttyUSB0 --record app.transcript",

@@ -1,9 +1,11 @@
 """What the four fields of an A record mean (§3.1, §13): the sheet's signed velocity, or
 the reference firmware's |0.7·x|, |0.7·y| and battery. The grammar is the same; a host
-that shows or checks the fields picks a layout (`--profile`)."""
+that shows or checks the fields picks a layout (`--profile`); both come from the
+profiles' files."""
 
 from __future__ import annotations
 
+from appmode.protocol import profile_file
 from appmode.protocol.slotted import Frozen
 
 
@@ -50,16 +52,24 @@ class ALayout(Frozen):
         return max(abs(values[i]) for i in self.motion) / self.scale
 
 
-VELOCITY = ALayout(
-    "velocity", ("x", "y", "z", "extra"), (0, 1, 2), 1.0, True, ("x", "y", "z", "extra")
-)
-SCALED = ALayout(
-    "scaled",
-    ("abs_x", "abs_y", "battery", "extra"),
-    (0, 1),
-    0.7,
-    False,
-    ("|0.7x|", "|0.7y|", "battery", "extra"),
-    battery=2,
-)
+def from_profile(name: str, profile: profile_file.ProfileFile) -> ALayout:
+    """The A record's layout a profile file declares (its motion fields share one scale
+    and signedness)."""
+    fields = profile.a
+    motion = tuple(i for i, field in enumerate(fields) if field.motion)
+    first = fields[motion[0]] if motion else fields[0]
+    battery = next((i for i, field in enumerate(fields) if field.battery), None)
+    return ALayout(
+        name,
+        tuple(field.name for field in fields),  # type: ignore[arg-type]  # four: checked
+        motion,
+        first.scale,
+        first.signed,
+        tuple(field.label for field in fields),  # type: ignore[arg-type]
+        battery,
+    )
+
+
+VELOCITY = from_profile("velocity", profile_file.load("sheet"))
+SCALED = from_profile("scaled", profile_file.load("minibalance"))
 A_LAYOUTS: dict[str, ALayout] = {layout.name: layout for layout in (VELOCITY, SCALED)}

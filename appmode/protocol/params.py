@@ -1,4 +1,5 @@
-"""The nine board parameters and the system-mode bits (docs/protocol.md §5, §6): one table.
+"""The nine board parameters and the system-mode bits (docs/protocol.md §5, §6): one table,
+the sheet's profile file's.
 
 The codec, the board model, the host, the console and the docs all read these tables;
 nothing else in appmode spells out a parameter's name, range or default.
@@ -11,6 +12,7 @@ from enum import IntEnum
 from typing import NamedTuple
 
 from appmode.errors import InvalidValue
+from appmode.protocol import profile_file
 
 U16 = 0xFFFF
 U32 = 0xFFFF_FFFF
@@ -32,17 +34,11 @@ class Param(NamedTuple):
         return f"{self.minimum}–{self.maximum}"
 
 
-PARAMS: tuple[Param, ...] = (
-    Param(0, "max_speed", "max speed (velocity unit)", U16, 500),
-    Param(1, "max_position", "position-mode position limit", U16, 10000),
-    Param(2, "position_kp", "position Kp", U32, 20),
-    Param(3, "position_ki", "position Ki", U32, 0),
-    Param(4, "position_kd", "position Kd", U32, 10),
-    Param(5, "velocity_kp", "velocity Kp", U32, 10),
-    Param(6, "velocity_ki", "velocity Ki", U32, 10),
-    Param(7, "gyro_compensation", "gyro compensation (0.00001)", U32, 0),
-    Param(8, "system_mode", "system mode bits", U16, 0),
+PARAMS: tuple[Param, ...] = tuple(
+    Param(i, p.name, p.label, p.maximum, p.default, p.minimum)
+    for i, p in enumerate(profile_file.load("sheet").params)
 )
+"""The sheet's nine, read from its profile file (`protocol/profiles/sheet.toml`)."""
 PARAM_COUNT = len(PARAMS)
 BY_NAME: dict[str, Param] = {p.name: p for p in PARAMS}
 NAMES: tuple[str, ...] = tuple(BY_NAME)

@@ -1,0 +1,388 @@
+"""Profiles as data files: what a firmware of the family sends and takes on its APP port,
+for a host — its records' fields, its parameters and their scales, its pages — in TOML
+(`appmode/protocol/profiles/*.toml` ship; `--profile PATH` reads a user's own).
+
+What a simulated board *does* is code (`board/profiles.py`); this is what a host shows.
+The tables appmode's codec reads (`params.PARAMS`, the A record layouts) come from the
+shipped `sheet` and `minibalance` files: one source of truth.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Callable, Mapping
+from functools import cache
+from typing import Any, NamedTuple
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+SHIPPED = ("sheet", "minibalance", "balance")
+"""The profiles appmode ships, in the order `profile list` shows them."""
+NAME_CHARACTERS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
+"""A profile's, a field's and a parameter's name: these, a letter first (a JSON key and
+a command word)."""
+FOLDER = os.path.join(os.path.dirname(__file__), "profiles")
+A_FIELDS = 4
+"""Fields of an A record: `{A f0:f1:f2:f3}$` for every firmware of the family."""
+MAX_FIELDS = 9
+"""At most nine fields in a B record, nine parameters (`{n:v}`: n is one digit, 0–8)."""
+
+
+class ProfileError(ValueError):
+    """What is wrong with a profile file, one line a mistake."""
+
+    def __init__(self, where: str, problems: list[str]) -> None:
+        super().__init__("\n".join(f"{where}: {problem}" for problem in problems))
+        self.problems = problems
+
+
+class Field(NamedTuple):
+    """One field of a record: its name (a JSON key), a label for people, its unit;
+    field = scale × the quantity, sent signed or as a magnitude, wrapping at `wrap`
+    if it does (an unsigned byte: 256); whether it grows with the car's speed, or is
+    the battery's percentage."""
+
+    name: str
+    label: str
+    unit: str
+    scale: float = 1.0
+    signed: bool = True
+    wrap: int | None = None
+    motion: bool = False
+    battery: bool = False
+
+
+class ParamSpec(NamedTuple):
+    """One parameter of the `{n:v}` / `{C…}$` set: the frame's integer runs from
+    minimum to maximum and is `scale` × the user's value (a gain sent ×100: scale 100)."""
+
+    name: str
+    label: str
+    minimum: int
+    maximum: int
+    default: int
+    scale: float = 1.0
+
+
+class ProfileFile(NamedTuple):
+    """A firmware's APP port as a host sees it."""
+
+    name: str
+    description: str
+    source: str
+    baud: int
+    period_ms: tuple[int, int]
+    """Shortest and longest time between records."""
+    control_port: bool
+    """It has the binary control port (UART2, `FF FE` frames)."""
+    saves: bool
+    """`{Q:W}` writes the parameters to flash."""
+    replies: tuple[str, ...]
+    """What it sends besides records (`##$` before a C record, in some builds)."""
+    pages: Mapping[str, str]
+    """Letters that switch the app's page, and the page's name."""
+    speed_keys: Mapping[str, int]
+    """Letters that change the speed by themselves, and by how much."""
+    a: tuple[Field, ...]
+    b: tuple[Field, ...]
+    params: tuple[ParamSpec, ...]
+    path: str
+    """Where it was read from."""
+
+
+def shipped_path(name: str) -> str:
+    return os.path.join(FOLDER, f"{name}.toml")
+
+
+@cache
+def load(source: str) -> ProfileFile:
+    """A shipped profile by name, or a file by path; ProfileError says what is wrong."""
+    path = shipped_path(source) if source in SHIPPED else source
+    try:
+        with open(path, encoding="utf-8") as file:
+            text = file.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        known = ", ".join(SHIPPED)
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ProfileError(
+            source, [f"cannot read it ({why}): give a file or one of {known}"]
+        ) from None
+    return parse(text, path)
+
+
+def parse(text: str, where: str) -> ProfileFile:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ProfileError(where, [f"not TOML: {exc}"]) from None
+    problems: list[str] = []
+    base: ProfileFile | None = None
+    like = data.get("like")
+    if like is not None:
+        if like not in SHIPPED or like == data.get("name"):
+            problems.append(f"like = {like!r}: name a shipped profile ({', '.join(SHIPPED)})")
+        else:
+            base = load(like)
+    profile = _build(data, base, where, problems.append)
+    if problems or profile is None:
+        raise ProfileError(where, problems)
+    return profile
+
+
+TOP = {
+    "name", "description", "source", "like", "baud", "period_ms", "control_port", "saves",
+    "replies", "pages", "speed_keys", "records", "params", "defaults",
+}  # fmt: skip
+FIELD_KEYS = {"name", "label", "unit", "scale", "signed", "wrap", "motion", "battery"}
+PARAM_KEYS = {"name", "label", "minimum", "maximum", "default", "scale"}
+
+
+def _build(
+    data: dict[str, Any], base: ProfileFile | None, where: str, problem: Callable[[str], None]
+) -> ProfileFile | None:
+    for key in sorted(set(data) - TOP):
+        problem(f"unknown key {key!r}: the keys are {', '.join(sorted(TOP))}")
+    name = _text(data, "name", problem, pattern=True)
+    description = _text(data, "description", problem, base.description if base else None)
+    source = _text(data, "source", problem, base.source if base else None)
+    baud = data.get("baud", base.baud if base else 9600)
+    if not _whole(baud) or baud <= 0:
+        problem(f"baud = {baud!r}: a rate in bits a second, such as 9600")
+    period = data.get("period_ms", list(base.period_ms) if base else None)
+    if not (
+        isinstance(period, list)
+        and len(period) == 2
+        and all(_whole(p) for p in period)
+        and 0 < period[0] <= period[1] <= 60_000
+    ):
+        problem(f"period_ms = {period!r}: [shortest, longest] in ms, such as [50, 50]")
+        period = [0, 0]
+    flags = {}
+    for key in ("control_port", "saves"):
+        flags[key] = data.get(key, getattr(base, key) if base else None)
+        if flags[key] is None:
+            problem(f"{key} is missing: {key} = true or false")
+        elif not isinstance(flags[key], bool):
+            problem(f"{key} = {flags[key]!r}: true or false")
+    replies = data.get("replies", list(base.replies) if base else [])
+    if not (isinstance(replies, list) and all(isinstance(r, str) and r for r in replies)):
+        problem(f'replies = {replies!r}: a list of texts, such as ["##$"]')
+        replies = []
+    pages = _letters(data, "pages", str, problem, base.pages if base else None)
+    speed_keys = _letters(data, "speed_keys", int, problem, base.speed_keys if base else None)
+    records = data.get("records", {})
+    if not isinstance(records, dict) or set(records) - {"A", "B"}:
+        problem("[records] holds A and B, each a list of fields")
+        records = {}
+    a = _fields(records, "A", problem, base.a if base else None)
+    b = _fields(records, "B", problem, base.b if base else None)
+    if a is not None and len(a) != A_FIELDS:
+        problem(f"records.A has {len(a)} fields: an A record has {A_FIELDS}")
+    params = _params(data, problem, base.params if base else None)
+    if not isinstance(name, str) or a is None or b is None or params is None:
+        return None
+    return ProfileFile(
+        name,
+        str(description),
+        str(source),
+        int(baud) if _whole(baud) else 0,
+        (int(period[0]), int(period[1])),
+        bool(flags["control_port"]),
+        bool(flags["saves"]),
+        tuple(replies),
+        pages,
+        speed_keys,
+        a,
+        b,
+        params,
+        where,
+    )
+
+
+def _under(at: str, problem: Callable[[str], None]) -> Callable[[str], None]:
+    """Problems said of a part of the file (`records.A[2]: …`)."""
+
+    def said(text: str) -> None:
+        problem(f"{at}: {text}")
+
+    return said
+
+
+def _whole(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _text(
+    data: Mapping[str, Any],
+    key: str,
+    problem: Callable[[str], None],
+    inherited: str | None = None,
+    pattern: bool = False,
+) -> str | None:
+    value = data.get(key, inherited)
+    if value is None:
+        problem(f'{key} is missing: {key} = "…"')
+        return None
+    if not isinstance(value, str) or not value.strip():
+        problem(f'{key} = {value!r}: a text, {key} = "…"')
+        return None
+    if pattern and not (value[0].isalpha() and set(value) <= NAME_CHARACTERS):
+        problem(f"{key} = {value!r}: lower-case letters, digits and _, a letter first")
+        return None
+    return value
+
+
+def _letters(
+    data: Mapping[str, Any],
+    key: str,
+    kind: type,
+    problem: Callable[[str], None],
+    inherited: Mapping[str, Any] | None,
+) -> dict[str, Any]:
+    table = data.get(key, dict(inherited) if inherited is not None else {})
+    what = "a page's name" if kind is str else "a speed change"
+    good = isinstance(table, dict) and all(
+        isinstance(k, str)
+        and len(k) == 1
+        and "A" <= k <= "Z"
+        and (isinstance(v, str) if kind is str else _whole(v))
+        for k, v in table.items()
+    )
+    if not good:
+        problem(f"[{key}]: a capital letter = {what}, one a line, such as K = …")
+        return {}
+    return dict(table)
+
+
+def _fields(
+    records: Mapping[str, Any],
+    kind: str,
+    problem: Callable[[str], None],
+    inherited: tuple[Field, ...] | None,
+) -> tuple[Field, ...] | None:
+    if kind not in records:
+        if inherited is None:
+            problem(f"records.{kind} is missing: {kind} = [ {{ name = …, unit = … }}, … ]")
+        return inherited
+    entries = records[kind]
+    if not isinstance(entries, list) or not 1 <= len(entries) <= MAX_FIELDS:
+        problem(f"records.{kind}: a list of 1–{MAX_FIELDS} fields")
+        return None
+    fields: list[Field] = []
+    for i, entry in enumerate(entries):
+        at = f"records.{kind}[{i}]"
+        if not isinstance(entry, dict):
+            problem(f'{at}: a field is a table, {{ name = "…", unit = "…" }}')
+            continue
+        for key in sorted(set(entry) - FIELD_KEYS):
+            problem(f"{at}: unknown key {key!r}: a field has {', '.join(sorted(FIELD_KEYS))}")
+        name = _text(entry, "name", _under(at, problem), pattern=True)
+        scale = entry.get("scale", 1.0)
+        if not _number(scale) or scale <= 0:
+            problem(f"{at}: scale = {scale!r}: a number above 0 (field = scale × value)")
+        wrap = entry.get("wrap")
+        if wrap is not None and (not _whole(wrap) or wrap < 2):
+            problem(f"{at}: wrap = {wrap!r}: where the field wraps, such as 256")
+        flags = {k: entry.get(k, k == "signed") for k in ("signed", "motion", "battery")}
+        for key, value in flags.items():
+            if not isinstance(value, bool):
+                problem(f"{at}: {key} = {value!r}: true or false")
+        unit, label = entry.get("unit", ""), entry.get("label", name)
+        if not isinstance(unit, str) or not isinstance(label, str):
+            problem(f"{at}: label and unit are texts")
+        if name is not None:
+            fields.append(
+                Field(name, str(label), str(unit), float(scale) if _number(scale) else 1.0,
+                      flags["signed"] is True, wrap if _whole(wrap) else None,
+                      flags["motion"] is True, flags["battery"] is True)
+            )  # fmt: skip
+    names = [f.name for f in fields]
+    for twice in sorted({n for n in names if names.count(n) > 1}):
+        problem(f"records.{kind}: two fields are called {twice!r}")
+    if sum(f.battery for f in fields) > 1:
+        problem(f"records.{kind}: one battery field at most")
+    return tuple(fields) if len(fields) == len(entries) else None
+
+
+def _params(
+    data: Mapping[str, Any],
+    problem: Callable[[str], None],
+    inherited: tuple[ParamSpec, ...] | None,
+) -> tuple[ParamSpec, ...] | None:
+    entries = data.get("params")
+    if entries is None:
+        if inherited is None:
+            problem("[[params]] is missing: one [[params]] table a parameter, in order")
+            return None
+        specs = list(inherited)
+    elif not isinstance(entries, list) or not 1 <= len(entries) <= MAX_FIELDS:
+        problem(f"[[params]]: 1–{MAX_FIELDS} tables, one a parameter, in order")
+        return None
+    else:
+        specs = []
+        for i, entry in enumerate(entries):
+            spec = _param(entry, f"params[{i}]", problem)
+            if spec is not None:
+                specs.append(spec)
+        if len(specs) != len(entries):
+            return None
+    defaults = data.get("defaults")
+    if defaults is not None:
+        if not (
+            isinstance(defaults, list)
+            and len(defaults) == len(specs)
+            and all(
+                _whole(d) and s.minimum <= d <= s.maximum
+                for d, s in zip(defaults, specs, strict=True)
+            )
+        ):
+            problem(f"defaults: {len(specs)} whole numbers, each in its parameter's range")
+            return None
+        specs = [
+            ParamSpec(s.name, s.label, s.minimum, s.maximum, d, s.scale)
+            for s, d in zip(specs, defaults, strict=True)
+        ]
+    names = [s.name for s in specs]
+    for twice in sorted({n for n in names if names.count(n) > 1}):
+        problem(f"[[params]]: two parameters are called {twice!r}")
+    return tuple(specs)
+
+
+def _param(entry: object, at: str, problem: Callable[[str], None]) -> ParamSpec | None:
+    if not isinstance(entry, dict):
+        problem(f"{at}: a [[params]] table")
+        return None
+    for key in sorted(set(entry) - PARAM_KEYS):
+        problem(f"{at}: unknown key {key!r}: a parameter has {', '.join(sorted(PARAM_KEYS))}")
+    name = _text(entry, "name", _under(at, problem), pattern=True)
+    low, high = entry.get("minimum", 0), entry.get("maximum")
+    default, scale = entry.get("default", low), entry.get("scale", 1.0)
+    if (
+        not (isinstance(low, int) and isinstance(high, int))
+        or isinstance(low, bool)
+        or isinstance(high, bool)
+        or not 0 <= low <= high <= 0xFFFF_FFFF
+    ):
+        problem(
+            f"{at}: minimum = {low!r}, maximum = {high!r}: "
+            "whole numbers, 0 ≤ minimum ≤ maximum < 2³²"
+        )
+        return None
+    if not isinstance(default, int) or isinstance(default, bool) or not low <= default <= high:
+        problem(f"{at}: default = {default!r}: a whole number in {low}–{high}")
+        return None
+    if not _number(scale) or scale <= 0:
+        problem(f"{at}: scale = {scale!r}: above 0 (the frame's integer = scale × value)")
+        return None
+    label = entry.get("label", name)
+    if name is None or not isinstance(label, str):
+        return None
+    return ParamSpec(name, label, low, high, default, float(scale))
