@@ -16,7 +16,6 @@ from playwright.sync_api import Browser
 
 from tests.support.processes import run
 from tests.support.web import WebProcess, wait_sent, web_process
-from tests.web.test_page import browser  # noqa: F401  (the fixture)
 from tests.web.test_server import get
 
 
@@ -105,7 +104,7 @@ def test_on_a_wildcard_address_the_host_must_be_an_address_or_this_machine(
         assert get(local(web) + "/", tls=insecure())[0] == 403, "no token"
 
 
-def test_the_page_drives_over_https(browser: Browser, tmp_path: Path) -> None:  # noqa: F811
+def test_the_page_drives_over_https(browser: Browser, tmp_path: Path) -> None:
     with web_process(tmp_path, "--listen", "0.0.0.0:0") as web:
         context = browser.new_context(ignore_https_errors=True)
         page = context.new_page()

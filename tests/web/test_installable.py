@@ -11,9 +11,6 @@ from pathlib import Path
 from playwright.sync_api import Browser
 
 from tests.support.web import web_process
-from tests.web.test_page import browser
-
-__all__ = ["browser"]
 
 
 def test_the_page_is_tidy_installable_and_says_when_the_server_is_gone(

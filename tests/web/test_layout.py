@@ -6,29 +6,16 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from playwright.sync_api import Browser, Page, sync_playwright
+from playwright.sync_api import Browser, Page
 
 from tests.support.web import WebProcess, wait_sent, web_process
 
-CHROMIUM = "/usr/bin/chromium"
 SCREENS = ((360, 640), (640, 360), (1280, 800))
 FINGER = 48
 """CSS pixels a touch target needs each way."""
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Browser]:
-    assert Path(CHROMIUM).exists(), "install Chromium: apt-get install chromium (.ci/run does)"
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM)
-        try:
-            yield browser
-        finally:
-            browser.close()
 
 
 def open_page(browser: Browser, web: WebProcess, width: int, height: int, ready: str) -> Page:
