@@ -88,7 +88,9 @@ def web_process(
         assert proc.stdout is not None
         sel = selectors.DefaultSelector()
         sel.register(proc.stdout, selectors.EVENT_READ)
-        line = proc.stdout.readline() if sel.select(20) else ""
+        # its address within 45 s: beside a second suite (load 8 on two cores) a start took
+        # over 20 s
+        line = proc.stdout.readline() if sel.select(45) else ""
         found = re.match(r"web: (https?://\S+)", line)
         web = WebProcess(proc, found.group(1) if found else "", board, record)
         try:
