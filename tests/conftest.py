@@ -14,15 +14,13 @@ import pytest
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: four workers for two cores. Most tests wait on boards, ptys and
-    processes in real time, so more workers than cores keep the cores busy (4 min 50 s
-    of CPU in a 4 min 6 s run; three workers took 5 min 10 s). Four once made real-time
-    tests fail: each cause is gone (a test's symlink kept leading to a dead board's
-    /dev/pts/N, which another worker's board then got; a send's earliness measured
-    against a median that carries the load's latency; a sim:// recording out of time
-    order)."""
+    """`-n auto`: three workers for two cores. Most tests wait on boards, ptys and
+    processes in real time, so more workers than cores keep the cores busy (5 min 2 s of
+    CPU in a 5 min 17 s run). Four took 4 min 6 s to 5 min 17 s, but starved the page's
+    heartbeats on a clean CI run (the car stopped for a lapse over 0.25 s mid-hold, as it
+    must): three it stays."""
     cores = os.cpu_count() or 1
-    return 2 * cores
+    return cores + cores // 2
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
