@@ -24,10 +24,18 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Tests marked `alone` go last: pytest-xdist hands them out when the other workers
-    are finishing, so a real-time run meets no load of this run's own (a starved board
-    applies commands late, and the suite in real time holds it to ±0.3 s)."""
-    items.sort(key=lambda item: item.get_closest_marker("alone") is not None)
+    """The page's tests in Chromium go first and tests marked `alone` last: pytest-xdist
+    hands the last out while the other workers are finishing, so a real-time run meets
+    no load of this run's own (a starved board applies commands late, and the suite in
+    real time holds it to ±0.3 s), and the browsers, whose heartbeats a burst of boards
+    starves past the page's 0.25-s lease (a held direction then stops, as it must), are
+    done before it (they came last by name, beside it)."""
+    items.sort(
+        key=lambda item: (
+            item.get_closest_marker("alone") is not None,
+            not item.nodeid.startswith("tests/web/"),
+        )
+    )
 
 
 @pytest.fixture(autouse=True)
