@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from appmode.host.state import HostState, LinkStats
-from appmode.protocol import app
+from appmode.session import instruments
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import STALE, link
 from appmode.text import counted
@@ -111,23 +111,22 @@ def reading(label: str, text: str, age: float | None) -> Row:
 
 
 def telemetry(state: HostState, now: float) -> list[Row]:
-    """The A and B records: velocity, attitude, battery."""
-    v, a = state.velocity, state.attitude
-    if v is None:
-        velocity = "  —"
-    else:
-        values, labels = app.record_fields(v)[1], state.layout.labels
-        velocity = "   ".join(f"{labels[i]} {values[i]:6d}" for i in state.layout.motion)
-    attitude = "  —" if a is None else f"pitch {a.pitch:4d}   roll {a.roll:4d}   yaw {a.yaw:4d}"
+    """The A and B records: velocity, attitude, battery (as `instruments.telemetry` reads
+    them)."""
+    t = instruments.telemetry(state, now)
+    velocity = "  —" if t.motion is None else "   ".join(f"{n} {v:6d}" for n, v in t.motion)
+    attitude = (
+        "  —" if t.pitch is None else f"pitch {t.pitch:4d}   roll {t.roll:4d}   yaw {t.yaw:4d}"
+    )
     rows = [
-        reading("velocity", velocity, state.velocities.age(now)),
-        reading("attitude", attitude, state.attitudes.age(now)),
+        reading("velocity", velocity, t.motion_age),
+        reading("attitude", attitude, t.attitude_age),
     ]
-    if a is None:
+    if t.battery is None:
         return [*rows, Row("battery", (("", "  —"),))]
-    old = (state.attitudes.age(now) or 0.0) > STALE
-    tone: Tone = "dim" if old else "low" if a.battery < 20 else "ok"
-    return [*rows, Row("battery", ((tone, f" {a.battery:3d} % {bar(a.battery)}"),))]
+    old = (t.attitude_age or 0.0) > STALE
+    tone: Tone = "dim" if old else "low" if t.battery < 20 else "ok"
+    return [*rows, Row("battery", ((tone, f" {t.battery:3d} % {bar(t.battery)}"),))]
 
 
 def hold_mode(driving: HoldToDrive) -> str:
