@@ -25,6 +25,8 @@ SHIPPED = ("sheet", "minibalance", "balance")
 NAME_CHARACTERS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
 """A profile's, a field's and a parameter's name: these, a letter first (a JSON key and
 a command word)."""
+MAX_SIZE = 256_000
+"""The largest profile file read, in bytes."""
 FOLDER = os.path.join(os.path.dirname(__file__), "profiles")
 A_FIELDS = 4
 """Fields of an A record: `{A f0:f1:f2:f3}$` for every firmware of the family."""
@@ -103,8 +105,12 @@ def load(source: str) -> ProfileFile:
     """A shipped profile by name, or a file by path; ProfileError says what is wrong."""
     path = shipped_path(source) if source in SHIPPED else source
     try:
+        if not os.path.isfile(path):  # a FIFO would wait for a writer, a device forever
+            raise OSError(0, "not a regular file" if os.path.exists(path) else "no such file")
+        if os.path.getsize(path) > MAX_SIZE:
+            raise OSError(0, f"over {MAX_SIZE // 1000} kB: a profile is a few kB")
         with open(path, encoding="utf-8") as file:
-            text = file.read()
+            text = file.read(MAX_SIZE + 1)
     except (OSError, UnicodeDecodeError) as exc:
         known = ", ".join(SHIPPED)
         why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)

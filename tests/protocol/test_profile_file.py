@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -98,8 +99,17 @@ def test_a_broken_profile_is_one_line_a_mistake(tmp_path: Path, text: str, said:
     assert "Traceback" not in done.stderr and any(said in line for line in lines)
 
 
-def test_a_missing_file_is_one_line(tmp_path: Path):
-    done = run("profile", "check", str(tmp_path / "nowhere.toml"))
-    assert done.returncode == 1
-    assert done.stderr.count("\n") == 1 and "cannot read it" in done.stderr
-    assert "give a file or one of sheet, minibalance, balance" in done.stderr
+def test_a_missing_file_a_fifo_and_a_huge_file_are_one_line_each(tmp_path: Path):
+    fifo, huge = tmp_path / "fifo.toml", tmp_path / "huge.toml"
+    os.mkfifo(fifo)  # nobody writes it: reading it would wait for ever
+    huge.write_bytes(b"#" * 1_000_000 + b"\n")
+    cases = (
+        (tmp_path / "nowhere.toml", "no such file"),
+        (fifo, "not a regular file"),
+        (huge, "over 256 kB"),
+    )
+    for path, why in cases:
+        done = run("profile", "check", str(path), timeout=10)
+        assert done.returncode == 1, done.stderr
+        assert done.stderr.count("\n") == 1 and f"cannot read it ({why}" in done.stderr
+        assert "give a file or one of sheet, minibalance, balance" in done.stderr
