@@ -46,7 +46,10 @@ def test_a_latched_session_that_stops_ticking_is_stopped(tmp_path: Path) -> None
     session = Session("sim://", HoldToDrive(latched=True), record=str(record))
     try:
         session.start()
+        ticked = time.monotonic()
+        session.tick()
         session.run("drive A")
+        driven = time.monotonic()
         assert session.moving
         time.sleep(STALL * 6)  # the session's loop is "blocked": no tick
         session.tick()
@@ -58,7 +61,8 @@ def test_a_latched_session_that_stops_ticking_is_stopped(tmp_path: Path) -> None
     drive = next(i for i, e in enumerate(sent) if e.data == b"A")
     stop = sent[drive + 1]
     assert stop.data == b"Z"
-    assert STALL <= stop.time - sent[drive].time < STALL * 4
+    # STALL counts from the last tick, which came before the A by up to `driven - ticked`
+    assert STALL - (driven - ticked) <= stop.time - sent[drive].time < STALL * 4
 
 
 def test_after_a_signal_not_acted_on_the_guard_stops_the_car_and_ends_the_process(
