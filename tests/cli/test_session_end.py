@@ -210,6 +210,9 @@ def test_two_ending_signals_at_once_still_stop_the_car(tmp_path: Path) -> None:
                 proc.communicate(timeout=10)
             finally:
                 proc.kill()
+            # the board, busy beside other work, may read the host's last bytes after it exits
+            with contextlib.suppress(AssertionError):
+                wait_for(lambda: sent_lines(record)[-1] == "Z", timeout=3.0)
             assert sent_lines(record)[-1] == "Z", f"trial {trial}: the car was left moving"
             assert proc.returncode == 130, f"trial {trial}: exit {proc.returncode}"
         assert board_state(board.url) == (STOPPED, DEFAULTS)
