@@ -86,10 +86,11 @@ class AppPort:
             reason = frame.reason or f"parameter {frame.index} is not settable on this board"
             core.note(now, "rejected", f"{shown}: ignored: {reason}", port)
         else:
-            index = frame.index
-            kept = c_int(frame.value) if index in INT_PARAMS else frame.value
+            index, file = frame.index, core.profile.file
+            whole = file is not None or index in INT_PARAMS  # a data profile's: integers
+            kept = c_int(frame.value) if whole else frame.value
             core.params[index] = kept
-            name = params.PARAMS[index].name
+            name = (file.params if file is not None else params.PARAMS)[index].name
             core.note(now, "applied", f"{shown}: {name} = {kept:.10g}", port)
 
     def _steer(self, event: app.ByteEvent) -> str:

@@ -91,7 +91,7 @@ class ControlPort:
                 core.out2 += control.encode(control.Reply(read.reply_id, value))
             core.reads.clear()
         if core.tick_ms % REPORT_MS == 0 and self._reports:
-            mode = int(core.params[params.SYSTEM_MODE])
+            mode = core.system_mode
             if mode & ENCODER_REPORT and not mode & APP_MODE:
                 core.out2 += self._report(mode)
 

@@ -21,6 +21,9 @@ MAX_NOTES = 1000
 """Log lines kept until taken: an edge that never reads them costs bounded memory."""
 UART3, UART2 = "uart3", "uart2"
 """The ports, as the board's log names them."""
+DATA_SPEED = 100.0
+"""The speed a data profile's board drives at, in its records' units (it has no model of
+the car: its parameters mean nothing to it)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,15 +89,30 @@ class Core:
     def note(self, now: float, level: str, text: str, port: str = UART3) -> None:
         self.notes.append(Note(now, level, text, port))
 
+    @property
+    def system_mode(self) -> int:
+        """system_mode's bits (0 on a data profile's board: its parameters are only
+        stored)."""
+        if self.profile.file is not None:
+            return 0
+        return int(self.params[params.SYSTEM_MODE])
+
+    @property
+    def max_speed(self) -> float:
+        """The speed a direction drives at: max_speed, or a data profile's DATA_SPEED."""
+        if self.profile.file is not None:
+            return DATA_SPEED
+        return self.params[params.MAX_SPEED]
+
     def mode(self, name: str) -> bool:
         """Whether a bit of system_mode is set."""
-        return bool(int(self.params[params.SYSTEM_MODE]) & params.MODE_BIT[name])
+        return bool(self.system_mode & params.MODE_BIT[name])
 
     @property
     def drive_type(self) -> params.DriveType:
         if not self.profile.drive_types:
             return params.DriveType.OMNI
-        drive = params.drive_type(int(self.params[params.SYSTEM_MODE]))
+        drive = params.drive_type(self.system_mode)
         assert drive is not None, "set frames with an invalid drive type are rejected"
         return drive
 
@@ -108,12 +126,13 @@ class Core:
         if not self.profile.saves:
             self.note(now, "rejected", f"{shown}: this board saves nothing (§13)", port)
             return
-        saved = (*params.saved_form([int(v) for v in self.params]), self.gyro_calibration)
+        values = [int(v) for v in self.params]
+        kept = values if self.profile.file is not None else params.saved_form(values)
+        saved = (*kept, self.gyro_calibration)
         try:
             self.store.save(saved)
         except AppmodeError as exc:
             self.errors += 1
             self.note(now, "rejected", f"{shown}: save failed: {exc}", port)
             return
-        nine, calibration = list(saved[: params.PARAM_COUNT]), saved[params.PARAM_COUNT]
-        self.note(now, "applied", f"{shown}: saved {nine} (gyro calibration {calibration})", port)
+        self.note(now, "applied", f"{shown}: saved {values} (gyro calibration {saved[-1]})", port)

@@ -162,7 +162,7 @@ class Board:
         reports on UART2."""
         core, telemetry = self.core, self.telemetry
         uart3, uart2 = float(telemetry.record_ms), telemetry.burst_ms
-        mode = int(core.params[params.SYSTEM_MODE])
+        mode = core.system_mode
         if mode & APP_MODE:
             uart3, uart2 = uart2, uart3
         if core.reads:
@@ -304,7 +304,7 @@ class Board:
         the APP port's direction moves the car in one step of them all."""
         core = self.core
         profile, vehicle = core.profile, core.vehicle
-        speed = core.params[params.MAX_SPEED]
+        speed = core.max_speed
         if 0 < speed < profile.stall_speed:
             core.params[params.MAX_SPEED] = speed = float(profile.stall_speed)
         if core.uart2_control and profile.firmware_uart2:
@@ -359,7 +359,7 @@ class Board:
         x = y = z = 0.0
         if isinstance(command, control.VelocityFrame):
             # worked out again only when what it depends on changed (100 times a second)
-            key = (command, speed, core.params[params.SYSTEM_MODE])
+            key = (command, speed, core.system_mode)
             if key != self._velocity_for:
                 self._velocity_for = key
                 self._velocity_is = self._velocity_target(command, speed)
@@ -395,7 +395,7 @@ class Board:
         """The velocity the APP port's direction asks for; worked out again only when
         what it depends on changed (it is asked 100 times a second)."""
         core = self.core
-        key = (core.page, core.direction, speed, core.params[params.SYSTEM_MODE])
+        key = (core.page, core.direction, speed, core.system_mode)
         if key != self._target_for:
             self._target_for = key
             if core.mode("motor_reverse"):

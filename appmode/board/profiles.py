@@ -10,14 +10,16 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cache
 from types import MappingProxyType
 
 from appmode.board.names import PROFILE_NAMES
 from appmode.errors import AppmodeError
-from appmode.protocol import params
+from appmode.protocol import layouts, params, profile_file
 from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
-from appmode.protocol.layouts import SCALED, VELOCITY, ALayout
+from appmode.protocol.layouts import SCALED, VELOCITY, Layout
 from appmode.protocol.params import DriveType
+from appmode.protocol.profile_file import ProfileError, ProfileFile
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,7 +67,7 @@ class Profile:
     dead_time: float
     """Seconds after power-up with the motors off and the battery voltage read as 0."""
     # -- records (§3)
-    a_layout: ALayout
+    a_layout: Layout
     """What the A record's fields hold."""
     truncate: bool
     """Whole numbers in records by truncation, as C casts do (else rounded)."""
@@ -104,6 +106,11 @@ class Profile:
     clamp, no lag), and until one does the motion freezes at the take-over; after each
     APP record UART2 carries what is left of the status the loop writes there. Else the
     sheet's frames (§8–§12)."""
+    # -- a data profile (a profile file with no firmware model here)
+    file: ProfileFile | None = None
+    """The profile file whose records this board writes, with no physics: the speed is
+    DATA_SPEED, the parameters are only stored, read and saved. None: sheet or
+    minibalance, modelled."""
 
     def record_period_ms(self, size: int) -> int:
         """Milliseconds from a record of `size` bytes to the next (§3.4, §13)."""
@@ -130,6 +137,11 @@ class Profile:
             raise AppmodeError(
                 f"the {self.name} profile has no drive types (see appmode protocol 13): "
                 "leave out the drive type"
+            )
+        if flash and self.file is not None:
+            raise AppmodeError(
+                f"the {self.name} profile's simulated board keeps what it saves in memory "
+                "(it has no model of that firmware's flash): leave out the flash file"
             )
         if flash and not self.saves:
             raise AppmodeError(
@@ -240,11 +252,63 @@ if tuple(PROFILES) != PROFILE_NAMES:
     raise AssertionError("board/names.py must name the profiles of board/profiles.py")
 
 
-def profile_named(name: str) -> Profile:
-    """The profile called `name`; AppmodeError lists the choices."""
-    try:
-        return PROFILES[name]
-    except KeyError:
+def from_file(file: ProfileFile) -> Profile:
+    """A board for a profile file: the family's byte-by-byte intake, its records and
+    parameters as the file declares them, on its shortest period; no physics."""
+    return Profile(
+        name=file.name,
+        firmware_frames=True,
+        steer_in_frames=False,
+        frame_restarts=False,
+        settable=frozenset(i for i, p in enumerate(file.params) if p.maximum > p.minimum),
+        stall_speed=0,
+        saves=file.saves,
+        defaults=tuple(p.default for p in file.params),
+        drive_types=False,
+        c_saturates=True,
+        buttons=BUTTON_PAGE,
+        numeric_buttons=False,
+        sticky_rotation=False,
+        ramp=None,
+        coast=1.0,
+        float32=False,
+        dead_time=0.0,
+        a_layout=layouts.Layout(file.name, file),
+        truncate=True,
+        yaw_low=-180,
+        battery_floor=True,
+        period_ms=file.period_ms[0],
+        pause_ms=0,
+        pause_step_ms=5,
+        byte_ms=10_000 / file.baud,
+        first_record="A",
+        read_lost_in_c=False,
+        startup_text=b"",
+        startup_ms=0,
+        first_record_ms=0,
+        takeover_byte=10,
+        control_modes=SHEET.control_modes if file.control_port else frozenset(),
+        firmware_uart2=False,
+        file=file,
+    )
+
+
+def shipped_profile(name: str) -> Profile:
+    """A profile appmode ships, by name (what a transcript may name: never a file)."""
+    if name not in profile_file.SHIPPED:
         raise AppmodeError(
-            f"unknown board profile {name!r}: choose one of {', '.join(PROFILE_NAMES)}"
-        ) from None
+            f"unknown board profile {name!r}: choose one of {', '.join(profile_file.SHIPPED)}"
+        )
+    return profile_named(name)
+
+
+@cache
+def profile_named(name: str) -> Profile:
+    """The profile called `name` (a modelled one, a shipped profile file's, or a file at
+    that path); AppmodeError says what is wrong, one line."""
+    if name in PROFILES:
+        return PROFILES[name]
+    try:
+        return from_file(profile_file.load(name))
+    except ProfileError as exc:
+        raise AppmodeError(str(exc).replace("\n", "; ")) from None

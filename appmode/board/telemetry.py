@@ -10,6 +10,7 @@ from appmode.board.chip import c_int, times_float32
 from appmode.board.core import Core
 from appmode.board.vehicle import YAW_GAIN, battery_percent, wrap_degrees
 from appmode.protocol import app, control
+from appmode.protocol.profile_file import Field
 
 APP_BYTE = 10 / 9600
 """A byte's time on the APP port's wire."""
@@ -58,7 +59,12 @@ class Telemetry:
             self._c_pending = False
             values = tuple(c_int(v) if profile.c_saturates else int(v) for v in core.params)
             data = self._bytes(b"C", values)
+            if profile.file is not None and profile.file.replies:
+                data = "".join(profile.file.replies).encode() + data
             self.c_on_wire_until = core.boot + at / 1000 + len(data) * APP_BYTE
+        elif profile.file is not None:
+            fields = profile.file.a if self._show_a else profile.file.b
+            data = self._data_record(b"A" if self._show_a else b"B", fields, at)
         else:
             data = self._a_record(at) if self._show_a else self._b_record(at)
         self._show_a = not self._show_a
@@ -108,6 +114,28 @@ class Telemetry:
         if layout.battery is not None:
             fields[layout.battery] = self._battery(ms)
         return self._bytes(b"A", tuple(fields))
+
+    def _data_record(self, letter: bytes, fields: tuple[Field, ...], ms: int) -> bytes:
+        """A data profile's record, with no physics: three motion fields show x, y and z;
+        others the forward speed, a wheel's (`left`, `right` in its name) with the turn;
+        the battery field the battery; the rest 0."""
+        v = self.core.vehicle
+        motion = [i for i, field in enumerate(fields) if field.motion]
+        values = [0] * len(fields)
+        for n, i in enumerate(motion):
+            field = fields[i]
+            if len(motion) == 3:
+                speed = (v.vx, v.vy, v.vz)[n]
+            else:
+                turn = ("left" in field.name) - ("right" in field.name)
+                speed = v.vy + turn * v.vz
+            shown = self._whole(field.scale * speed)
+            shown = shown if field.signed else abs(shown)
+            values[i] = shown % field.wrap if field.wrap else shown
+        for i, field in enumerate(fields):
+            if field.battery:
+                values[i] = self._battery(ms)
+        return self._bytes(letter, tuple(values))
 
     def _b_record(self, ms: int) -> bytes:
         core = self.core

@@ -47,8 +47,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_profile(
         board,
-        "the board's behaviour: sheet (the vendor's sheet, the default) or "
-        "minibalance (the reference firmware as measured; see appmode protocol 13)",
+        "the board's behaviour: sheet (the vendor's sheet, the default), minibalance (the "
+        "reference firmware as measured; see appmode protocol 13), or balance or a profile "
+        "FILE: its records and parameters as declared, with no physics",
     )
     board.add_argument(
         "--drive", choices=DRIVE_NAMES, help="drive type (default: the saved one, else omni)"

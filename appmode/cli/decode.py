@@ -13,16 +13,19 @@ from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:  # the codec is imported when the command runs: start-up stays short
     from appmode.protocol import app
-    from appmode.protocol.layouts import ALayout
+    from appmode.protocol.layouts import Layout
 
 CHUNK = 65536
 
 
-def decode_chunks(chunks: Iterable[bytes], source: str) -> Iterator[app.Event]:
-    """Events of a stream from the host (`host`) or the board (`board`)."""
+def decode_chunks(chunks: Iterable[bytes], source: str, b_fields: int = 4) -> Iterator[app.Event]:
+    """Events of a stream from the host (`host`) or the board (`board`, whose B records
+    have `b_fields` fields)."""
     from appmode.protocol import app_decoders
 
-    decoder = app_decoders.HostDecoder() if source == "host" else app_decoders.BoardDecoder()
+    decoder = (
+        app_decoders.HostDecoder() if source == "host" else app_decoders.BoardDecoder(b_fields)
+    )
     for chunk in chunks:
         yield from decoder.feed(chunk)
     yield from decoder.flush()
@@ -48,7 +51,7 @@ def run_decode(
     out: TextIO,
     source: str,
     name: str = "standard input",
-    layout: ALayout | None = None,
+    layout: Layout | None = None,
 ) -> int:
     """Write one JSON object a line (A records as `layout` reads them, by default the
     sheet's); returns the number of undecodable runs."""
@@ -59,7 +62,8 @@ def run_decode(
     layout = layout or VELOCITY
     errors = 0
     write = out.write
-    for event in coalesce(decode_chunks(read_chunks(stream, name, out), source)):
+    chunks = read_chunks(stream, name, out)
+    for event in coalesce(decode_chunks(chunks, source, len(layout.b_fields))):
         errors += isinstance(event, app.ERRORS)
         write(json_line(event, layout) + "\n")
     out.flush()

@@ -13,7 +13,7 @@ from appmode.host.client import Event, Host
 from appmode.host.control_client import ControlHost
 from appmode.host.query import QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, LinkStatus
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.render import describe, line, to_json
 
@@ -29,7 +29,7 @@ def open_host(
     url: Target,
     record: str | None,
     stop_on_close: bool = True,
-    layout: ALayout = VELOCITY,
+    layout: Layout = VELOCITY,
     stop_again: bytes | None = None,
     frames_stop: bool = False,
 ) -> Host:

@@ -22,7 +22,7 @@ from appmode.cli.options import (
 )
 from appmode.errors import AppmodeError
 from appmode.protocol import app
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.text import counted
 
 if TYPE_CHECKING:
@@ -115,7 +115,7 @@ def run_monitor(
     stop_on_exit: bool = False,
     kinds: frozenset[str] | None = None,
     name: str = "monitor",
-    layout: ALayout = VELOCITY,
+    layout: Layout = VELOCITY,
 ) -> int:
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none

@@ -8,14 +8,12 @@ import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeAlias
 
-from appmode.board.names import PROFILE_NAMES
-
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
     from _typeshed import SupportsWrite
 
     from appmode.board.profiles import Profile
     from appmode.ports.target import Target
-    from appmode.protocol.layouts import ALayout
+    from appmode.protocol.layouts import Layout
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
@@ -63,9 +61,13 @@ def add_record(parser: argparse.ArgumentParser) -> None:
     )
 
 
+SHIPPED_PROFILES = ("sheet", "minibalance", "balance")
+"""The profiles appmode ships (profile_file.SHIPPED, which checks it): named here so the
+command line offers them without loading them."""
 HOLDS = (
-    "for what its A record holds: sheet (x, y, z) or minibalance (|0.7x|, |0.7y|, battery; "
-    "see appmode protocol 13)"
+    "for what its records hold: sheet (x, y, z), minibalance (|0.7x|, |0.7y|, battery; "
+    "see appmode protocol 13), balance (the two-wheel balance car), or a profile FILE of "
+    "your own (appmode profile show sheet --toml writes one to start from)"
 )
 A_RECORD = f"the board's profile, {HOLDS}"
 ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {HOLDS}"
@@ -83,19 +85,33 @@ def add_profile(
     then applies)."""
     parser.add_argument(
         "--profile",
-        choices=PROFILE_NAMES,
+        type=profile_name,
+        metavar="NAME|FILE",
         default=default,
         help=f"{what} (default: {default or unset})",
     )
 
 
+def profile_name(text: str) -> str:
+    """A shipped profile's name, or a profile file that reads (one line when not)."""
+    if text in SHIPPED_PROFILES:
+        return text
+    from appmode.protocol.profile_file import ProfileError, load
+
+    try:
+        load(text)
+    except ProfileError as exc:
+        raise argparse.ArgumentTypeError(str(exc).replace("\n", "; ")) from None
+    return text
+
+
 def profile_for(target: Target | None, name: str | None) -> Profile:
     """The profile `--profile NAME` names, else a sim:// target's, else the sheet."""
-    from appmode.board.profiles import PROFILES, SHEET
+    from appmode.board.profiles import profile_named
 
     if name is None and target is not None:
         name = target.profile
-    return PROFILES.get(name or "sheet", SHEET)
+    return profile_named(name or "sheet")
 
 
 def stop_again_for(target: Target | None, name: str | None) -> bytes:
@@ -105,7 +121,7 @@ def stop_again_for(target: Target | None, name: str | None) -> bytes:
     return stop_again(frames_take_letters=not profile_for(target, name).steer_in_frames)
 
 
-def layout_for(target: Target | None, name: str | None) -> ALayout:
+def layout_for(target: Target | None, name: str | None) -> Layout:
     """The A record layout of `profile_for(target, name)`."""
     return profile_for(target, name).a_layout
 

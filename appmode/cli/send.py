@@ -25,7 +25,7 @@ from appmode.host.token_help import APP_TOKENS, CONTROL_TOKENS
 
 if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
     from appmode.ports.target import Target
-    from appmode.protocol.layouts import ALayout
+    from appmode.protocol.layouts import Layout
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -97,7 +97,7 @@ def run_send(
     as_json: bool,
     record: str | None,
     out: TextIO,
-    layout: ALayout,
+    layout: Layout,
     stop_again: bytes | None = None,
     frames_stop: bool = False,
 ) -> int:

@@ -19,7 +19,7 @@ from appmode.ports.target import Target, as_target
 from appmode.ports.urls import open_link
 from appmode.protocol import app, params, session_end
 from appmode.protocol.escaping import escape
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.render import motion_text
 
 CONFIRM_STEP = 0.05
@@ -41,7 +41,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
         tap: Tap | None = None,
         opener: Opener = open_link,
         stop_on_close: bool = True,
-        layout: ALayout = VELOCITY,
+        layout: Layout = VELOCITY,
         confirm_stop: bool = False,
         stop_again: bytes = session_end.stop_again(frames_take_letters=True),
         frames_stop: bool = False,

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 from appmode.host.query import Outcome, ParamQuery, QueryFailed
 from appmode.protocol import app, app_decoders, params, session_end
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.render import motion_text
 from appmode.text import counted
 
@@ -111,12 +111,12 @@ class LinkStats:
 class HostState:
     """Last records seen and link counters, fed with the board's bytes."""
 
-    def __init__(self, layout: ALayout = VELOCITY, frames_stop: bool = False) -> None:
+    def __init__(self, layout: Layout = VELOCITY, frames_stop: bool = False) -> None:
         self.layout = layout
         """How the board's A records are laid out (§3.1, §13)."""
         self.frames_stop = frames_stop
         """Every frame sent stops the car (a minibalance board: its `{` steers, §13)."""
-        self.decoder = app_decoders.BoardDecoder()
+        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields))
         self.in_step = False
         """A record has come since the link opened: undecodable bytes are errors now."""
         self.stats = LinkStats()
@@ -242,11 +242,13 @@ class HostState:
 
     def reset_decoder(self) -> None:
         """Forget a partial record (after the link was lost: the board may restart)."""
-        self.decoder = app_decoders.BoardDecoder()
+        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields))
         self.in_step = False
         self.letters_ignored = False
 
     def _apply(self, event: app.BoardEvent, now: float) -> Outcome | None:
+        if isinstance(event, app.Garbage) and event.raw in self.layout.replies:
+            return None  # what this firmware sends besides records (`##$`)
         if isinstance(event, app.ERRORS):
             if not self.in_step and not event.raw.startswith(b"{"):  # no record's start
                 self.stats.skipped += len(event.raw)

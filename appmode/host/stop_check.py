@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from appmode.host.state import STILL
 from appmode.protocol import app
-from appmode.protocol.layouts import ALayout
+from appmode.protocol.layouts import Layout
 
 SETTLE = 1.5
 """Seconds after a stop by which the car must be at rest (the reference firmware's
@@ -25,7 +25,7 @@ TRIES = 3
 
 @dataclass
 class StopCheck:
-    layout: ALayout
+    layout: Layout
     again: bytes
     """What a new try sends."""
     since: float

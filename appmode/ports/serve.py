@@ -307,7 +307,10 @@ class ServeOptions:
     def banner(self, drive: DriveType) -> str:
         """What is served (boards of `drive` type), in a line."""
         profile = self.profile
-        if profile.drive_types:
+        if profile.file is not None:
+            saves = f"flash {self.flash or 'in memory'}" if profile.saves else "saves nothing"
+            body = f"{saves}, its records and parameters only: no physics for this profile"
+        elif profile.drive_types:
             body = f"{drive.cli_name} drive, flash {self.flash or 'in memory'}"
         else:
             body = "no drive types, saves nothing"

@@ -253,7 +253,7 @@ _FIELDS = re.compile(rb"-?[0-9]+(?::-?[0-9]+)*")
 _RECORD_SIZES = {ord("A"): 4, ord("B"): 4, ord("C"): params.PARAM_COUNT}
 
 
-def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
+def _parse_record(raw: bytes, body: bytes, terminated: bool, b_fields: int = 4) -> BoardEvent:
     if not body:
         return Malformed(raw, "empty record")
     letter = body[0]
@@ -263,9 +263,9 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool) -> BoardEvent:
     if not _FIELDS.fullmatch(fields):
         return Malformed(raw, "fields are not ':'-separated integers")
     values = tuple(int(f) for f in fields.split(b":"))
-    size = _RECORD_SIZES.get(letter)
-    if size is None:
-        return OtherRecord(chr(letter), values, terminated, raw)
+    size = b_fields if letter == 0x42 else _RECORD_SIZES.get(letter)
+    if size is None or (letter == 0x42 and size != 4 and len(values) == size):
+        return OtherRecord(chr(letter), values, terminated, raw)  # a profile names the Bs
     if len(values) != size:
         return Malformed(raw, f"{chr(letter)} record has {len(values)} fields, expected {size}")
     a, b, c, d = values[:4]
@@ -280,6 +280,8 @@ _FAST = re.compile(rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?
 """A complete A or B record: the common case, decoded without the general path. It opens
 with a literal `{`, so the search skips to each `{` and fails within a few bytes there:
 linear in the input, whatever it holds."""
+_FAST_A = re.compile(rb"(\{A(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")
+"""`_FAST` for A records alone (a profile whose B record has other than four fields)."""
 _FAST_KIND = {0x41: Velocity, 0x42: Attitude}
 
 
@@ -289,8 +291,12 @@ class BoardDecoder:
     LIMIT = max(MAX_RECORD, MAX_RUN)
     """Most bytes ever held between calls."""
 
-    def __init__(self) -> None:
+    def __init__(self, b_fields: int = 4) -> None:
+        """`b_fields`: how many fields the profile's B record has (the sheet's four are
+        an `Attitude`; other counts an `OtherRecord` that the profile's layout names)."""
         self._buf = b""
+        self._b_fields = b_fields
+        self._fast = _FAST if b_fields == 4 else _FAST_A
 
     @property
     def buffered(self) -> int:
@@ -304,7 +310,7 @@ class BoardDecoder:
         pos = 0
         # split scans in C: [gap, record, x, y, z, w, gap, record, …, gap]; each gap
         # goes the general way, the last one held if it may continue
-        parts = iter(_FAST.split(buf))
+        parts = iter(self._fast.split(buf))
         for gap, raw, x, y, z, w in zip(*[parts] * 6, strict=False):  # the last gap left out
             if gap:
                 general(buf, pos, pos + len(gap), out, False)
@@ -315,8 +321,7 @@ class BoardDecoder:
         self._buf = buf[pos:]
         return out
 
-    @staticmethod
-    def _general(buf: bytes, pos: int, n: int, out: list[BoardEvent], hold: bool) -> int:
+    def _general(self, buf: bytes, pos: int, n: int, out: list[BoardEvent], hold: bool) -> int:
         """Decode buf[pos:n]. With `hold`, stop where more bytes could change the outcome
         (a partial record or garbage run at the end); without, n is the start of a record.
         Returns where it stopped."""
@@ -350,7 +355,9 @@ class BoardDecoder:
                     break  # a '$' may follow
                 end = close + 2 if close + 1 < n and buf[close + 1] == DOLLAR else close + 1
                 raw = buf[pos:end]
-                out.append(_parse_record(raw, raw[1 : close - pos], end == close + 2))
+                out.append(
+                    _parse_record(raw, raw[1 : close - pos], end == close + 2, self._b_fields)
+                )
                 pos = end
             elif n - pos >= MAX_RECORD:
                 out.append(Malformed(buf[pos:limit], f"over {MAX_RECORD} bytes without '}}'"))
@@ -371,5 +378,5 @@ class BoardDecoder:
         if raw[0] != LBRACE:
             return [Garbage(raw)]
         if raw.endswith(b"}"):
-            return [_parse_record(raw, raw[1:-1], False)]
+            return [_parse_record(raw, raw[1:-1], False, self._b_fields)]
         return [Malformed(raw, "unterminated record at end of stream")]

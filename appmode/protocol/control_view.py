@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from appmode.protocol import app, control, render, settings
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 
 EVENTS = (
     control.VelocityFrame,
@@ -113,7 +113,7 @@ def settings_table(values: dict[str, int]) -> str:
 
 
 def view(
-    event: app.Event | control.HostEvent | control.BoardEvent, layout: ALayout = VELOCITY
+    event: app.Event | control.HostEvent | control.BoardEvent, layout: Layout = VELOCITY
 ) -> tuple[dict[str, Any], str, str | None]:
     """An event of either port for people and machines: its JSON body, its
     description, and how to show its bytes (hex pairs on UART2; None: escaped text)."""

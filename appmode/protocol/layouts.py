@@ -1,75 +1,90 @@
-"""What the four fields of an A record mean (§3.1, §13): the sheet's signed velocity, or
-the reference firmware's |0.7·x|, |0.7·y| and battery. The grammar is the same; a host
-that shows or checks the fields picks a layout (`--profile`); both come from the
-profiles' files."""
+"""What a profile's records hold, for a host that names them: the A record's four fields
+(the sheet's signed velocity, the reference firmware's |0.7·x|, |0.7·y| and battery, the
+balance car's encoders and angle), the B record's fields and the C record's parameters.
+The grammar is the same for the whole family; a host that shows or checks the fields
+picks a layout (`--profile`); every layout comes from a profile's file."""
 
 from __future__ import annotations
 
 from appmode.protocol import profile_file
+from appmode.protocol.profile_file import Field, ParamSpec, ProfileFile
 from appmode.protocol.slotted import Frozen
 
 
-class ALayout(Frozen):
-    """One reading of `{A<f0>:<f1>:<f2>:<f3>}$`."""
+class Layout(Frozen):
+    """One reading of `{A<f0>:<f1>:<f2>:<f3>}$`, `{B…}$` and `{C…}$`: a profile file's."""
 
-    __slots__ = _fields = _shown = (
-        "name",
+    _fields = ("name", "profile")
+    _shown = ("name", "a_fields", "b_fields", "params", "replies")  # hashable: not the file's
+    __slots__ = (
+        *_fields,
+        "a_fields",
+        "b_fields",
+        "params",
+        "replies",
         "fields",
+        "labels",
         "motion",
         "scale",
         "signed",
-        "labels",
         "battery",
     )
     name: str
+    profile: ProfileFile
+    a_fields: tuple[Field, ...]
+    """The A record's four fields."""
+    b_fields: tuple[Field, ...]
+    """The B record's fields."""
+    params: tuple[ParamSpec, ...]
+    """The C record's fields: the parameters, with their ranges and scales."""
+    replies: tuple[bytes, ...]
+    """What the board sends besides records (`##$`)."""
     fields: tuple[str, str, str, str]
-    """The fields' names (JSON keys), in order."""
+    """The A fields' names (JSON keys), in order."""
+    labels: tuple[str, str, str, str]
+    """The A fields' names for people."""
     motion: tuple[int, ...]
-    """The fields that grow with the car's speed."""
+    """The A fields that grow with the car's speed."""
     scale: float
-    """field = scale × velocity for the motion fields."""
+    """field = scale × velocity for the motion fields (they share one scale)."""
     signed: bool
     """Whether the motion fields carry a sign (else they are magnitudes)."""
-    labels: tuple[str, str, str, str]
-    """The fields' names for people."""
     battery: int | None
-    """The field holding the battery percentage, if any."""
+    """The A field holding the battery percentage, if any."""
 
-    def __init__(
-        self,
-        name: str,
-        fields: tuple[str, str, str, str],
-        motion: tuple[int, ...],
-        scale: float,
-        signed: bool,
-        labels: tuple[str, str, str, str],
-        battery: int | None = None,
-    ) -> None:
-        self._fill(name, fields, motion, scale, signed, labels, battery)
+    def __init__(self, name: str, profile: ProfileFile) -> None:
+        a = profile.a
+        motion = tuple(i for i, field in enumerate(a) if field.motion)
+        first = a[motion[0]] if motion else a[0]
+        self._fill(name, profile)
+        derived = {
+            "a_fields": a,
+            "b_fields": profile.b,
+            "params": profile.params,
+            "replies": tuple(reply.encode() for reply in profile.replies),
+            "fields": tuple(field.name for field in a),
+            "labels": tuple(field.label for field in a),
+            "motion": motion,
+            "scale": first.scale,
+            "signed": first.signed,
+            "battery": next((i for i, field in enumerate(a) if field.battery), None),
+        }
+        for key, value in derived.items():
+            object.__setattr__(self, key, value)
 
     def speed(self, values: tuple[int, ...]) -> float:
         """The largest speed the motion fields show, in the board's velocity unit."""
         return max(abs(values[i]) for i in self.motion) / self.scale
 
+    @property
+    def b_names(self) -> tuple[str, ...]:
+        return tuple(field.name for field in self.b_fields)
 
-def from_profile(name: str, profile: profile_file.ProfileFile) -> ALayout:
-    """The A record's layout a profile file declares (its motion fields share one scale
-    and signedness)."""
-    fields = profile.a
-    motion = tuple(i for i, field in enumerate(fields) if field.motion)
-    first = fields[motion[0]] if motion else fields[0]
-    battery = next((i for i, field in enumerate(fields) if field.battery), None)
-    return ALayout(
-        name,
-        tuple(field.name for field in fields),  # type: ignore[arg-type]  # four: checked
-        motion,
-        first.scale,
-        first.signed,
-        tuple(field.label for field in fields),  # type: ignore[arg-type]
-        battery,
-    )
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(param.name for param in self.params)
 
 
-VELOCITY = from_profile("velocity", profile_file.load("sheet"))
-SCALED = from_profile("scaled", profile_file.load("minibalance"))
-A_LAYOUTS: dict[str, ALayout] = {layout.name: layout for layout in (VELOCITY, SCALED)}
+VELOCITY = Layout("velocity", profile_file.load("sheet"))
+SCALED = Layout("scaled", profile_file.load("minibalance"))
+A_LAYOUTS: dict[str, Layout] = {layout.name: layout for layout in (VELOCITY, SCALED)}

@@ -21,7 +21,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 SHIPPED = ("sheet", "minibalance", "balance")
-"""The profiles appmode ships, in the order `profile list` shows them."""
+"""The profiles appmode ships, in the order `profile list` shows them (the command line's
+options.SHIPPED_PROFILES names them too: a test keeps the two equal)."""
 NAME_CHARACTERS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
 """A profile's, a field's and a parameter's name: these, a letter first (a JSON key and
 a command word)."""
@@ -92,6 +93,8 @@ class ProfileFile(NamedTuple):
     a: tuple[Field, ...]
     b: tuple[Field, ...]
     params: tuple[ParamSpec, ...]
+    boot: str
+    """Text its start-up output holds (the sensor's messages), or ""."""
     path: str
     """Where it was read from."""
 
@@ -141,7 +144,7 @@ def parse(text: str, where: str) -> ProfileFile:
 
 TOP = {
     "name", "description", "source", "like", "baud", "period_ms", "control_port", "saves",
-    "replies", "pages", "speed_keys", "records", "params", "defaults",
+    "replies", "pages", "speed_keys", "records", "params", "defaults", "boot",
 }  # fmt: skip
 FIELD_KEYS = {"name", "label", "unit", "scale", "signed", "wrap", "motion", "battery"}
 PARAM_KEYS = {"name", "label", "minimum", "maximum", "default", "scale"}
@@ -178,6 +181,10 @@ def _build(
     if not (isinstance(replies, list) and all(isinstance(r, str) and r for r in replies)):
         problem(f'replies = {replies!r}: a list of texts, such as ["##$"]')
         replies = []
+    boot = data.get("boot", base.boot if base else "")
+    if not isinstance(boot, str) or len(boot) > 200:
+        problem(f'boot = {boot!r}: a text its start-up output holds, such as "mpu_set_sensor"')
+        boot = ""
     pages = _letters(data, "pages", str, problem, base.pages if base else None)
     speed_keys = _letters(data, "speed_keys", int, problem, base.speed_keys if base else None)
     records = data.get("records", {})
@@ -205,6 +212,7 @@ def _build(
         a,
         b,
         params,
+        boot,
         where,
     )
 

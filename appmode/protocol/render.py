@@ -9,23 +9,23 @@ from typing import Any
 from appmode.protocol import app as p
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape, text_part
-from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, ALayout
+from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, Layout
 from appmode.protocol.params import DEFAULTS, PARAMS, value_error
 from appmode.text import counted
 
-RECORD_FIELDS: dict[str, tuple[str, ...]] = {
-    "A": VELOCITY.fields,
-    "B": ("pitch", "roll", "yaw", "battery"),
-    "C": tuple(param.name for param in PARAMS),
-}
-"""The names of each record's fields, in order (the A record as the sheet lays it out)."""
-JSON_KEYS: tuple[str, ...] = (
-    "kind",
-    *dict.fromkeys(
-        name
-        for names in (*RECORD_FIELDS.values(), *(a.fields for a in A_LAYOUTS.values()))
-        for name in names
-    ),
+
+def record_names(letter: str, layout: Layout = VELOCITY) -> tuple[str, ...]:
+    """The names of a record's fields, in order, as `layout` reads them."""
+    if letter == "A":
+        return layout.fields
+    if letter == "B":
+        return layout.b_names
+    if letter == "C":
+        return layout.param_names
+    return ()
+
+
+OTHER_KEYS = (
     "letter",
     "values",
     "direction",
@@ -41,20 +41,34 @@ JSON_KEYS: tuple[str, ...] = (
     "terminated",
     "raw",
 )
-"""Every key `to_json` may write, in the order a table (CSV) shows them."""
 
 
-def to_json(event: p.Event, layout: ALayout = VELOCITY) -> dict[str, Any]:
+def json_keys(layout: Layout = VELOCITY) -> tuple[str, ...]:
+    """Every key `to_json` may write with `layout`, in the order a table (CSV) shows them:
+    its records' fields, then the other shipped A layouts' (a table of any transcript)."""
+    names = [record_names(letter, layout) for letter in "ABC"]
+    names += [a.fields for a in A_LAYOUTS.values()]
+    return ("kind", *dict.fromkeys(name for group in names for name in group), *OTHER_KEYS)
+
+
+KINDS = {"A": "velocity", "B": "attitude", "C": "params"}
+"""The JSON `kind` of each record the family sends, whatever a profile's fields mean."""
+
+
+def to_json(event: p.Event, layout: Layout = VELOCITY) -> dict[str, Any]:
     """One JSON-ready object: `kind`, the integer values (an A record's named as `layout`
     reads them), and `raw` (escaped bytes)."""
     body: dict[str, Any]
-    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord)):
-        letter, values = p.record_fields(event)
-        kind = {"A": "velocity", "B": "attitude", "C": "params"}[letter]
-        names = layout.fields if letter == "A" else RECORD_FIELDS[letter]
-        body = {"kind": kind, **dict(zip(names, values, strict=True))}
-        if isinstance(event, p.ParamsRecord) and event.out_of_range:
-            body["out_of_range"] = list(event.out_of_range)
+    named = isinstance(event, p.OtherRecord) and len(event.values) == len(
+        record_names(event.letter, layout)
+    )  # a B record of a profile whose B has other than four fields
+    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord)) or named:
+        letter, values = p.record_fields(event)  # type: ignore[arg-type]  # a record
+        names = record_names(letter, layout)
+        body = {"kind": KINDS[letter], **dict(zip(names, values, strict=True))}
+        odd = out_of_range(values, layout) if isinstance(event, p.ParamsRecord) else ()
+        if odd:
+            body["out_of_range"] = list(odd)
     elif isinstance(event, p.OtherRecord):
         body = {"kind": "record", "letter": event.letter, "values": list(event.values)}
     elif isinstance(event, p.Move):
@@ -83,7 +97,7 @@ def to_json(event: p.Event, layout: ALayout = VELOCITY) -> dict[str, Any]:
     elif isinstance(event, p.Noise):
         body = {"kind": "noise"}
     elif isinstance(event, p.Garbage):
-        body = {"kind": "garbage"}
+        body = {"kind": "reply" if event.raw in layout.replies else "garbage"}
     else:
         body = {
             "kind": "bad_frame" if isinstance(event, p.BadFrame) else "malformed",
@@ -100,11 +114,11 @@ def to_json(event: p.Event, layout: ALayout = VELOCITY) -> dict[str, Any]:
 _JSON = json.JSONEncoder(ensure_ascii=False).encode
 
 
-def json_line(event: p.Event, layout: ALayout = VELOCITY) -> str:
+def json_line(event: p.Event, layout: Layout = VELOCITY) -> str:
     """`to_json(event, layout)` as `json.dumps(…, ensure_ascii=False)` writes it. Whole A
     and B records whose text needs no JSON escaping are formatted directly: `appmode
     decode` spends its time here."""
-    if layout is not VELOCITY and isinstance(event, p.Velocity):
+    if layout is not VELOCITY:
         return _JSON(to_json(event, layout))
     if isinstance(event, (p.Velocity, p.Attitude)) and event.terminated:
         raw = escape(event.raw)
@@ -118,15 +132,20 @@ def json_line(event: p.Event, layout: ALayout = VELOCITY) -> str:
                 f'{{"kind": "attitude", "pitch": {event.pitch}, "roll": {event.roll}, '
                 f'"yaw": {event.yaw}, "battery": {event.battery}, "raw": "{raw}"}}'
             )
-    return _JSON(to_json(event))
+    return _JSON(to_json(event, layout))
 
 
-def motion_text(record: p.Velocity, layout: ALayout = VELOCITY) -> str:
+def motion_text(record: p.Velocity, layout: Layout = VELOCITY) -> str:
     """An A record's fields by name, as `layout` reads them: `x=0 y=500 z=0`."""
     values = (record.x, record.y, record.z, record.extra)
     shown = [f"{layout.fields[i]}={values[i]}" for i in layout.motion]
     if layout.battery is not None:
         shown.append(f"battery={values[layout.battery]}%")
+    shown += [  # what else has a unit (the balance car's angle; not the sheet's `extra`)
+        f"{field.name}={values[i]}"
+        for i, field in enumerate(layout.a_fields)
+        if field.unit and i not in layout.motion and i != layout.battery
+    ]
     return " ".join(shown)
 
 
@@ -135,19 +154,37 @@ SHOWN_PARAMS = 1
 prints them as a table, `--json` by name)."""
 
 
-def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
+def out_of_range(values: tuple[int, ...], layout: Layout = VELOCITY) -> tuple[str, ...]:
+    """The names of a C record's values outside `layout`'s ranges (a board holds what it
+    is sent: they are shown, flagged)."""
+    specs = layout.params
+    if layout.params == VELOCITY.params or len(values) != len(specs):
+        return p.ParamsRecord(values).out_of_range if len(values) == len(VELOCITY.params) else ()
+    return tuple(
+        s.name for s, v in zip(specs, values, strict=True) if not s.minimum <= v <= s.maximum
+    )
+
+
+def describe(event: p.Event, layout: Layout = VELOCITY) -> str:
     """A short human description of an event (an A record's fields as `layout` reads them)."""
     if isinstance(event, p.Velocity):
         return f"velocity {motion_text(event, layout)}"
-    if isinstance(event, p.Attitude):
+    if isinstance(event, p.Attitude) and layout.b_fields == VELOCITY.b_fields:
         return (
             f"attitude pitch={event.pitch} roll={event.roll} yaw={event.yaw} "
             f"battery={event.battery}%"
         )
+    if isinstance(event, (p.Attitude, p.OtherRecord)) and (
+        p.record_fields(event)[0] == "B" and len(p.record_fields(event)[1]) == len(layout.b_fields)
+    ):
+        values = p.record_fields(event)[1]
+        pairs = zip(layout.b_fields, values, strict=True)
+        shown = (f"{f.name}={v}{'%' if f.battery else ''}" for f, v in pairs)
+        return "attitude " + " ".join(shown)
     if isinstance(event, p.ParamsRecord):
-        first = list(event.as_dict().items())[:SHOWN_PARAMS]
+        first = list(zip(layout.param_names, event.values, strict=False))[:SHOWN_PARAMS]
         text = "params " + " ".join(f"{k}={v}" for k, v in first) + " …"
-        odd = event.out_of_range
+        odd = out_of_range(event.values, layout)
         return text if not odd else f"{text} (out of range: {', '.join(odd)})"
     if isinstance(event, p.OtherRecord):
         return f"record {event.letter} {list(event.values)}"
@@ -164,6 +201,8 @@ def describe(event: p.Event, layout: ALayout = VELOCITY) -> str:
         return f"set {event.name} = {event.value}"
     if isinstance(event, (p.BadFrame, p.Malformed)):
         return f"error: {event.reason}"
+    if isinstance(event, p.Garbage) and event.raw in layout.replies:
+        return f"reply (this firmware sends it besides records: {layout.name})"
     if event.raw.endswith(b"}$") and b"{" not in event.raw:
         return f"a record's end, its start missed ({counted(len(event.raw), 'byte')})"
     if event.raw and text_part(event.raw) == event.raw:

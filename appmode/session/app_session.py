@@ -28,7 +28,7 @@ from appmode.protocol.directions import (
     grid_for,
     letter_name,
 )
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.session import instruments
 from appmode.session.app_commands import COMMANDS
 from appmode.session.base import (
@@ -68,7 +68,7 @@ class Session(BaseSession):
         driving: HoldToDrive | None = None,
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
-        layout: ALayout = VELOCITY,
+        layout: Layout = VELOCITY,
         stop_again: bytes | None = None,
         frames_stop: bool = False,
     ) -> None:

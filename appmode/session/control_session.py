@@ -25,7 +25,7 @@ from appmode.host.tokens import Wait
 from appmode.ports.target import Target
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
 from appmode.session.base import SPEED_KEYS, BaseSession
 from appmode.session.control_commands import COMMANDS, SETTING_NAMES
@@ -96,7 +96,7 @@ class ControlSession(BaseSession):
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
         app_url: Target | str | None = None,
-        layout: ALayout = VELOCITY,
+        layout: Layout = VELOCITY,
         drive: DriveType | None = None,
         takeover_byte: int = TAKEOVER_BYTE,
         reads: bool = True,

@@ -12,15 +12,15 @@ from io import BytesIO
 from pathlib import Path
 from typing import Any, TextIO
 
-from appmode.board.profiles import PROFILES
+from appmode.board.profiles import profile_named
 from appmode.errors import AppmodeError, InvalidValue
 from appmode.files import check_writable, say_if_fifo, write_whole
 from appmode.protocol import app, control
 from appmode.protocol.control_view import view
-from appmode.protocol.layouts import VELOCITY, ALayout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT2, PortsReader
-from appmode.protocol.render import JSON_KEYS, RECORD_FIELDS, line
+from appmode.protocol.render import json_keys, line, record_names
 from appmode.protocol.transcript import (
     DIRECTIONS,
     Directive,
@@ -37,9 +37,6 @@ from appmode.transcript.matcher import (
     board_needs,
     parse_pattern,
 )
-
-CSV_FIELDS = ("t", "dir", *JSON_KEYS)
-
 
 Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent
 
@@ -83,10 +80,10 @@ def needs_of(path: str, warn: Callable[[str], None]) -> BoardNeeds:
     return needs
 
 
-def expectation_json(pattern: Pattern, layout: ALayout = VELOCITY) -> dict[str, Any]:
+def expectation_json(pattern: Pattern, layout: Layout = VELOCITY) -> dict[str, Any]:
     """An expectation as `to_json` shows records, `"*"` for a field that matches any and
     `"LO..HI"` for a range."""
-    names = layout.fields if pattern.letter == "A" else RECORD_FIELDS.get(pattern.letter, ())
+    names = record_names(pattern.letter, layout)
     values: list[int | str] = [
         "*" if f is None else f[0] if f[0] == f[1] else f"{f[0]}..{f[1]}" for f in pattern.fields
     ]
@@ -103,9 +100,10 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
     transcript's `@board profile=…`, else the sheet's)."""
     say_if_fifo(path)
     needs = needs_of(path, lambda text: None)  # the second pass warns
-    layout = (PROFILES[profile] if profile else needs.profile).a_layout
+    layout = (profile_named(profile) if profile else needs.profile).a_layout
     if fmt == "csv":
-        writer = csv.DictWriter(out, fieldnames=CSV_FIELDS, extrasaction="ignore")
+        fields = ("t", "dir", *json_keys(layout))
+        writer = csv.DictWriter(out, fieldnames=fields, extrasaction="ignore")
         writer.writeheader()
     items = iter_transcript(path, lambda text: print(f"appmode: WARNING: {text}", file=sys.stderr))
     for t, direction, event in decoded(items, needs.drive, path):

@@ -24,7 +24,7 @@ import bisect
 import re
 from dataclasses import dataclass, field
 
-from appmode.board.profiles import SHEET, Profile, profile_named
+from appmode.board.profiles import SHEET, Profile, shipped_profile
 from appmode.errors import AppmodeError, InvalidValue
 from appmode.line.wire import APP as APP_PORT
 from appmode.line.wire import UART2 as UART2_PORT
@@ -333,7 +333,7 @@ def board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:
             )
         found[key] = value
     try:
-        profile = profile_named(found.get("profile", "sheet"))
+        profile = shipped_profile(found.get("profile", "sheet"))
         drive = DriveType.from_cli_name(found["drive"]) if "drive" in found else None
         profile.check(drive=drive is not None, flash=False)
     except (AppmodeError, ValueError) as exc:

@@ -33,7 +33,7 @@ def test_escape_is_the_table_byte_by_byte(data: bytes) -> None:
 
 def test_json_keys_name_every_key_to_json_writes() -> None:
     from appmode.protocol import app_decoders
-    from appmode.protocol.render import JSON_KEYS, to_json
+    from appmode.protocol.render import json_keys, to_json
 
     events = [
         *app_decoders.BoardDecoder().feed(
@@ -46,4 +46,4 @@ def test_json_keys_name_every_key_to_json_writes() -> None:
     kinds = {to_json(e)["kind"] for e in events}
     assert len(kinds) >= 12, kinds
     for event in events:
-        assert set(to_json(event)) <= set(JSON_KEYS), to_json(event)
+        assert set(to_json(event)) <= set(json_keys()), to_json(event)
