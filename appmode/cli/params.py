@@ -17,7 +17,8 @@ from appmode.cli.options import (
     profile_for,
 )
 from appmode.errors import AppmodeError
-from appmode.protocol import params
+from appmode.protocol import param_values, params
+from appmode.protocol.param_values import Specs
 
 if TYPE_CHECKING:  # imported when the command runs: start-up stays short
     from appmode.board.profiles import Profile
@@ -109,19 +110,20 @@ def run(args: argparse.Namespace) -> int:
     )
 
 
-def parse_assignment(text: str) -> tuple[int, int]:
-    """`NAME=VALUE` (or `N=VALUE`), checked against the parameter table."""
+def parse_assignment(text: str, specs: Specs = param_values.SHEET) -> tuple[int, int]:
+    """`NAME=VALUE` (or `N=VALUE`), in the user's units, checked against the profile's
+    table: (index, the frame's integer)."""
     name, sep, value = text.partition("=")
     if not sep:
-        raise AppmodeError(f"--set {text!r}: expected NAME=VALUE, e.g. max_speed=800")
-    param = params.lookup(name.strip())
-    number = params.whole(value)
-    if number is None:
-        raise AppmodeError(
-            f"--set {text!r}: {param.name} takes a whole number in {param.range_text}"
-        )
-    params.check_value(param.index, number)
-    return param.index, number
+        example = f"{specs[0].name}={param_values.to_user(specs[0], specs[0].default)}"
+        raise AppmodeError(f"--set {text!r}: expected NAME=VALUE, e.g. {example}")
+    try:
+        index = param_values.lookup(specs, name.strip())
+        number = param_values.from_user(specs[index], value)
+        param_values.check(specs, index, number)
+    except AppmodeError as exc:
+        raise AppmodeError(f"--set {text!r}: {exc}") from None
+    return index, number
 
 
 def run_params(
@@ -143,7 +145,8 @@ def run_params(
     from appmode.host import saves
     from appmode.protocol.render import params_table
 
-    changes = [parse_assignment(text) for text in assignments]  # all checked first
+    specs = profile.a_layout.params
+    changes = [parse_assignment(text, specs) for text in assignments]  # all checked first
     saved = saves.recall(url.url) if verify else None
     if verify and saved is None:
         raise AppmodeError(
@@ -155,7 +158,8 @@ def run_params(
         values = host.read_params()
         for index, value in changes:
             values = host.set_param(index, value)
-            print(f"set {params.PARAMS[index].name} = {value} (verified)", file=sys.stderr)
+            shown = param_values.to_user(specs[index], value)
+            print(f"set {specs[index].name} = {shown} (verified)", file=sys.stderr)
         if save:
             host.save()
             values = host.read_params()
@@ -173,17 +177,16 @@ def run_params(
                 )
     status = 0
     if saved is not None:
-        status = _verify(values, *saved)
+        status = _verify(specs, values, *saved)
     if as_json:
-        out.write(
-            json.dumps({p.name: v for p, v in zip(params.PARAMS, values, strict=True)}) + "\n"
-        )
+        pairs = zip(specs, values, strict=True)
+        out.write(json.dumps({s.name: param_values.user_number(s, v) for s, v in pairs}) + "\n")
     else:
-        out.write(params_table(values, profile.defaults) + "\n")
+        out.write(params_table(values, profile.defaults, specs) + "\n")
     for index, value in enumerate(values):
-        error = params.value_error(index, value)
+        error = param_values.error(specs, index, value)
         if error is not None:  # a board may hold it: say so, and how to repair it
-            name = params.PARAMS[index].name
+            name = specs[index].name
             print(
                 f"appmode: the board holds {name} = {value} ({error}): repair it with "
                 f"--set {name}=N",
@@ -192,9 +195,13 @@ def run_params(
     return status
 
 
-def _verify(values: tuple[int, ...], saved: tuple[int, ...], at: str) -> int:
+def _verify(specs: Specs, values: tuple[int, ...], saved: tuple[int, ...], at: str) -> int:
     """Say whether the board holds what was saved; 1 if it does not."""
-    differ = params.changes(saved, values)
+    differ = [
+        f"{spec.name} {param_values.to_user(spec, a)} → {param_values.to_user(spec, b)}"
+        for spec, a, b in zip(specs, saved, values, strict=False)
+        if a != b
+    ]
     if not differ:
         print(f"the board holds the parameters saved at {at}: the save held", file=sys.stderr)
         return 0

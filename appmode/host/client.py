@@ -17,9 +17,10 @@ from appmode.host.stop_check import SETTLE, StopCheck
 from appmode.line.wire import UART2, Tap
 from appmode.ports.target import Target, as_target
 from appmode.ports.urls import open_link
-from appmode.protocol import app, params, session_end
+from appmode.protocol import app, session_end
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
+from appmode.protocol.param_values import Specs
 from appmode.protocol.render import motion_text
 
 CONFIRM_STEP = 0.05
@@ -114,12 +115,16 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
 
     def read_params(self, timeout: float = TIMEOUT, tries: int = TRIES) -> tuple[int, ...]:
         """Send `{Q:P}` and wait for the C record, retrying; AppmodeError if none comes."""
-        return self.query(ParamQuery(None, timeout, tries, self.url))
+        return self.query(ParamQuery(None, timeout, tries, self.url, specs=self._specs))
 
     def set_param(self, index: int, value: int, tries: int = TRIES) -> tuple[int, ...]:
-        """Set a parameter and verify it by reading back; returns the parameters read."""
-        params.check_value(index, value)
-        return self.query(ParamQuery((index, value), TIMEOUT, tries, self.url))
+        """Set a parameter (the frame's integer, checked against the profile's table) and
+        verify it by reading back; returns the parameters read."""
+        return self.query(ParamQuery((index, value), TIMEOUT, tries, self.url, specs=self._specs))
+
+    @property
+    def _specs(self) -> Specs:
+        return self.state.layout.params
 
     def save(self) -> None:
         """Send `{Q:W}`: the board saves its running parameters to flash."""

@@ -6,8 +6,7 @@ and 115200 for the control port's traffic (UART2: encoder reports, the reference
 firmware's status bursts). The only bytes ever sent are `{Q:P}` frames to a port that
 streams APP records, to read its parameters: never a drive letter, and nothing to a
 silent port, where a control port would count them toward its take-over (§8.3). The
-firmware is told from its record period (§3.4, §13: 50 ms on the sheet, about 60 ms on
-the reference firmware).
+firmware is told from what it sends, against the shipped profiles (`identify`).
 """
 
 from __future__ import annotations
@@ -21,13 +20,14 @@ from dataclasses import dataclass, field
 
 import serial
 
-from appmode.board.profiles import PROFILES, Profile
+from appmode.board.profiles import Profile, profile_named
 from appmode.errors import AppmodeError
+from appmode.host import identify
 from appmode.host.client import Host
 from appmode.line.wire import APP_BAUD, UART2_BAUD
 from appmode.ports.target import Target, as_target
 from appmode.ports.urls import open_link
-from appmode.protocol import app, app_decoders, control, control_decoders, params
+from appmode.protocol import app, app_decoders, control, control_decoders, param_values
 from appmode.protocol.escaping import text_part
 
 RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
@@ -44,8 +44,6 @@ ENOUGH = 3
 """Records (or control-port bursts) that show what a port carries."""
 STARTED = 8
 """Records after a board's start-up text that give its period."""
-PERIOD_FIT = 0.1
-"""How far (as a fraction) a measured record period may be from a firmware's."""
 READ_TRIES = 2
 """Rounds of `{Q:P}` for the parameters (each asks for two agreeing C records)."""
 STATUS_RATE = 40
@@ -54,6 +52,8 @@ reference firmware sends one after each record (about 17 a second); a device tha
 streams `00 FF` without pause makes thousands."""
 SAMPLE = 48
 """Bytes of text kept to show what a port that is not a board sent."""
+TEXT = 4096
+"""Bytes of text kept for firmware identification (a start-up text is about 400)."""
 
 Progress = Callable[[str], None]
 
@@ -74,6 +74,15 @@ class Heard:
     """Bytes decoded outside records."""
     printable: int = 0
     sample: bytearray = field(default_factory=bytearray)
+    shapes: list[tuple[str, tuple[int, ...]]] = field(default_factory=list)
+    """The first records (letter, values), whatever their field counts."""
+    said: bytearray = field(default_factory=bytearray)
+    """The first text outside records (a start-up text, a `##$` reply)."""
+
+    @property
+    def sent(self) -> identify.Sent:
+        """What firmware identification reads of it."""
+        return identify.Sent(self.shapes, self.period_ms, bytes(self.said))
 
     @property
     def records(self) -> int:
@@ -120,12 +129,15 @@ class Heard:
             if isinstance(event, app.RECORDS) and event.terminated:
                 self.record_times.append(at)
                 self.record_sizes.append(len(event.raw))
+                if len(self.shapes) < identify.SHOWN:
+                    self.shapes.append(app.record_fields(event))
             elif not isinstance(event, app.RECORDS):
                 self.outside += len(event.raw)
                 printable = text_part(event.raw)
                 self.printable += len(printable)
                 if len(printable) == len(event.raw):
                     self.sample += printable[: SAMPLE - len(self.sample)]
+                    self.said += printable[: TEXT - len(self.said)]
         for burst in uart2_decoder.feed(data):
             if isinstance(burst, (control.EncoderReport, control.Status, control.Reply)):
                 self.uart2_bursts += 1
@@ -149,6 +161,8 @@ class Finding:
     period_ms: float | None = None
     values: tuple[int, ...] | None = None
     heard: list[Heard] = field(default_factory=list)
+    specs: param_values.Specs = param_values.SHEET
+    """The parameters' table that names `values` (the profile's, or the nearest's)."""
 
     @property
     def is_car(self) -> bool:
@@ -166,7 +180,10 @@ class Finding:
             "record_period_ms": None if self.period_ms is None else round(self.period_ms, 1),
             "params": None
             if self.values is None
-            else {p.name: v for p, v in zip(params.PARAMS, self.values, strict=True)},
+            else {
+                s.name: param_values.user_number(s, v)
+                for s, v in zip(self.specs, self.values, strict=False)
+            },
             "heard": [
                 {
                     "baud": h.baud,
@@ -180,17 +197,11 @@ class Finding:
         }
 
 
-def firmware(heard: Heard) -> Profile | None:
-    """The profile whose record period fits what was heard, if one does."""
-    measured = heard.period_ms
-    if measured is None:
-        return None
-    for profile in PROFILES.values():
-        sizes = heard.record_sizes[:-1] or heard.record_sizes
-        expected = sum(profile.record_period_ms(size) for size in sizes) / len(sizes)
-        if abs(measured - expected) <= PERIOD_FIT * expected:
-            return profile
-    return None
+def firmware(sent: identify.Sent) -> tuple[Profile | None, identify.Judgement]:
+    """The shipped profile that fits what was sent (None when none does), and the
+    nearest one's judgement."""
+    found, nearest = identify.best(sent)
+    return (profile_named(found.name) if found else None), nearest
 
 
 def listen(
@@ -201,7 +212,7 @@ def listen(
     port = open_link(url, timeout=0.02, baud=baud)
     heard = Heard(baud)
     app_decoder, uart2_decoder = (
-        app_decoders.BoardDecoder(),
+        app_decoders.BoardDecoder(b_fields=None),  # any field count: the firmware is not known
         control_decoders.ReplyDecoder(wheels=None),
     )
     start = time.monotonic()
@@ -277,14 +288,14 @@ def _car(
     progress: Progress,
 ) -> Finding:
     url, fixed = given.url, bool(given.scheme)
-    profile = firmware(one)
+    profile, nearest = firmware(one.sent)
     ports = [port]
 
     def reopen(target: str) -> serial.SerialBase:
         return ports.pop() if ports else open_link(target, timeout=0.02, baud=one.baud)
 
     progress(f"reading the parameters at {one.baud} bps")
-    layout = (profile or PROFILES["sheet"]).a_layout
+    layout = (profile or profile_named(nearest.profile.name)).a_layout
     values: tuple[int, ...] | None = None
     failure = ""
     host = Host(path, opener=reopen, stop_on_close=False, layout=layout)
@@ -294,6 +305,10 @@ def _car(
         failure = str(exc)
     finally:
         host.close()
+    replied = bytes(host.state.outside)  # a `##$` before the C record names some firmware
+    if replied:
+        sent = one.sent
+        profile, nearest = firmware(sent._replace(text=sent.text + replied))
     target = _with_baud(path, one.baud, APP_BAUD, fixed)
     rate = "" if fixed else f" at {one.baud} bps"
     period = f"a record every {5 * round((one.period_ms or 0) / 5)} ms"  # to 5 ms: a rhythm
@@ -302,19 +317,33 @@ def _car(
     if profile is not None and profile.name != "sheet" and not given.simulated:
         flag = f" --profile {profile.name}"
     drive = f"appmode drive {shlex.quote(target)}{flag}"
+    if profile is None:
+        name = nearest.profile.name
+        drive = (
+            f"its records fit no shipped profile (nearest: {name}, but "
+            f"{'; '.join(nearest.against[:2])}): write one for it, starting from "
+            f"appmode profile show {name} --toml > mycar.toml, then "
+            f"appmode drive {shlex.quote(target)} --profile mycar.toml"
+        )
+    else:
+        drive = f"drive it with: {drive}"
+    specs = (profile or profile_named(nearest.profile.name)).a_layout.params
     if values is None:
         return Finding(
             url,
             "app",
             f"a car's APP port{rate}, {what}; its parameters did not come",
-            f"{failure}; drive it with: {drive}",
+            f"{failure}; {drive}",
             one.baud,
             profile.name if profile else None,
             one.period_ms,
             None,
             heard,
+            specs,
         )
-    shown = ", ".join(f"{p.name}={v}" for p, v in zip(params.PARAMS, values, strict=True))
+    shown = ", ".join(
+        f"{s.name}={param_values.to_user(s, v)}" for s, v in zip(specs, values, strict=False)
+    )
     note = (
         ""
         if fixed or one.baud == APP_BAUD
@@ -324,12 +353,13 @@ def _car(
         url,
         "app",
         f"this is a car: APP port{rate}{note}, {what}, parameters {shown}",
-        f"drive it with: {drive}",
+        drive,
         one.baud,
         profile.name if profile else None,
         one.period_ms,
         values,
         heard,
+        specs,
     )
 
 

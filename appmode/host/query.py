@@ -16,7 +16,8 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 
-from appmode.protocol import app, params
+from appmode.protocol import app, param_values
+from appmode.protocol.param_values import Specs
 
 TIMEOUT = 0.5
 TRIES = 5
@@ -56,9 +57,12 @@ class ParamQuery:
         tries: int = TRIES,
         where: str = "the board",
         agree: int = AGREE,
+        specs: Specs = param_values.SHEET,
     ) -> None:
         if change is not None:
-            params.check_value(*change)
+            param_values.check(specs, *change)
+        self.specs = specs
+        """The parameters' table (the profile's): their names and ranges."""
         self.change = change
         self.timeout = timeout
         self.tries = tries
@@ -84,7 +88,7 @@ class ParamQuery:
         read = app.encode(app.ReadParams())
         if self.change is None or not with_change:
             return read
-        return app.encode(app.SetParam(*self.change)) + read
+        return app.set_frame(*self.change) + read
 
     def start(self, now: float) -> bytes:
         """The bytes to send first."""
@@ -109,7 +113,9 @@ class ParamQuery:
             return b"", QueryDone(values, "parameters read")
         index, value = self.change
         if values[index] == value:
-            return b"", QueryDone(values, f"{params.PARAMS[index].name} = {value} (verified)")
+            spec = self.specs[index]
+            shown = param_values.to_user(spec, value)
+            return b"", QueryDone(values, f"{spec.name} = {shown} (verified)")
         same = self._mismatch == values[index]
         self._mismatch = values[index]
         self._mismatches = self._mismatches + 1 if same else 1
@@ -119,15 +125,19 @@ class ParamQuery:
         return self._retry(now)
 
     def _refused(self, index: int, value: int) -> QueryFailed:
-        name = params.PARAMS[index].name
-        held = self._mismatch
+        spec = self.specs[index]
+        name = spec.name
+        mismatch = self._mismatch
+        held = "?" if mismatch is None else param_values.to_user(spec, mismatch)
         if self.known is None:
             what = f"{name} reads {held}"
-        elif held == self.known[index]:
+        elif mismatch == self.known[index]:
             what = f"the board ignored it: {name} is still {held}"
         else:
             what = f"the board set {name} to {held} instead"
-        return QueryFailed(f"set {name} = {value} was not taken: {what}")
+        return QueryFailed(
+            f"set {name} = {param_values.to_user(spec, value)} was not taken: {what}"
+        )
 
     def on_garbled(self, now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived garbled: the link is noisy; ask again at once rather than

@@ -19,6 +19,8 @@ from appmode.text import counted
 RATE_WINDOW = 2.0
 DEGRADED_WINDOW = 5.0
 TRACE_SECONDS = 10.0
+OUTSIDE = 256
+"""Bytes kept of what came outside records (`HostState.outside`)."""
 """How much of the telemetry the host keeps, for waveforms."""
 
 
@@ -116,9 +118,11 @@ class HostState:
         """How the board's A records are laid out (§3.1, §13)."""
         self.frames_stop = frames_stop
         """Every frame sent stops the car (a minibalance board: its `{` steers, §13)."""
-        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields))
+        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields), len(self.layout.params))
         self.in_step = False
         """A record has come since the link opened: undecodable bytes are errors now."""
+        self.outside = bytearray()
+        """The first OUTSIDE bytes that were no record (a firmware's `##$` reply)."""
         self.stats = LinkStats()
         self.velocity: app.Velocity | None = None
         self.attitude: app.Attitude | None = None
@@ -242,7 +246,7 @@ class HostState:
 
     def reset_decoder(self) -> None:
         """Forget a partial record (after the link was lost: the board may restart)."""
-        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields))
+        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields), len(self.layout.params))
         self.in_step = False
         self.letters_ignored = False
 
@@ -250,6 +254,7 @@ class HostState:
         if isinstance(event, app.Garbage) and event.raw in self.layout.replies:
             return None  # what this firmware sends besides records (`##$`)
         if isinstance(event, app.ERRORS):
+            self.outside += event.raw[: OUTSIDE - len(self.outside)]
             if not self.in_step and not event.raw.startswith(b"{"):  # no record's start
                 self.stats.skipped += len(event.raw)
             else:

@@ -216,7 +216,7 @@ class ParamsRecord(Slotted):
     def out_of_range(self) -> tuple[str, ...]:
         """The names of the values outside the sheet's ranges: a real firmware takes any
         value it is sent, so a board can hold them (they are shown, flagged)."""
-        if params.values_error(self.values) is None:
+        if len(self.values) != params.PARAM_COUNT or params.values_error(self.values) is None:
             return ()
         return tuple(
             p.name
@@ -282,6 +282,12 @@ def record_fields(record: Record) -> tuple[str, tuple[int, ...]]:
     return record.letter, record.values
 
 
+def set_frame(index: int, value: int) -> bytes:
+    """`{n:v}`, unchecked: the caller checked `value` against its profile's table
+    (`encode(SetParam(…))` checks it against the sheet's)."""
+    return b"{%d:%d}" % (index, value)
+
+
 def record_bytes(letter: bytes, values: Sequence[int]) -> bytes:
     """A record's wire bytes: `{`, its letter, its values joined by `:`, `}$`."""
     return b"{%s%s}$" % (letter, b":".join(b"%d" % v for v in values))
@@ -305,7 +311,7 @@ def encode(item: Event) -> bytes:
         return b"{Q" + bytes([item.separator]) + b"W}"
     if isinstance(item, SetParam):
         params.check_value(item.index, item.value)
-        return b"{%d:%d}" % (item.index, item.value)
+        return set_frame(item.index, item.value)
     if isinstance(item, Velocity):
         return record_bytes(b"A", (item.x, item.y, item.z, item.extra))
     if isinstance(item, Attitude):

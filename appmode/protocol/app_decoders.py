@@ -253,7 +253,11 @@ _FIELDS = re.compile(rb"-?[0-9]+(?::-?[0-9]+)*")
 _RECORD_SIZES = {ord("A"): 4, ord("B"): 4, ord("C"): params.PARAM_COUNT}
 
 
-def _parse_record(raw: bytes, body: bytes, terminated: bool, b_fields: int = 4) -> BoardEvent:
+def _parse_record(
+    raw: bytes, body: bytes, terminated: bool, b_fields: int | None = 4, c_fields: int = 9
+) -> BoardEvent:
+    """One record's event; `b_fields` None: any record whose field count is not the
+    sheet's is an OtherRecord (a probe that does not know the firmware yet)."""
     if not body:
         return Malformed(raw, "empty record")
     letter = body[0]
@@ -263,7 +267,9 @@ def _parse_record(raw: bytes, body: bytes, terminated: bool, b_fields: int = 4) 
     if not _FIELDS.fullmatch(fields):
         return Malformed(raw, "fields are not ':'-separated integers")
     values = tuple(int(f) for f in fields.split(b":"))
-    size = b_fields if letter == 0x42 else _RECORD_SIZES.get(letter)
+    size = {0x42: b_fields, 0x43: c_fields}.get(letter, _RECORD_SIZES.get(letter))
+    if b_fields is None and len(values) != _RECORD_SIZES.get(letter):
+        size = None
     if size is None or (letter == 0x42 and size != 4 and len(values) == size):
         return OtherRecord(chr(letter), values, terminated, raw)  # a profile names the Bs
     if len(values) != size:
@@ -291,16 +297,22 @@ class BoardDecoder:
     LIMIT = max(MAX_RECORD, MAX_RUN)
     """Most bytes ever held between calls."""
 
-    def __init__(self, b_fields: int = 4) -> None:
-        """`b_fields`: how many fields the profile's B record has (the sheet's four are
-        an `Attitude`; other counts an `OtherRecord` that the profile's layout names)."""
+    def __init__(self, b_fields: int | None = 4, c_fields: int = params.PARAM_COUNT) -> None:
+        """`b_fields`, `c_fields`: how many fields the profile's B and C records have
+        (the sheet's four B fields are an `Attitude`; other counts an `OtherRecord` that
+        the profile's layout names); `b_fields` None: any count, as an OtherRecord."""
         self._buf = b""
         self._b_fields = b_fields
-        self._fast = _FAST if b_fields == 4 else _FAST_A
+        self._c_fields = c_fields
+        self._fast = _FAST if b_fields in (4, None) else _FAST_A
 
     @property
     def buffered(self) -> int:
         return len(self._buf)
+
+    @property
+    def _sizes(self) -> tuple[int | None, int]:
+        return self._b_fields, self._c_fields
 
     @linear
     def feed(self, data: bytes) -> list[BoardEvent]:
@@ -355,9 +367,7 @@ class BoardDecoder:
                     break  # a '$' may follow
                 end = close + 2 if close + 1 < n and buf[close + 1] == DOLLAR else close + 1
                 raw = buf[pos:end]
-                out.append(
-                    _parse_record(raw, raw[1 : close - pos], end == close + 2, self._b_fields)
-                )
+                out.append(_parse_record(raw, raw[1 : close - pos], end == close + 2, *self._sizes))
                 pos = end
             elif n - pos >= MAX_RECORD:
                 out.append(Malformed(buf[pos:limit], f"over {MAX_RECORD} bytes without '}}'"))
@@ -378,5 +388,5 @@ class BoardDecoder:
         if raw[0] != LBRACE:
             return [Garbage(raw)]
         if raw.endswith(b"}"):
-            return [_parse_record(raw, raw[1:-1], False, self._b_fields)]
+            return [_parse_record(raw, raw[1:-1], False, *self._sizes)]
         return [Malformed(raw, "unterminated record at end of stream")]

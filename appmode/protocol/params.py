@@ -34,9 +34,10 @@ class Param(NamedTuple):
         return f"{self.minimum}–{self.maximum}"
 
 
+SPECS: tuple[profile_file.ParamSpec, ...] = profile_file.load("sheet").params
+"""The sheet's nine as its file declares them (`param_values` reads any profile's)."""
 PARAMS: tuple[Param, ...] = tuple(
-    Param(i, p.name, p.label, p.maximum, p.default, p.minimum)
-    for i, p in enumerate(profile_file.load("sheet").params)
+    Param(i, p.name, p.label, p.maximum, p.default, p.minimum) for i, p in enumerate(SPECS)
 )
 """The sheet's nine, read from its profile file (`protocol/profiles/sheet.toml`)."""
 PARAM_COUNT = len(PARAMS)

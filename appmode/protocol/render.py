@@ -7,10 +7,11 @@ from collections.abc import Iterable, Iterator
 from typing import Any
 
 from appmode.protocol import app as p
+from appmode.protocol import param_values
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape, text_part
 from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, Layout
-from appmode.protocol.params import DEFAULTS, PARAMS, value_error
+from appmode.protocol.params import DEFAULTS
 from appmode.text import counted
 
 
@@ -157,12 +158,9 @@ prints them as a table, `--json` by name)."""
 def out_of_range(values: tuple[int, ...], layout: Layout = VELOCITY) -> tuple[str, ...]:
     """The names of a C record's values outside `layout`'s ranges (a board holds what it
     is sent: they are shown, flagged)."""
-    specs = layout.params
-    if layout.params == VELOCITY.params or len(values) != len(specs):
-        return p.ParamsRecord(values).out_of_range if len(values) == len(VELOCITY.params) else ()
-    return tuple(
-        s.name for s, v in zip(specs, values, strict=True) if not s.minimum <= v <= s.maximum
-    )
+    if len(values) != len(layout.params):
+        return ()
+    return param_values.out_of_range(layout.params, values)
 
 
 def describe(event: p.Event, layout: Layout = VELOCITY) -> str:
@@ -262,14 +260,19 @@ def line(time: float, direction: str, raw: bytes, text: str, shown: str | None =
     return f"{head}{shown:<{min(RAW_WIDTH, max(room, len(shown)))}} {text}"
 
 
-def params_table(values: tuple[int, ...], defaults: tuple[int, ...] = DEFAULTS) -> str:
-    """The nine parameters as an aligned table with their ranges and the board's defaults;
-    a value outside its range (a real board may hold one) is flagged."""
+def params_table(
+    values: tuple[int, ...],
+    defaults: tuple[int, ...] = DEFAULTS,
+    specs: param_values.Specs = param_values.SHEET,
+) -> str:
+    """The parameters as an aligned table, in the user's units, with their ranges and the
+    board's defaults; a value outside its range (a real board may hold one) is flagged."""
     rows = [f"{'n':>2}  {'name':<18} {'value':>10}  {'range':<14} {'default':>7}"]
-    for param, value, default in zip(PARAMS, values, defaults, strict=True):
-        flag = "" if value_error(param.index, value) is None else "  out of range"
+    for index, (spec, value, default) in enumerate(zip(specs, values, defaults, strict=True)):
+        flag = "" if param_values.error(specs, index, value) is None else "  out of range"
+        shown, usual = param_values.to_user(spec, value), param_values.to_user(spec, default)
         rows.append(
-            f"{param.index:>2}  {param.name:<18} {value:>10}  "
-            f"{param.range_text:<14} {default:>7}{flag}"
+            f"{index:>2}  {spec.name:<18} {shown:>10}  "
+            f"{param_values.range_text(spec):<14} {usual:>7}{flag}"
         )
     return "\n".join(rows)

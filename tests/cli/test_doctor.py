@@ -210,22 +210,38 @@ def test_no_ports_at_all_says_how_to_connect_one(
 
 def timed_records(period_ms: float, records: list[bytes]) -> probe.Heard:
     heard = probe.Heard(9600)
-    decoders = app_decoders.BoardDecoder(), probe.control_decoders.ReplyDecoder(wheels=None)
+    decoders = (
+        app_decoders.BoardDecoder(b_fields=None),
+        probe.control_decoders.ReplyDecoder(wheels=None),
+    )
     for i, record in enumerate(records):
         heard.feed(record, i * period_ms / 1000, *decoders)
     return heard
 
 
-def test_the_firmware_is_told_by_its_record_period() -> None:
-    a, b = app.encode(app.Velocity(0, 0, 0, 0)), app.encode(app.Attitude(0, 0, 0, 100))
-    assert probe.firmware(timed_records(50, [a, b] * 8)) is SHEET
-    assert probe.firmware(timed_records(60, [a, b] * 8)) is MINIBALANCE
-    assert probe.firmware(timed_records(100, [a, b] * 8)) is None
-    assert probe.firmware(timed_records(50, [a, b])) is None  # too few to tell
+def test_the_firmware_is_told_by_what_it_sends() -> None:
+    """Issue 53.4: field counts, value patterns and the period, against the shipped
+    profiles' files."""
+    sheet_a, sheet_b = b"{A0:0:0:0}$", b"{B0:0:0:100}$"
+    mini_a = b"{A0:0:100:0}$"  # |0.7x|, |0.7y|, battery: the B record's battery too
+    balance_a, balance_b = b"{A0:0:95:2}$", b"{B2:0:0}$"  # B: angle, left, right
+    assert probe.firmware(timed_records(50, [sheet_a, sheet_b] * 8).sent)[0] is SHEET
+    assert probe.firmware(timed_records(60, [mini_a, sheet_b] * 8).sent)[0] is MINIBALANCE
+    # the values decide even when a loaded host's period misleads (60 ms for the sheet)
+    assert probe.firmware(timed_records(60, [sheet_a, sheet_b] * 8).sent)[0] is SHEET
+    found, _ = probe.firmware(timed_records(50, [balance_a, balance_b] * 8).sent)
+    assert found is not None and found.name == "balance"
+    # B records of two fields: no shipped profile; the nearest says why
+    found, nearest = probe.firmware(timed_records(50, [balance_a, b"{B0:0}$"] * 8).sent)
+    assert found is None and nearest.profile.name == "balance"
+    assert nearest.against == ("B records of 2 fields (3 here)",)
+    # far off every period (400 ms) and records of no shipped shape
+    found, _ = probe.firmware(timed_records(400, [b"{A-5:0:0:0}$", b"{B0:0}$"] * 8).sent)
+    assert found is None
     c = app.encode(app.ParamsRecord(params.DEFAULTS))
     # a long record keeps the reference loop waiting longer (§13): still that firmware
     mixed = timed_records(MINIBALANCE.record_period_ms(len(c)), [c] * 6)
-    assert probe.firmware(mixed) is MINIBALANCE
+    assert probe.firmware(mixed.sent)[0] is MINIBALANCE
 
 
 def test_a_file_or_a_folder_is_not_a_serial_port(tmp_path: Any) -> None:
@@ -294,3 +310,33 @@ def test_text_is_told_as_quickly_as_silence() -> None:
     assert status == 1 and found["kind"] == "text"
     assert len(found["heard"]) == 1, found["heard"]
     assert took < 8, took
+
+
+def test_a_balance_car_is_named_and_a_car_of_no_shipped_profile_is_told_how_to_write_one(
+    tmp_path: Path,
+) -> None:
+    """Issue 53.4, end to end: boards serving the balance profile and a user's own."""
+    own = tmp_path / "twofield.toml"
+    text = (ROOT / "appmode" / "protocol" / "profiles" / "balance.toml").read_text()
+    own.write_text(
+        text.replace('name = "balance"', 'name = "twofield"').replace(
+            '  { name = "angle", label = "balance angle", unit = "°" },\n  { name = "encoder_left"',
+            '  { name = "encoder_left"',
+        )
+    )
+    with (
+        board_process("--pty", "--profile", "balance", "-q") as balance,
+        board_process("--pty", "--profile", str(own), "-q") as other,
+    ):
+        status, (car, unknown), _ = doctor(balance.url, unknown_url := other.url)
+    assert status == 0
+    assert car["profile"] == "balance"
+    assert car["params"]["balance_kp"] == 300 and car["params"]["velocity_ki"] == 0.4
+    assert car["fix"] == f"drive it with: appmode drive {balance.url} --profile balance"
+    assert unknown["kind"] == "app" and unknown["profile"] is None
+    assert "unknown firmware" in unknown["verdict"]
+    assert unknown["fix"].startswith(
+        "its records fit no shipped profile (nearest: balance, but B records of 2 fields "
+        "(3 here)): write one for it, starting from appmode profile show balance --toml"
+    )
+    assert unknown["fix"].endswith(f"appmode drive {unknown_url} --profile mycar.toml")

@@ -1,0 +1,131 @@
+"""Which firmware of the family a board runs, from what it sends: `appmode doctor`'s
+judgement, against the shipped profiles' files.
+
+Each profile is held to what was heard: the field count of each record kind, the
+values its fields may take (a magnitude is never negative, a wrapped field stays under
+its wrap, a battery is at most 100 % and the same in the A and B records when both
+carry it), the record period, the start-up text (`boot`) and the extra replies (`##$`). A profile
+that something heard contradicts is out; among the rest the one with the most positive
+evidence wins (the order of `SHIPPED` breaks a tie). The period only counts against a
+profile when it is far off: a loaded host delivers records late, in bursts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import NamedTuple
+
+from appmode.protocol import profile_file
+from appmode.protocol.profile_file import Field, ProfileFile
+
+SHOWN = 64
+"""Records kept of what a port sent, for the judgement."""
+PERIOD_FITS = (0.9, 1.1)
+"""A measured period within these fractions of a profile's range is evidence for it."""
+PERIOD_FAR = (0.6, 1.5)
+"""Outside these, against it."""
+BATTERY_AGREES = 3
+"""Percent by which the A and B records' battery readings may differ (read apart)."""
+
+
+class Sent(NamedTuple):
+    """What a port sent: its records (letter and values, as many fields as came), the
+    mean record period, the text outside records."""
+
+    records: Sequence[tuple[str, tuple[int, ...]]]
+    period_ms: float | None
+    text: bytes
+
+
+class Judgement(NamedTuple):
+    profile: ProfileFile
+    score: int
+    against: tuple[str, ...]
+    """What was heard that this profile contradicts; empty: it fits."""
+
+
+def judge(sent: Sent, profiles: Sequence[ProfileFile] | None = None) -> list[Judgement]:
+    """Each profile's fit, the best first (those that fit before those that do not)."""
+    profiles = profiles or [profile_file.load(name) for name in profile_file.SHIPPED]
+    found = [_judge(profile, sent) for profile in profiles]
+    order = {id(j): i for i, j in enumerate(found)}
+    return sorted(found, key=lambda j: (bool(j.against), len(j.against), -j.score, order[id(j)]))
+
+
+def best(sent: Sent) -> tuple[ProfileFile | None, Judgement]:
+    """The profile that fits best (None when none does) and the nearest judgement."""
+    first = judge(sent)[0]
+    return (None if first.against else first.profile), first
+
+
+def _judge(profile: ProfileFile, sent: Sent) -> Judgement:
+    against: list[str] = []
+    score = 0
+    by_kind = {"A": profile.a, "B": profile.b}
+    columns: dict[str, list[tuple[int, ...]]] = {"A": [], "B": []}
+    for letter, values in sent.records:
+        fields = by_kind.get(letter)
+        if letter == "C" and len(values) != len(profile.params):
+            against.append(f"C records of {len(values)} fields ({len(profile.params)} here)")
+        if fields is None:
+            continue
+        if len(values) != len(fields):
+            against.append(f"{letter} records of {len(values)} fields ({len(fields)} here)")
+            continue
+        columns[letter].append(values)
+    if columns["B"]:
+        score += 1  # its B records have this profile's field count
+    batteries: dict[str, list[int]] = {}
+    for letter, rows in columns.items():
+        for i, field in enumerate(by_kind[letter]):
+            column = [row[i] for row in rows]
+            problem = _field_problem(field, column)
+            if problem:
+                against.append(f"{letter} field {i + 1} {problem} ({field.name} here)")
+            if field.battery and column:
+                batteries[letter] = column
+    score += _battery_evidence(batteries, against)
+    score += _period_evidence(profile, sent.period_ms, against)
+    if profile.boot and profile.boot.encode() in sent.text:
+        score += 3
+    for reply in profile.replies:
+        if reply.encode() in sent.text:
+            score += 2
+    if b"##$" in sent.text and "##$" not in profile.replies:
+        against.append("it sends ##$ before its C record (this firmware does not)")
+    return Judgement(profile, score, tuple(dict.fromkeys(against)))
+
+
+def _field_problem(field: Field, column: list[int]) -> str:
+    if not column:
+        return ""
+    if not field.signed and min(column) < 0:
+        return f"is negative ({min(column)}): a magnitude"
+    if field.wrap is not None and max(column) >= field.wrap:
+        return f"reaches {max(column)}: it wraps at {field.wrap}"
+    if field.battery and max(column) > 100:  # below 0: a board reading 0 V (§13.1)
+        return f"reads {max(column)}: a battery percentage"
+    return ""
+
+
+def _battery_evidence(batteries: dict[str, list[int]], against: list[str]) -> int:
+    """A battery field that reads as one is evidence; two that disagree are against."""
+    if len(batteries) == 2:
+        a, b = batteries["A"], batteries["B"]
+        if abs(sum(a) / len(a) - sum(b) / len(b)) > BATTERY_AGREES:
+            against.append(f"its A and B records' battery fields differ ({a[-1]}, {b[-1]})")
+            return 0
+        return 2 if max(a) > 0 else 0
+    column = next(iter(batteries.values()), [])
+    return 1 if column and min(column) > 0 and max(column) - min(column) <= BATTERY_AGREES else 0
+
+
+def _period_evidence(profile: ProfileFile, period: float | None, against: list[str]) -> int:
+    if period is None:
+        return 0
+    low, high = profile.period_ms
+    if low * PERIOD_FITS[0] <= period <= high * PERIOD_FITS[1]:
+        return 1
+    if not low * PERIOD_FAR[0] <= period <= high * PERIOD_FAR[1]:
+        against.append(f"a record every {period:.0f} ms ({low}–{high} ms here)")
+    return 0
