@@ -11,7 +11,7 @@ from collections import deque
 from dataclasses import dataclass, field
 
 from appmode.host.query import Outcome, ParamQuery, QueryFailed
-from appmode.protocol import app, app_decoders, params, session_end
+from appmode.protocol import app, params, session_end
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.render import motion_text
 from appmode.text import counted
@@ -118,7 +118,7 @@ class HostState:
         """How the board's A records are laid out (§3.1, §13)."""
         self.frames_stop = frames_stop
         """Every frame sent stops the car (a minibalance board: its `{` steers, §13)."""
-        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields), len(self.layout.params))
+        self.decoder = self.layout.board_decoder()
         self.in_step = False
         """A record has come since the link opened: undecodable bytes are errors now."""
         self.outside = bytearray()
@@ -246,7 +246,7 @@ class HostState:
 
     def reset_decoder(self) -> None:
         """Forget a partial record (after the link was lost: the board may restart)."""
-        self.decoder = app_decoders.BoardDecoder(len(self.layout.b_fields), len(self.layout.params))
+        self.decoder = self.layout.board_decoder()
         self.in_step = False
         self.letters_ignored = False
 

@@ -7,6 +7,7 @@ picks a layout (`--profile`); every layout comes from a profile's file."""
 from __future__ import annotations
 
 from appmode.protocol import profile_file
+from appmode.protocol.app_decoders import BoardDecoder
 from appmode.protocol.profile_file import Field, ParamSpec, ProfileFile
 from appmode.protocol.slotted import Frozen
 
@@ -75,6 +76,10 @@ class Layout(Frozen):
     def speed(self, values: tuple[int, ...]) -> float:
         """The largest speed the motion fields show, in the board's velocity unit."""
         return max(abs(values[i]) for i in self.motion) / self.scale
+
+    def board_decoder(self) -> BoardDecoder:
+        """A decoder of the board's records with this layout's field counts."""
+        return BoardDecoder(len(self.b_fields), len(self.params))
 
     @property
     def b_names(self) -> tuple[str, ...]:

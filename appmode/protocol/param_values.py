@@ -6,7 +6,7 @@ against the profile's ranges. The sheet's own rules (system_mode's drive type) a
 from __future__ import annotations
 
 from collections.abc import Sequence
-from decimal import Decimal, InvalidOperation
+from decimal import Decimal, DecimalException
 
 from appmode.errors import InvalidValue
 from appmode.protocol import params
@@ -59,12 +59,14 @@ def from_user(spec: ParamSpec, text: str) -> int:
             raise InvalidValue(f"{spec.name} takes a whole number in {range_text(spec)}")
         return number
     try:
-        if len(text) > 40 or not text.isascii():
-            raise InvalidOperation
+        if len(text) > 40 or not text.isascii() or text.startswith("+") or "_" in text:
+            raise DecimalException
         frame = Decimal(text) * Decimal(repr(spec.scale))
-    except InvalidOperation:
+        if not frame.is_finite() or not 0 <= frame <= spec.maximum:
+            raise DecimalException
+    except DecimalException:  # not a number, or out of every range (1e999999999)
         raise InvalidValue(f"{spec.name} takes a number in {range_text(spec)}") from None
-    if not frame.is_finite() or frame != frame.to_integral_value() or frame < 0:
+    if frame != frame.to_integral_value():
         step = to_user(spec, 1)
         raise InvalidValue(f"{spec.name} takes steps of {step} in {range_text(spec)}")
     return int(frame)

@@ -9,6 +9,7 @@ system_mode setting), from the moment it is sent, and decodes every direction.
 from __future__ import annotations
 
 from appmode.protocol import app, app_decoders, control, control_decoders, params
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
 
 SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
@@ -18,9 +19,11 @@ Event = app.Event | control.HostEvent | control.BoardEvent
 class PortsReader:
     """Decoders for `>`, `<`, `2>` and `2<`, kept in step with the board's system_mode."""
 
-    def __init__(self, system_mode: int = 0, drive: DriveType | None = None) -> None:
+    def __init__(
+        self, system_mode: int = 0, drive: DriveType | None = None, layout: Layout = VELOCITY
+    ) -> None:
         self.host = app_decoders.HostDecoder()
-        self.board = app_decoders.BoardDecoder()
+        self.board = layout.board_decoder()
         self.host2 = control_decoders.FrameDecoder()
         self.board2 = control_decoders.ReplyDecoder()
         self.app_mode = False

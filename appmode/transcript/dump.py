@@ -42,13 +42,16 @@ Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.Board
 
 
 def decoded(
-    items: Iterable[Entry | Directive], drive: DriveType | None, path: str
+    items: Iterable[Entry | Directive],
+    drive: DriveType | None,
+    path: str,
+    layout: Layout = VELOCITY,
 ) -> Iterator[tuple[float, str, Decoded]]:
     """(time, direction, event) for every command, record, frame and reply of a
     transcript's lines; a `<` line with `*` or `LO..HI` fields (a `2<` line with `??`) is
     an expectation, not bytes. UART2 lines are read as the board the transcript describes
     reads them (`PortsReader`: its drive type, APP text while system_mode bit 7 is set)."""
-    reader = PortsReader(drive=drive)
+    reader = PortsReader(drive=drive, layout=layout)
     last = dict.fromkeys(DIRECTIONS, 0.0)
     for entry in items:
         if not isinstance(entry, Entry):
@@ -106,7 +109,7 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
         writer = csv.DictWriter(out, fieldnames=fields, extrasaction="ignore")
         writer.writeheader()
     items = iter_transcript(path, lambda text: print(f"appmode: WARNING: {text}", file=sys.stderr))
-    for t, direction, event in decoded(items, needs.drive, path):
+    for t, direction, event in decoded(items, needs.drive, path, layout):
         shown = None
         if isinstance(event, BytesPattern):
             body = {"kind": "expectation", "raw": event.text}

@@ -72,7 +72,7 @@ def check_recorded(
     check = Check(expected)
     units = _send_units(check)
     anchors = _Anchors(check)
-    reader = PortsReader(drive=check.needs.drive)
+    reader = PortsReader(drive=check.needs.drive, layout=check.needs.profile.a_layout)
     k = 0
     for entry in recording.entries:
         anchors.apply()

@@ -26,7 +26,8 @@ from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.target import Target, as_target
 from appmode.ports.urls import open_link
-from appmode.protocol import app, app_decoders, params
+from appmode.protocol import app, app_decoders, param_values, params
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
 from appmode.text import wrapped
@@ -54,8 +55,9 @@ def run_virtual(transcript: Transcript) -> Result:
     check = Check(transcript)
     needs = check.needs
     wire = Wire(Board(MemoryStore(), drive=needs.drive, profile=needs.profile), 9600)
-    decoder = app_decoders.BoardDecoder()
-    reader = PortsReader(drive=needs.drive)
+    layout = needs.profile.a_layout
+    decoder = layout.board_decoder()
+    reader = PortsReader(drive=needs.drive, layout=layout)
     now = 0.0
     while not check.done and now <= check.end:
         # what arrived by `now` first: it came before what is sent at `now`
@@ -128,11 +130,11 @@ def run_live(
         if url2 is None:
             why = "has UART2 lines: give the board's control port with --board2 URL"
             return Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
-    with Host(url) as host, contextlib.ExitStack() as stack:
+    with Host(url, layout=check.needs.profile.a_layout) as host, contextlib.ExitStack() as stack:
         if url2 is not None and check.uses_uart2:
             link2 = open_link(url2, timeout=0, baud=UART2_BAUD)
             stack.callback(link2.close)
-        reader = PortsReader(drive=check.needs.drive)
+        reader = PortsReader(drive=check.needs.drive, layout=check.needs.profile.a_layout)
         if check.needs.drive is not None:
             values = host.read_params()
             have = params.drive_type(values[params.SYSTEM_MODE])
@@ -270,7 +272,9 @@ def run_conform(
             print(f"appmode: WARNING: {warning}", file=sys.stderr)
         if not transcript.entries:
             raise AppmodeError(f"{transcript.path} has no '>' or '<' lines: nothing to check")
-    transcripts = _for_profile(transcripts, profile_named(profile), out)
+    chosen = profile_named(profile)
+    layout = chosen.a_layout
+    transcripts = _for_profile(transcripts, chosen, out)
     interactive = sys.stderr.isatty()
 
     def progress(text: str) -> None:
@@ -279,17 +283,17 @@ def run_conform(
 
     board, board2 = (as_target(b) if b is not None else None for b in (board, board2))
     live = board is not None and not board.simulated  # sim:// is a new board each time
-    found = _read_params(board) if live and board is not None else None
+    found = _read_params(board, layout) if live and board is not None else None
     results: list[Result] = []
     between = None
     if board is not None and found is not None:
         url, values = board, found
-        between = lambda: put_back(url, values)  # noqa: E731 - the run's own undo
+        between = lambda: put_back(url, values, layout)  # noqa: E731 - the run's own undo
     try:
         _run_all(transcripts, board, progress, interactive, results, out, board2, between)
     finally:
         if board is not None and found is not None:
-            out.write(restore_params(board, found) + "\n")
+            out.write(restore_params(board, found, layout) + "\n")
     if board2 is not None and not board2.simulated and _sent_on_uart2(transcripts, results):
         out.write(wrapped(f"note: {TAKEN_OVER}") + "\n")
     failed = sum(not r.passed for r in results)
@@ -374,8 +378,8 @@ def _for_profile(transcripts: list[Transcript], profile: Profile, out: TextIO) -
     return chosen
 
 
-def _read_params(url: Target) -> tuple[int, ...]:
-    with Host(url) as host:
+def _read_params(url: Target, layout: Layout) -> tuple[int, ...]:
+    with Host(url, layout=layout) as host:
         try:
             return host.read_params()
         except AppmodeError as exc:
@@ -391,26 +395,27 @@ def _set_back(host: Host, values: tuple[int, ...]) -> list[int]:
     return changed
 
 
-def put_back(url: Target | str, values: tuple[int, ...]) -> str | None:
+def put_back(url: Target | str, values: tuple[int, ...], layout: Layout = VELOCITY) -> str | None:
     """Between two transcripts on a real board: its parameters back to `values`
     (verified, not saved); what went wrong, in a line, or None."""
     try:
-        with Host(url) as host:
+        with Host(url, layout=layout) as host:
             _set_back(host, values)
     except AppmodeError as exc:
         return f"could not put the parameters back before the next transcript: {exc}"
     return None
 
 
-def restore_params(url: Target | str, values: tuple[int, ...]) -> str:
+def restore_params(url: Target | str, values: tuple[int, ...], layout: Layout = VELOCITY) -> str:
     """Set the board's parameters back to `values` (verified) and send `{Q:W}`: what a
     run against a real board changed is undone. Returns what was done, in a line."""
     try:
-        with Host(url) as host:
+        with Host(url, layout=layout) as host:
             changed = _set_back(host, values)
             host.save()
     except AppmodeError as exc:
-        shown = ", ".join(f"{p.name}={v}" for p, v in zip(params.PARAMS, values, strict=True))
+        pairs = zip(layout.params, values, strict=True)
+        shown = ", ".join(f"{p.name}={param_values.to_user(p, v)}" for p, v in pairs)
         return f"could not restore the parameters found at the start ({shown}): {exc}"
     return (
         f"restored the parameters found at the start ({len(changed)} had changed) and "
