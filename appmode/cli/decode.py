@@ -18,13 +18,16 @@ if TYPE_CHECKING:  # the codec is imported when the command runs: start-up stays
 CHUNK = 65536
 
 
-def decode_chunks(chunks: Iterable[bytes], source: str, b_fields: int = 4) -> Iterator[app.Event]:
-    """Events of a stream from the host (`host`) or the board (`board`, whose B records
-    have `b_fields` fields)."""
+def decode_chunks(
+    chunks: Iterable[bytes], source: str, layout: Layout | None = None
+) -> Iterator[app.Event]:
+    """Events of a stream from the host (`host`) or the board (`board`, its records as
+    `layout` counts their fields; by default the sheet's)."""
     from appmode.protocol import app_decoders
+    from appmode.protocol.layouts import VELOCITY
 
     decoder = (
-        app_decoders.HostDecoder() if source == "host" else app_decoders.BoardDecoder(b_fields)
+        app_decoders.HostDecoder() if source == "host" else (layout or VELOCITY).board_decoder()
     )
     for chunk in chunks:
         yield from decoder.feed(chunk)
@@ -63,7 +66,7 @@ def run_decode(
     errors = 0
     write = out.write
     chunks = read_chunks(stream, name, out)
-    for event in coalesce(decode_chunks(chunks, source, len(layout.b_fields))):
+    for event in coalesce(decode_chunks(chunks, source, layout)):
         errors += isinstance(event, app.ERRORS)
         write(json_line(event, layout) + "\n")
     out.flush()

@@ -274,12 +274,12 @@ def _parse_record(
         return OtherRecord(chr(letter), values, terminated, raw)  # a profile names the Bs
     if len(values) != size:
         return Malformed(raw, f"{chr(letter)} record has {len(values)} fields, expected {size}")
-    a, b, c, d = values[:4]
+    if letter == 0x43:
+        return ParamsRecord(values, terminated, raw)  # out-of-range values too: boards hold them
+    a, b, c, d = values
     if letter == 0x41:
         return Velocity(a, b, c, d, terminated, raw)
-    if letter == 0x42:
-        return Attitude(a, b, c, d, terminated, raw)
-    return ParamsRecord(values, terminated, raw)  # out-of-range values too: boards hold them
+    return Attitude(a, b, c, d, terminated, raw)
 
 
 _FAST = re.compile(rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")

@@ -160,3 +160,18 @@ def test_property_records_survive_surrounding_noise(parts: list[object]) -> None
     events = decode_whole(BoardDecoder, data)
     sent = [p for p in parts if not isinstance(p, bytes)]
     assert [e for e in events if not isinstance(e, (Garbage, Malformed))] == sent
+
+
+def test_a_profile_s_field_counts_decode_alike_however_split() -> None:
+    """Issue 53: a balance car's B record has three fields; a user's C record fewer than
+    nine; a probe takes any count."""
+    data = b"{A1:2:95:3}${B3:-4:5}$##${C42:100}${B1:2:3:4}$"
+    events = assert_split_invariant(lambda: BoardDecoder(3, 2), data)
+    kinds = [type(e).__name__ for e in events]
+    assert kinds == ["Velocity", "OtherRecord", "Garbage", "ParamsRecord", "Malformed"]
+    assert events[1].values == (3, -4, 5) and events[3].values == (42, 100)
+    assert events[4].reason == "B record has 4 fields, expected 3"
+    probe = assert_split_invariant(lambda: BoardDecoder(None), data)
+    assert [type(e).__name__ for e in probe] == [
+        "Velocity", "OtherRecord", "Garbage", "OtherRecord", "Attitude"
+    ]  # fmt: skip
