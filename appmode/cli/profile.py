@@ -8,6 +8,7 @@ import sys
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers
+from appmode.protocol import param_values
 from appmode.protocol.profile_file import SHIPPED, Field, ProfileError, ProfileFile, load
 
 
@@ -71,6 +72,7 @@ def shown(profile: ProfileFile) -> str:
         f"{'{Q:W} saves' if profile.saves else '{Q:W} saves nothing'}; "
         f"{'a control port (UART2)' if profile.control_port else 'no control port'}",
         f"  pages: {pages}" + (f"; also sends {' '.join(profile.replies)}" * bool(profile.replies)),
+        f"  the speed keys (+, −) change: {profile.speed_param or 'nothing (no speed parameter)'}",
         "",
     ]
     for kind, fields in (("A", profile.a), ("B", profile.b)):
@@ -82,15 +84,9 @@ def shown(profile: ProfileFile) -> str:
         scale = (
             "" if p.scale == 1 else f"×{p.scale:g}: {p.name} 0.42 is {{{i}:{0.42 * p.scale:.0f}}}"
         )
-        span = f"{user(p.minimum, p.scale)}–{user(p.maximum, p.scale)}"
-        lines.append(f"  {i:2d}  {p.name:<18}  {span:<24}  {user(p.default, p.scale):>10}  {scale}")
+        span, default = param_values.range_text(p), param_values.to_user(p, p.default)
+        lines.append(f"  {i:2d}  {p.name:<18}  {span:<24}  {default:>10}  {scale}")
     return "\n".join(lines) + "\n"
-
-
-def user(value: int, scale: float) -> str:
-    """A frame's integer as the user's value: 30000 at scale 100 is 300."""
-    shown = round(value / scale, 6)
-    return str(int(shown)) if shown == int(shown) else repr(shown)
 
 
 def _field(index: int, field: Field) -> str:

@@ -7,8 +7,6 @@ from appmode.host.state import TRACE_SECONDS, HostState, Trace
 from appmode.protocol import app
 
 LEVELS = "▁▂▃▄▅▆▇█"
-ATTITUDE: tuple[tuple[str, int], ...] = (("pitch", 0), ("roll", 1), ("yaw", 2), ("battery", 3))
-"""(label, field) of each B record line; the A record's lines follow the board's layout."""
 
 
 def sparkline(points: list[tuple[float, int]], now: float, width: int) -> str:
@@ -41,13 +39,14 @@ def sparkline(points: list[tuple[float, int]], now: float, width: int) -> str:
 
 
 def waveform_lines(state: HostState, now: float, width: int) -> list[str]:
-    """One line per SERIES: label, waveform, and the range it spans."""
+    """One line a field: label, waveform, and the range it spans; the A record's motion
+    fields, then the B record's, as the board's layout names them."""
     layout = state.layout
     series: list[tuple[str, Trace, int]] = [
         (f"v{layout.labels[i]}" if layout.signed else layout.labels[i], state.velocities, i)
         for i in layout.motion
     ]
-    series += [(label, state.attitudes, i) for label, i in ATTITUDE]
+    series += [(field.label, state.attitudes, i) for i, field in enumerate(layout.b_fields)]
     lines = []
     for label, trace, field in series:
         points = [(t, app.record_fields(event)[1][field]) for t, event in trace.points]

@@ -19,18 +19,22 @@ from appmode.text import counted
 RATE_WINDOW = 2.0
 DEGRADED_WINDOW = 5.0
 TRACE_SECONDS = 10.0
+"""How much of the telemetry the host keeps, for waveforms."""
 OUTSIDE = 256
 """Bytes kept of what came outside records (`HostState.outside`)."""
-"""How much of the telemetry the host keeps, for waveforms."""
+
+
+Sample = app.Velocity | app.Attitude | app.OtherRecord
+"""A record a trace keeps: A, or B (a profile's own B record is an OtherRecord)."""
 
 
 class Trace:
     """The last TRACE_SECONDS of one kind of record, each with the time it came."""
 
     def __init__(self) -> None:
-        self.points: deque[tuple[float, app.Velocity | app.Attitude]] = deque(maxlen=4096)
+        self.points: deque[tuple[float, Sample]] = deque(maxlen=4096)
 
-    def add(self, now: float, event: app.Velocity | app.Attitude) -> None:
+    def add(self, now: float, event: Sample) -> None:
         self.points.append((now, event))
         while self.points and self.points[0][0] < now - TRACE_SECONDS:
             self.points.popleft()
@@ -270,6 +274,8 @@ class HostState:
         elif isinstance(event, app.Attitude):
             self.attitude = event
             self.attitudes.add(now, event)
+        elif isinstance(event, app.OtherRecord) and event.letter == "B":
+            self.attitudes.add(now, event)  # a profile's own B record: named by its layout
         elif isinstance(event, app.ParamsRecord):
             self.params = event
             if self.query is not None:

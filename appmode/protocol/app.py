@@ -194,10 +194,6 @@ class Attitude(Slotted):
         self.raw = raw
 
 
-ATTITUDE_UNITS: dict[str, str] = {"pitch": "°", "roll": "°", "yaw": "°", "battery": "%"}
-"""The B record's fields, in order, and their units."""
-
-
 class ParamsRecord(Slotted):
     """`{C p0:…:p8}$`: the nine parameters in index order."""
 

@@ -89,6 +89,27 @@ class Layout(Frozen):
     def param_names(self) -> tuple[str, ...]:
         return tuple(param.name for param in self.params)
 
+    @property
+    def extra_a(self) -> tuple[int, ...]:
+        """The A fields shown besides the motion and the battery: those with a unit (the
+        balance car's angle; not the sheet's `extra`)."""
+        return tuple(
+            i
+            for i, field in enumerate(self.a_fields)
+            if field.unit and i not in self.motion and i != self.battery
+        )
+
+    @property
+    def speed_index(self) -> int | None:
+        """The parameter the speed keys change (max_speed), or None: the profile has none."""
+        wanted = self.profile.speed_param
+        return None if wanted is None else self.param_names.index(wanted)
+
+    @property
+    def sheet_b(self) -> bool:
+        """Its B record is the sheet's: pitch, roll, yaw, battery (an `Attitude`)."""
+        return self.b_fields == VELOCITY.b_fields
+
 
 VELOCITY = Layout("velocity", profile_file.load("sheet"))
 SCALED = Layout("scaled", profile_file.load("minibalance"))

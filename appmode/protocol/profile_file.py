@@ -93,6 +93,9 @@ class ProfileFile(NamedTuple):
     a: tuple[Field, ...]
     b: tuple[Field, ...]
     params: tuple[ParamSpec, ...]
+    speed_param: str | None
+    """The parameter the speed keys (+, −) change (`max_speed`), or None: none does
+    (`speed_param = ""` in a file that is `like` one that has it)."""
     boot: str
     """Text its start-up output holds (the sensor's messages), or ""."""
     path: str
@@ -144,7 +147,7 @@ def parse(text: str, where: str) -> ProfileFile:
 
 TOP = {
     "name", "description", "source", "like", "baud", "period_ms", "control_port", "saves",
-    "replies", "pages", "speed_keys", "records", "params", "defaults", "boot",
+    "replies", "pages", "speed_keys", "records", "params", "defaults", "boot", "speed_param",
 }  # fmt: skip
 FIELD_KEYS = {"name", "label", "unit", "scale", "signed", "wrap", "motion", "battery"}
 PARAM_KEYS = {"name", "label", "minimum", "maximum", "default", "scale"}
@@ -196,6 +199,10 @@ def _build(
     if a is not None and len(a) != A_FIELDS:
         problem(f"records.A has {len(a)} fields: an A record has {A_FIELDS}")
     params = _params(data, problem, base.params if base else None)
+    speed_param = data.get("speed_param", base.speed_param if base else None) or None  # "": none
+    names = [p.name for p in params or ()]
+    if speed_param is not None and speed_param not in names:
+        problem(f"speed_param = {speed_param!r}: name one of the parameters ({', '.join(names)})")
     if not isinstance(name, str) or a is None or b is None or params is None:
         return None
     return ProfileFile(
@@ -212,6 +219,7 @@ def _build(
         a,
         b,
         params,
+        speed_param,
         boot,
         where,
     )

@@ -142,11 +142,7 @@ def motion_text(record: p.Velocity, layout: Layout = VELOCITY) -> str:
     shown = [f"{layout.fields[i]}={values[i]}" for i in layout.motion]
     if layout.battery is not None:
         shown.append(f"battery={values[layout.battery]}%")
-    shown += [  # what else has a unit (the balance car's angle; not the sheet's `extra`)
-        f"{field.name}={values[i]}"
-        for i, field in enumerate(layout.a_fields)
-        if field.unit and i not in layout.motion and i != layout.battery
-    ]
+    shown += [f"{layout.fields[i]}={values[i]}" for i in layout.extra_a]
     return " ".join(shown)
 
 

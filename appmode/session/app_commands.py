@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from appmode.errors import AppmodeError
-from appmode.protocol import params
+from appmode.protocol import param_values, params
 from appmode.session.base import SPEED_COMPLETES, SPEED_STEP, CommandSpec
 
 if TYPE_CHECKING:
@@ -16,10 +16,14 @@ PAGE_WORDS = {"direction": "J", "joystick": "J", "gravity": "I", "button": "K"}
 
 
 def _set(session: Session, args: list[str]) -> None:
-    value = params.whole(args[1]) if len(args) == 2 else None
-    if value is None:
-        raise AppmodeError("usage: set NAME VALUE, e.g. set max_speed 800")
-    session.set_param(params.lookup(args[0]).index, value)
+    """`set NAME VALUE`, in the user's units of the profile (`set balance_kp 0.42`)."""
+    specs = session.specs
+    if len(args) != 2:
+        first = specs[0]
+        example = f"{first.name} {param_values.to_user(first, first.default)}"
+        raise AppmodeError(f"usage: set NAME VALUE, e.g. set {example}")
+    index = param_values.lookup(specs, args[0])
+    session.set_param(index, param_values.from_user(specs[index], args[1]))
 
 
 def _drive(session: Session, args: list[str]) -> None:

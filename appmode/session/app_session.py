@@ -17,7 +17,7 @@ from appmode.host.query import ParamQuery, QueryDone, QueryFailed
 from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.target import Target
-from appmode.protocol import params
+from appmode.protocol import param_values, params
 from appmode.protocol.app import Move, Noise, Stop, SwitchPage
 from appmode.protocol.app_decoders import HostDecoder
 from appmode.protocol.directions import (
@@ -222,29 +222,38 @@ class Session(BaseSession):
         if record is None:
             rows.append(Row("params", (("", " not read yet (p reads them)"),)))
         else:
-            pairs = zip(params.PARAMS, record.values, strict=True)
-            rows.append(Row("params", pairs=tuple(f"{p.name} {value}" for p, value in pairs)))
+            pairs = zip(self.specs, record.values, strict=False)
+            shown = tuple(f"{p.name} {param_values.to_user(p, v)}" for p, v in pairs)
+            rows.append(Row("params", pairs=shown))
         return rows
+
+    @property
+    def specs(self) -> param_values.Specs:
+        """The parameters' table of the board's profile."""
+        return self.host.state.layout.params
 
     def instruments(self) -> Instruments:
         host, state = self.host, self.host.state
         now = host.now()
-        table = [(p.name, p.minimum, p.maximum) for p in params.PARAMS]
+        specs = self.specs
+        table = [(p.name, p.minimum, p.maximum) for p in specs]
+        names = [p.name for p in specs]
         now_values = () if state.params is None else state.params.values
-        read = dict(zip(params.NAMES, now_values, strict=False))
+        read = dict(zip(names, now_values, strict=False))
         unsaved = [
             name
-            for name, old, new in zip(params.NAMES, self.baseline or (), now_values, strict=False)
+            for name, old, new in zip(names, self.baseline or (), now_values, strict=False)
             if old != new
         ]
-        values = instruments.values(table, read, unsaved)
+        values = instruments.values(table, read, unsaved, [p.scale for p in specs])
+        speed = state.layout.speed_index
         return Instruments(
             link=instruments.link(host.connected, state.stats, now),
             telemetry=instruments.telemetry(state, now),
             in_force="stopped" if not self.moving else letter_name(self.page, self.in_force),
             moving=self.moving,
             page=PAGE_NAMES[self.page_letter],
-            speed=values[params.MAX_SPEED],
+            speed=None if speed is None else values[speed],
             values=values,
             values_read=state.params is not None,
             wheels=None,
@@ -291,28 +300,39 @@ class Session(BaseSession):
         if self.host.state.frames_stop:
             self.stop()
             self.say("stopped: a minibalance car stops at every frame; drive again after it")
-        else:
+        elif self.host.state.layout is VELOCITY:  # the sheet's board: what the other does
             self.say("note: on a minibalance car (--profile) this frame would stop it")
 
     def read_params(self) -> None:
-        self._query(ParamQuery(where=self.url))
+        self._query(ParamQuery(where=self.url, specs=self.specs))
 
     def set_param(self, index: int, value: int) -> None:
-        params.check_value(index, value)
-        self._query(ParamQuery((index, value), where=self.url))
+        """Set a parameter to the frame's integer `value`, verified by reading back."""
+        param_values.check(self.specs, index, value)
+        self._query(ParamQuery((index, value), where=self.url, specs=self.specs))
+
+    def _speed_index(self) -> int:
+        index = self.host.state.layout.speed_index
+        if index is None:
+            name = self.host.state.layout.profile.name
+            raise AppmodeError(f"the {name} profile has no speed parameter: + and - change nothing")
+        return index
 
     def change_speed(self, delta: int) -> None:
+        index = self._speed_index()
         current = self.host.state.params
         if current is None:
             self.say("parameters not read yet: reading them, try again")
             self.read_params()
             return
-        top = params.PARAMS[params.MAX_SPEED].maximum
-        wanted = current.values[params.MAX_SPEED] + delta
-        value = min(top, max(0, wanted))
+        spec = self.specs[index]
+        wanted = current.values[index] + delta
+        value = min(spec.maximum, max(spec.minimum, wanted))
         if value != wanted:
-            self.say(f"max_speed {wanted} is out of 0–{top}: setting {value}")
-        self.set_param(params.MAX_SPEED, value)
+            self.say(
+                f"{spec.name} {wanted} is out of {spec.minimum}–{spec.maximum}: setting {value}"
+            )
+        self.set_param(index, value)
 
     def save(self) -> None:
         if self._send(b"{Q:W}"):
@@ -327,18 +347,22 @@ class Session(BaseSession):
         current = self.host.state.params
         if current is None or self.baseline is None:
             return None
-        changed = params.changes(self.baseline, current.values)
+        changed = [
+            f"{p.name} {param_values.to_user(p, a)} → {param_values.to_user(p, b)}"
+            for p, a, b in zip(self.specs, self.baseline, current.values, strict=False)
+            if a != b
+        ]
         return f"not saved: {', '.join(changed)}" if changed else None
 
     def speed_command(self, args: list[str]) -> None:
-        """`speed +N`, `speed -N` or `speed N`: max_speed."""
+        """`speed +N`, `speed -N` or `speed N`: max_speed (the profile's speed parameter)."""
         number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
         if number is None:
             raise AppmodeError("usage: speed +N, speed -N or speed N")
         if args[0][0] in "+-":
             self.change_speed(-number if args[0][0] == "-" else number)
         else:
-            self.set_param(params.MAX_SPEED, number)
+            self.set_param(self._speed_index(), number)
 
     def send_tokens(self, tokens: list[str]) -> None:
         """`send`: letters, frames and escaped bytes, as they are."""

@@ -56,8 +56,10 @@ def link(connected: bool, stats: LinkStats, now: float) -> Link:
 
 @dataclass(frozen=True, slots=True)
 class Telemetry:
-    """The A and B records as numbers: the motion fields by their labels, attitude in
-    degrees, battery in percent; each None until its record came, and with its age."""
+    """The A and B records as numbers: the motion fields by their labels (and the A
+    record's other fields with a unit: the balance car's angle), attitude in degrees,
+    battery in percent; each None until its record came, and with its age. A profile
+    whose B record is not the sheet's has it in `b`, by its fields' labels."""
 
     motion: tuple[tuple[str, int], ...] | None
     speed: float | None
@@ -68,15 +70,32 @@ class Telemetry:
     yaw: int | None
     battery: int | None
     attitude_age: float | None
+    b: tuple[tuple[str, int], ...] | None = None
+    battery_age: float | None = None
+    has_attitude: bool = True
+    """Its B record is the sheet's (pitch, roll, yaw): a page draws the dials."""
+    """The age of the record the battery came from (the B record's, or the A's)."""
 
 
 def telemetry(state: HostState, now: float) -> Telemetry:
-    v, a = state.velocity, state.attitude
-    motion, speed = None, None
+    layout, v, a = state.layout, state.velocity, state.attitude
+    motion, speed, battery = None, None, None
+    battery_age = state.velocities.age(now)  # until a B record gives it
     if v is not None:
-        values, labels = app.record_fields(v)[1], state.layout.labels
-        motion = tuple((labels[i], values[i]) for i in state.layout.motion)
-        speed = state.layout.speed(values)
+        values, labels = app.record_fields(v)[1], layout.labels
+        shown = [*layout.motion, *(i for i in layout.extra_a)]
+        motion = tuple((labels[i], values[i]) for i in shown)
+        speed = layout.speed(values)
+        battery = None if layout.battery is None else values[layout.battery]
+    b = None
+    if not layout.sheet_b and state.attitudes.points:
+        b_values = app.record_fields(state.attitudes.points[-1][1])[1]
+        b = tuple((f.label, value) for f, value in zip(layout.b_fields, b_values, strict=False))
+        held = [value for f, value in zip(layout.b_fields, b_values, strict=False) if f.battery]
+        if held:
+            battery, battery_age = held[0], state.attitudes.age(now)
+    elif a is not None:
+        battery, battery_age = a.battery, state.attitudes.age(now)
     return Telemetry(
         motion,
         speed,
@@ -84,8 +103,11 @@ def telemetry(state: HostState, now: float) -> Telemetry:
         None if a is None else a.pitch,
         None if a is None else a.roll,
         None if a is None else a.yaw,
-        None if a is None else a.battery,
+        battery,
         state.attitudes.age(now),
+        b,
+        battery_age,
+        layout.sheet_b,
     )
 
 
@@ -99,6 +121,9 @@ class Value:
     minimum: int
     maximum: int
     unsaved: bool = False
+    scale: float = 1.0
+    """The user's value is value / scale (a gain sent ×100: 100); minimum, maximum and
+    value are the frame's integers."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,8 +147,9 @@ class Instruments:
     moving: bool
     page: str | None
     """The app page the board is on (joystick, gravity, button), or None (UART2)."""
-    speed: Value
-    """What the speed keys change: max_speed on the APP port, the keys' speed on UART2."""
+    speed: Value | None
+    """What the speed keys change: max_speed on the APP port, the keys' speed on UART2;
+    None: the profile has no speed parameter."""
     values: tuple[Value, ...]
     """The parameters (or settings) in the table's order."""
     values_read: bool
@@ -135,10 +161,15 @@ class Instruments:
 
 
 def values(
-    table: Sequence[tuple[str, int, int]], now: dict[str, int], unsaved: Collection[str]
+    table: Sequence[tuple[str, int, int]],
+    now: dict[str, int],
+    unsaved: Collection[str],
+    scales: Sequence[float] = (),
 ) -> tuple[Value, ...]:
-    """Each (name, minimum, maximum) of a table with its value now (None: not read) and
-    whether it is among the unsaved."""
+    """Each (name, minimum, maximum) of a table with its value now (None: not read),
+    whether it is among the unsaved, and its scale (1 unless given)."""
+    scale = [*scales, *[1.0] * (len(table) - len(scales))]
     return tuple(
-        Value(name, now.get(name), low, high, name in unsaved) for name, low, high in table
+        Value(name, now.get(name), low, high, name in unsaved, s)
+        for (name, low, high), s in zip(table, scale, strict=True)
     )

@@ -115,16 +115,19 @@ def telemetry(state: HostState, now: float) -> list[Row]:
     them)."""
     t = instruments.telemetry(state, now)
     velocity = "  —" if t.motion is None else "   ".join(f"{n} {v:6d}" for n, v in t.motion)
-    attitude = (
-        "  —" if t.pitch is None else f"pitch {t.pitch:4d}   roll {t.roll:4d}   yaw {t.yaw:4d}"
-    )
+    if t.b is not None:  # a profile's own B record, by its fields' labels
+        attitude = "   ".join(f"{n} {v:6d}" for n, v in t.b)
+    elif t.pitch is None:
+        attitude = "  —"
+    else:
+        attitude = f"pitch {t.pitch:4d}   roll {t.roll:4d}   yaw {t.yaw:4d}"
     rows = [
         reading("velocity", velocity, t.motion_age),
         reading("attitude", attitude, t.attitude_age),
     ]
     if t.battery is None:
         return [*rows, Row("battery", (("", "  —"),))]
-    old = (t.attitude_age or 0.0) > STALE
+    old = (t.battery_age or 0.0) > STALE
     tone: Tone = "dim" if old else "low" if t.battery < 20 else "ok"
     return [*rows, Row("battery", ((tone, f" {t.battery:3d} % {bar(t.battery)}"),))]
 

@@ -208,22 +208,22 @@ def _traces(state: HostState | None, now: float) -> dict[str, Any] | None:
         return None
     velocity = [(now - t, app.record_fields(v)[1]) for t, v in state.velocities.points]
     attitude = [(now - t, app.record_fields(a)[1]) for t, a in state.attitudes.points]
-    labels = state.layout.labels
+    labels, units = state.layout.labels, [f.unit for f in state.layout.a_fields]
     series = [
         {
             "label": labels[i],
-            "unit": "velocity unit",
+            "unit": units[i],
             "points": [[round(ago, 3), values[i]] for ago, values in velocity],
         }
         for i in state.layout.motion
     ]
     series += [
         {
-            "label": name,
-            "unit": unit,
-            "points": [[round(ago, 3), values[i]] for ago, values in attitude],
+            "label": field.label,
+            "unit": field.unit,
+            "points": [[round(ago, 3), values[i]] for ago, values in attitude if i < len(values)],
         }
-        for i, (name, unit) in enumerate(app.ATTITUDE_UNITS.items())
+        for i, field in enumerate(state.layout.b_fields)
     ]
     return {"seconds": TRACE_SECONDS, "series": series}
 

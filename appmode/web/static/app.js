@@ -400,17 +400,19 @@ function showInstruments(ins) {
   $("page-name").textContent = ins.page ? `${ins.page} page` : "";
   $("tilt-page").textContent = ins.page || "";
   $("tilt-page-line").hidden = !ins.page;
-  $("speed-name").textContent = ins.speed.name;
-  $("speed").textContent = ins.speed.value === null ? "—" : String(ins.speed.value);
+  const speed = ins.speed; // null: the profile has no speed parameter (the keys change nothing)
+  $("speed-name").textContent = speed ? speed.name : "speed";
+  $("speed").textContent = !speed ? "fixed" : speed.value === null ? "—" : String(speed.value);
+  $("slower").disabled = $("faster").disabled = !speed;
   const t = ins.telemetry;
   const fresh = (age) => age !== null && age <= 0.5;
   $("measured").textContent = t && t.speed !== null ? `now ${Math.round(t.speed)}` : "";
-  $("dials").hidden = !t;
+  $("dials").hidden = !t || !t.has_attitude;
   $("battery-text").textContent = "— (no APP port)";
   if (t) {
     $("battery").value = t.battery === null ? 0 : Math.max(0, Math.min(100, t.battery));
     $("battery-text").textContent = t.battery === null ? "—" : `${t.battery} %`;
-    $("battery-tile").classList.toggle("stale", !fresh(t.attitude_age));
+    $("battery-tile").classList.toggle("stale", !fresh(t.battery_age));
     $("dials").classList.toggle("stale", !fresh(t.attitude_age));
     if (t.yaw !== null) {
       $("needle").setAttribute("transform", `rotate(${t.yaw})`);
@@ -423,7 +425,8 @@ function showInstruments(ins) {
       $("yaw").textContent = `${t.yaw}°`;
       $("tilt-values").textContent = `pitch ${t.pitch}° roll ${t.roll}°`;
     }
-    $("motion").textContent = t.motion ? t.motion.map(([name, v]) => `${name} ${v}`).join("  ") : "";
+    const fields = [...(t.motion || []), ...(t.b || [])]; // a profile's own B record too
+    $("motion").textContent = fields.map(([name, v]) => `${name} ${v}`).join("  ");
     $("motion").classList.toggle("stale", !fresh(t.motion_age));
     $("measured").classList.toggle("stale", !fresh(t.motion_age));
   }
@@ -431,7 +434,7 @@ function showInstruments(ins) {
   $("battery-tile").classList.toggle("wide", ins.driver === null);
   $("driver").textContent = ins.driver === null ? "" : ins.driver;
   $("wheels-tile").hidden = ins.driver === null;
-  showWheels(ins.wheels, ins.wheels_age, ins.speed.value);
+  showWheels(ins.wheels, ins.wheels_age, speed ? speed.value : null);
   showParams(ins.values, ins.values_read);
 }
 
@@ -481,6 +484,12 @@ function fromSlider(position, low, high) {
   return low + Math.round(Math.expm1((position / SLIDER_STEPS) * Math.log1p(high - low)));
 }
 
+function user(frame, scale) { // the frame's integer as the user's value: 42 at scale 100 is 0.42
+  if (scale === 1) return String(frame);
+  const digits = Math.max(0, Math.ceil(Math.log10(scale)));
+  return String(Number((frame / scale).toFixed(digits)));
+}
+
 function showParams(values, read) {
   const box = $("values");
   if (!read && !box.children.length) {
@@ -494,7 +503,7 @@ function showParams(values, read) {
   values.forEach((v, i) => {
     const row = box.children[i];
     row.classList.toggle("unsaved", v.unsaved);
-    row.querySelector(".value").textContent = v.value === null ? "?" : String(v.value);
+    row.querySelector(".value").textContent = v.value === null ? "?" : user(v.value, v.scale);
     const slider = row.querySelector("input[type=range]");
     if (v.value !== null && document.activeElement !== slider && !slider.dataset.moved) {
       slider.value = String(toSlider(v.value, v.minimum, v.maximum));
@@ -511,16 +520,18 @@ function paramRow(v) {
   row.innerHTML = '<div class="head"><span class="name"></span><span class="value"></span></div>'
     + '<div class="edit"><input type="range"><input type="number" inputmode="numeric">'
     + '<button type="button">Set</button></div>';
-  row.querySelector(".name").textContent = `${v.name} (${v.minimum}–${v.maximum})`;
+  const [low, high] = [user(v.minimum, v.scale), user(v.maximum, v.scale)];
+  row.querySelector(".name").textContent = `${v.name} (${low}–${high})`;
   const [slider, input] = row.querySelectorAll("input");
   const wide = v.maximum - v.minimum > SLIDER_STEPS;
   Object.assign(slider, { min: wide ? 0 : v.minimum, max: wide ? SLIDER_STEPS : v.maximum, step: 1 });
-  Object.assign(input, { min: v.minimum, max: v.maximum, step: 1 });
+  Object.assign(input, { min: low, max: high, step: user(1, v.scale) }); // the user's units
+  if (v.scale !== 1) input.inputMode = "decimal";
   slider.setAttribute("aria-label", `${v.name} slider`);
   input.setAttribute("aria-label", `new ${v.name}`);
   slider.addEventListener("input", () => {
     slider.dataset.moved = "1";
-    input.value = String(fromSlider(Number(slider.value), v.minimum, v.maximum));
+    input.value = user(fromSlider(Number(slider.value), v.minimum, v.maximum), v.scale);
   });
   const button = row.querySelector("button");
   button.setAttribute("aria-label", `set ${v.name}`);
