@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, file_name
+from appmode.cli.options import Subparsers, add_profile, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -20,12 +20,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     plot.add_argument(
         "-o", "--output", required=True, type=file_name, metavar="PNG", help="the image to write"
     )
+    add_profile(plot, default=None, unset="the transcript's @board profile=…, else sheet")
     return plot
 
 
 def run(args: argparse.Namespace) -> int:
     from appmode.transcript.dump import run_plot
 
-    run_plot(args.file, args.output)
+    run_plot(args.file, args.output, args.profile)
     print(f"wrote {args.output}", file=sys.stderr)
     return 0

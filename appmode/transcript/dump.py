@@ -157,8 +157,9 @@ def command_labels(commands: list[tuple[float, str]], gap: float) -> list[tuple[
 VELOCITY_LABELS = ("x (lateral, right +)", "y (forward +)", "z (rotation, cw +)", "extra")
 
 
-def run_plot(path: str, output: str) -> int:
-    """Velocities, attitude and battery over time, with the commands marked."""
+def run_plot(path: str, output: str, profile: str | None = None) -> int:
+    """Velocities, attitude and battery over time, with the commands marked; the fields
+    named as `profile` lays them out (default: the transcript's `@board profile=…`)."""
     check_writable(output, "plot")
     try:
         import matplotlib
@@ -174,36 +175,61 @@ def run_plot(path: str, output: str) -> int:
     transcript = read_transcript(path)
     for warning in transcript.warnings:
         print(f"appmode: WARNING: {warning}", file=sys.stderr)
-    layout = Check(transcript).needs.profile.a_layout
-    motion, series, commands = _series(transcript, path)
-    if not series["tA"] and not series["tB"]:
+    needs = Check(transcript).needs
+    layout = (profile_named(profile) if profile else needs.profile).a_layout
+    a, b, commands = _series(transcript, path, layout)
+    if not a and not b:
         return _plot_reports(plt, transcript, path, output)
     fig, (strip, vel, att, bat) = plt.subplots(
         4, 1, sharex=True, figsize=(11, 8.5), height_ratios=(0.7, 3, 3, 2), layout="constrained"
     )
     names = VELOCITY_LABELS if layout is VELOCITY else layout.labels
-    for i, column in motion.items():
-        vel.plot(series["tA"], column, label=names[i], drawstyle="steps-post")
+    ta = [t for t, _ in a]
+    for i in layout.motion:
+        vel.plot(ta, [v[i] for _, v in a], label=names[i], drawstyle="steps-post")
+    unit = layout.a_fields[layout.motion[0]].unit if layout.motion else ""
+    scaled = f"{layout.scale:g}·" if layout.scale != 1 else ""
+    wraps = layout.a_fields[layout.motion[0]].wrap if layout.motion else None
     vel.set_ylabel(
-        "velocity (board unit)" if layout.signed else f"|{layout.scale:g}·v| (wraps at 256)"
+        f"{unit or 'value'}"
+        if layout.signed
+        else f"|{scaled}v| ({unit})" + (f", wraps at {wraps}" if wraps else "")
     )
-    for k in ("pitch", "roll", "yaw"):
-        att.plot(series["tB"], series[k], label=k, drawstyle="steps-post")
-    att.set_ylabel("degrees")
-    bat.plot(series["tB"], series["battery"], color="tab:green", drawstyle="steps-post")
+    tb = [t for t, _ in b]
+    shown = [(i, f) for i, f in enumerate(layout.b_fields) if not f.battery]
+    for i, field in shown:
+        att.plot(tb, [v[i] for _, v in b], label=field.label, drawstyle="steps-post")
+    words = {"°": "degrees", "": "value"}
+    att.set_ylabel(" / ".join(dict.fromkeys(words.get(f.unit, f.unit) for _, f in shown)))
+    times, battery = _battery(layout, a, b)
+    bat.plot(times, battery, color="tab:green", drawstyle="steps-post")
     bat.set_ylabel("battery %")
-    if series["battery"]:  # the range it spans, so that a change shows
-        low, high = min(series["battery"]), max(series["battery"])
+    if battery:  # the range it spans, so that a change shows
+        low, high = min(battery), max(battery)
         pad = max(2.0, (high - low) * 0.1)
         bat.set_ylim(low - pad, high + pad)
         bat.yaxis.set_major_locator(MaxNLocator(integer=True))
     bat.set_xlabel("time (s)")
-    times = series["tA"] + series["tB"] + [t for t, _ in commands]
-    _mark_commands(strip, (vel, att, bat), commands, max(times) - min(times))
+    every = ta + tb + [t for t, _ in commands]
+    _mark_commands(strip, (vel, att, bat), commands, max(every) - min(every))
     vel.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     att.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.suptitle(_title(path, transcript), fontsize=11)
     return _save(plt, fig, output)
+
+
+Series = list[tuple[float, tuple[int, ...]]]
+"""(time, a record's values), in order."""
+
+
+def _battery(layout: Layout, a: Series, b: Series) -> tuple[list[float], list[int]]:
+    """The battery over time, from the B record's battery field, else the A record's."""
+    held = next((i for i, f in enumerate(layout.b_fields) if f.battery), None)
+    if held is not None:
+        return [t for t, _ in b], [v[held] for _, v in b]
+    if layout.battery is not None:
+        return [t for t, _ in a], [v[layout.battery] for _, v in a]
+    return [], []
 
 
 def _title(path: str, transcript: Transcript) -> str:
@@ -278,24 +304,21 @@ def _save(plt: Any, fig: Any, output: str) -> int:
 
 
 def _series(
-    transcript: Transcript, path: str
-) -> tuple[dict[int, list[int]], dict[str, list[Any]], list[tuple[float, str]]]:
-    """What a plot draws: the A record's motion fields by index, the times of A and B
-    records with B's fields, and the commands sent (time, text)."""
+    transcript: Transcript, path: str, layout: Layout
+) -> tuple[Series, Series, list[tuple[float, str]]]:
+    """What a plot draws: the A and B records (time, values) as `layout` counts their
+    fields, and the commands sent (time, text)."""
     needs = Check(transcript).needs
-    motion: dict[int, list[int]] = {i: [] for i in needs.profile.a_layout.motion}
-    series: dict[str, list[Any]] = {k: [] for k in ("tA", "tB", "pitch", "roll", "yaw", "battery")}
+    a: Series = []
+    b: Series = []
     commands: list[tuple[float, str]] = []
-    for t, direction, event in decoded(transcript.items, needs.drive, path):
-        if isinstance(event, app.Velocity):
-            series["tA"].append(t)
-            values = app.record_fields(event)[1]
-            for i, column in motion.items():
-                column.append(values[i])
-        elif isinstance(event, app.Attitude):
-            series["tB"].append(t)
-            for k in ("pitch", "roll", "yaw", "battery"):
-                series[k].append(getattr(event, k))
+    for t, direction, event in decoded(transcript.items, needs.drive, path, layout):
+        if isinstance(event, (app.Velocity, app.Attitude, app.OtherRecord)):
+            letter, values = app.record_fields(event)
+            if letter == "A":
+                a.append((t, values))
+            elif letter == "B" and len(values) == len(layout.b_fields):
+                b.append((t, values))
         elif direction == ">" and isinstance(event, app.Command):
             commands.append((t, event.raw.decode("latin-1")))
-    return motion, series, commands
+    return a, b, commands

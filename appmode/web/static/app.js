@@ -527,6 +527,9 @@ function paramRow(v) {
   Object.assign(slider, { min: wide ? 0 : v.minimum, max: wide ? SLIDER_STEPS : v.maximum, step: 1 });
   Object.assign(input, { min: low, max: high, step: user(1, v.scale) }); // the user's units
   if (v.scale !== 1) input.inputMode = "decimal";
+  if (v.minimum === v.maximum) { // taken and ignored by the firmware: nothing to set
+    [slider, input, row.querySelector("button")].forEach((e) => { e.disabled = true; });
+  }
   slider.setAttribute("aria-label", `${v.name} slider`);
   input.setAttribute("aria-label", `new ${v.name}`);
   slider.addEventListener("input", () => {
