@@ -11,7 +11,7 @@ from typing import TextIO
 from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile
-from appmode.protocol import app, app_decoders
+from appmode.protocol import app
 from appmode.protocol.params import DRIVE_NAMES, DriveType
 
 ROUTE: tuple[tuple[float, app.Command], ...] = (
@@ -44,7 +44,7 @@ def run_demo(
 
     board = Board(drive=drive if profile.drive_types else None, profile=profile)
     layout = profile.a_layout
-    decoder = app_decoders.BoardDecoder()
+    decoder = layout.board_decoder()
     started = time.monotonic()
     start = profile.dead_time + 0.2 if profile.dead_time else 0.0
     end = start + END
@@ -86,8 +86,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_profile(
         demo,
-        "the simulated board's behaviour: sheet or minibalance (the reference firmware, "
-        "see appmode protocol 13; it has no drive types)",
+        "the simulated board's behaviour: sheet, minibalance (the reference firmware, "
+        "see appmode protocol 13; it has no drive types), balance or a profile FILE (its "
+        "records and parameters, no physics)",
     )
     demo.add_argument(
         "--fast", action="store_true", help="run on virtual time instead of real time"

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
+    HOLDS,
     Subparsers,
     add_profile,
     add_record,
@@ -110,8 +111,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
     )
     add_profile(
         parser,
-        "the board's profile: with no URL, the simulated board's (sheet or minibalance: the "
-        "reference firmware; see appmode protocol 13); with a URL, what its A record holds",
+        f"the board's profile: with no URL, the simulated board's; with a URL, {HOLDS}",
         default=None,
     )
     add_record(parser)

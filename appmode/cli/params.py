@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, TextIO
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
+    HOLDS,
     Subparsers,
     add_profile,
     add_record,
@@ -74,8 +75,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_profile(
         prm,
-        "the board's profile (with a sim:// URL, the simulated board's), for the defaults "
-        "shown: sheet or minibalance (the reference firmware; see appmode protocol 13)",
+        f"the board's profile (with a sim:// URL, the simulated board's), for the names, "
+        f"ranges, scales and defaults shown, {HOLDS}",
         default=None,
     )
     add_record(prm)

@@ -6,6 +6,8 @@ picks a layout (`--profile`); every layout comes from a profile's file."""
 
 from __future__ import annotations
 
+from functools import cache
+
 from appmode.protocol import profile_file
 from appmode.protocol.app_decoders import BoardDecoder
 from appmode.protocol.profile_file import Field, ParamSpec, ProfileFile
@@ -114,3 +116,10 @@ class Layout(Frozen):
 VELOCITY = Layout("velocity", profile_file.load("sheet"))
 SCALED = Layout("scaled", profile_file.load("minibalance"))
 A_LAYOUTS: dict[str, Layout] = {layout.name: layout for layout in (VELOCITY, SCALED)}
+
+
+@cache
+def named(profile: str) -> Layout:
+    """The layout of a profile by name or file (ProfileError when it does not read)."""
+    shipped = {"sheet": VELOCITY, "minibalance": SCALED}
+    return shipped.get(profile) or Layout(profile, profile_file.load(profile))

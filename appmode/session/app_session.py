@@ -28,7 +28,7 @@ from appmode.protocol.directions import (
     grid_for,
     letter_name,
 )
-from appmode.protocol.layouts import VELOCITY, Layout
+from appmode.protocol.layouts import VELOCITY, Layout, named
 from appmode.session import instruments
 from appmode.session.app_commands import COMMANDS
 from appmode.session.base import (
@@ -68,15 +68,17 @@ class Session(BaseSession):
         driving: HoldToDrive | None = None,
         record: str | None = None,
         on_message: Callable[[str], None] | None = None,
-        layout: Layout = VELOCITY,
+        layout: Layout | None = None,
         stop_again: bytes | None = None,
         frames_stop: bool = False,
     ) -> None:
+        """`layout`: how the board's records read (default: its sim:// URL's profile's,
+        else the sheet's)."""
         super().__init__(url, driving, on_message)
         self.host = Host(
             self.target,
             tap=self._tap,
-            layout=layout,
+            layout=layout or named(self.target.profile or "sheet"),
             confirm_stop=stop_again is not None,
             stop_again=stop_again or b"",
             frames_stop=frames_stop,
@@ -96,7 +98,7 @@ class Session(BaseSession):
         stop guard starts watching."""
         self.guard.start()
         self.switch_page("J")
-        self.host.start_query(ParamQuery(where=self.url))
+        self.host.start_query(ParamQuery(where=self.url, specs=self.specs))
 
     def close(self) -> None:
         """Stop the car — `Z` is the last byte sent, and with `stop_again` confirmed on

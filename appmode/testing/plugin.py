@@ -41,7 +41,8 @@ OPTIONS = ("profile", "drive", "faults", "pace", "flash")
 MARKER = (
     "appmode_board(profile='sheet', drive=None, faults='', pace=True, flash=None): the "
     "simulated board of the appmode_board and appmode_sim_url fixtures — its profile "
-    "(sheet or minibalance), drive type (omni, mecanum, diff, diff-gyro), a faulty link "
+    "(sheet, minibalance, balance or a profile file), drive type (omni, mecanum, diff, "
+    "diff-gyro), a faulty link "
     "('drop:0.01,corrupt:0.01'), pacing at the real line rates, and a flash file"
 )
 _SHARES = itertools.count(1)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import io
 import os
+import re
 import subprocess
 import time
 from pathlib import Path
@@ -193,3 +194,53 @@ def test_a_console_recording_has_the_times_the_board_took_its_bytes(tmp_path: Pa
         float(line.split(" ")[0]) for line in record.read_text().splitlines() if " > A" in line
     ]
     assert stamps[0] == took
+
+
+def test_a_balance_car_s_session_shows_and_sets_its_own_fields(tmp_path: Path) -> None:
+    """Issue 53.3: the console's panel, the page's instruments and the commands follow
+    the profile: its B record by its fields, its gains in the user's units, no speed
+    keys (it has no speed parameter)."""
+    record = tmp_path / "s.transcript"
+    script = (
+        b"drive A\nwait 0.6\nstatus\nstop\nparams\nwait 0.5\nset balance_kp 0.42\n"
+        b"wait 0.6\nstatus\nspeed +100\nquit\n"
+    )
+    done = run(
+        "drive", "sim://?profile=balance", "--keep-going", "--record", str(record), stdin=script
+    )
+    assert done.returncode == 1, done.stderr  # the speed command
+    out = done.stdout
+    assert "attitude  balance angle" in out and "left encoder" in out and "right encoder" in out
+    driving = re.search(r"\|1\.1 right\| +(\d+) +\|1\.1 left\| +(\d+)", out)
+    assert driving and min(map(int, driving.groups())) > 100, out  # |1.1 × 100| soon
+    assert "balance_kp = 0.42 (verified)" in out
+    assert "balance_kp 0.42 · balance_kd 1 · velocity_kp 80" in out
+    assert "battery   100 %" in out
+    assert "the balance profile has no speed parameter: + and - change nothing" in done.stderr
+    assert "note: on a minibalance car" not in out
+    sent = [line.split(" > ")[1] for line in record.read_text().splitlines() if " > " in line]
+    assert "{0:42}" in sent and sent[-1] == "Z"
+
+    session = Session("sim://?profile=balance", HoldToDrive(latched=True))
+    try:
+        session.start()
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline:
+            session.tick()
+            shown = session.instruments()
+            if shown.values_read and shown.telemetry and shown.telemetry.b:
+                break
+            time.sleep(0.05)
+        t = shown.telemetry
+        assert t is not None and not t.has_attitude and t.pitch is None
+        assert [name for name, _ in t.b or ()] == [
+            "balance angle", "left encoder", "right encoder"
+        ]  # fmt: skip
+        assert t.battery == 100 and [n for n, _ in t.motion or ()] == [
+            "|1.1 right|", "|1.1 left|", "balance angle"
+        ]  # fmt: skip
+        assert shown.speed is None
+        kp = shown.values[0]
+        assert (kp.name, kp.value, kp.scale, kp.maximum) == ("balance_kp", 30000, 100, 2**31 - 1)
+    finally:
+        session.close()
