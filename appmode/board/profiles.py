@@ -131,6 +131,16 @@ class Profile:
         """The drive type a host need not read: omni on a board without drive types."""
         return None if self.drive_types else DriveType.OMNI
 
+    def check_uart2(self) -> Profile:
+        """Itself, or AppmodeError when its firmware has no control port (a profile file
+        that says so): a host must not send it `FF FE` frames."""
+        if self.file is not None and not self.file.control_port:
+            raise AppmodeError(
+                f"the {self.name} profile has no control port (UART2): drive its APP port "
+                "(leave out --uart2)"
+            )
+        return self
+
     def check(self, drive: bool, flash: bool) -> None:
         """AppmodeError when a board of this profile is asked for what it does not have."""
         if drive and not self.drive_types:

@@ -164,7 +164,7 @@ def make_session(
         app, board = board, uart2.with_sim(profile=args.profile, drive=args.drive_type)
         if app.simulated and board.simulated:
             app, board = _one_board(app, board)
-    profile = profile_for(board, args.profile)
+    profile = profile_for(board, args.profile).check_uart2()
     return ControlSession(
         board,
         driving,

@@ -86,6 +86,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     args.url = args.url.with_sim(profile=args.profile)
     if args.uart2:
+        profile_for(args.url, args.profile).check_uart2()
         if args.verify_saved:
             raise AppmodeError(
                 "--verify-saved is for the APP port: over --uart2, restart the board and "

@@ -64,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
     if args.uart2:
         from appmode.cli import uart2  # here: start-up stays short
 
+        profile_for(args.url, args.profile).check_uart2()
         return uart2.run_send(
             args.url,
             args.tokens,

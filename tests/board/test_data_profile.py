@@ -158,3 +158,17 @@ def test_conform_runs_the_balance_suite_on_its_simulated_board() -> None:
     assert "4 passed, 0 failed against the embedded simulated board (balance profile)" in (
         done.stdout
     )
+
+
+def test_a_profile_without_a_control_port_refuses_uart2() -> None:
+    for args in (
+        ["params", "sim://", "--profile", "balance", "--uart2"],
+        ["send", "sim://", "--profile", "balance", "--uart2", "Z"],
+        ["drive", "--profile", "balance", "--uart2"],
+    ):
+        done = run(*args, stdin=b"quit\n")
+        assert done.returncode == 2, args
+        assert done.stderr.strip() == (
+            "appmode: error: the balance profile has no control port (UART2): drive its "
+            "APP port (leave out --uart2)"
+        )
