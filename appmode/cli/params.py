@@ -119,12 +119,12 @@ def parse_assignment(text: str, specs: Specs = param_values.SHEET) -> tuple[int,
     if not sep:
         example = f"{specs[0].name}={param_values.to_user(specs[0], specs[0].default)}"
         raise AppmodeError(f"--set {text!r}: expected NAME=VALUE, e.g. {example}")
+    index = param_values.lookup(specs, name.strip())
     try:
-        index = param_values.lookup(specs, name.strip())
         number = param_values.from_user(specs[index], value)
-        param_values.check(specs, index, number)
     except AppmodeError as exc:
         raise AppmodeError(f"--set {text!r}: {exc}") from None
+    param_values.check(specs, index, number)
     return index, number
 
 

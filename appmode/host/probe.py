@@ -313,20 +313,7 @@ def _car(
     rate = "" if fixed else f" at {one.baud} bps"
     period = f"a record every {5 * round((one.period_ms or 0) / 5)} ms"  # to 5 ms: a rhythm
     what = f"{profile.name if profile else 'unknown'} firmware ({period})"
-    flag = ""  # a sim:// URL names its own profile
-    if profile is not None and profile.name != "sheet" and not given.simulated:
-        flag = f" --profile {profile.name}"
-    drive = f"appmode drive {shlex.quote(target)}{flag}"
-    if profile is None:
-        name = nearest.profile.name
-        drive = (
-            f"its records fit no shipped profile (nearest: {name}, but "
-            f"{'; '.join(nearest.against[:2])}): write one for it, starting from "
-            f"appmode profile show {name} --toml > mycar.toml, then "
-            f"appmode drive {shlex.quote(target)} --profile mycar.toml"
-        )
-    else:
-        drive = f"drive it with: {drive}"
+    drive = _drive_it(profile, nearest, target, given.simulated)
     specs = (profile or profile_named(nearest.profile.name)).a_layout.params
     if values is None:
         return Finding(
@@ -361,6 +348,25 @@ def _car(
         heard,
         specs,
     )
+
+
+def _drive_it(
+    profile: Profile | None, nearest: identify.Judgement, target: str, simulated: bool
+) -> str:
+    """What to do next with a car: the command that drives it, or how to write a profile
+    for a firmware that fits none."""
+    if profile is None:
+        name = nearest.profile.name
+        return (
+            f"its records fit no shipped profile (nearest: {name}, but "
+            f"{'; '.join(nearest.against[:2])}): write one for it, starting from "
+            f"appmode profile show {name} --toml > mycar.toml, then "
+            f"appmode drive {shlex.quote(target)} --profile mycar.toml"
+        )
+    flag = ""  # a sim:// URL names its own profile
+    if profile.name != "sheet" and not simulated:
+        flag = f" --profile {profile.name}"
+    return f"drive it with: appmode drive {shlex.quote(target)}{flag}"
 
 
 def _control_port(url: str, one: Heard, heard: list[Heard], fixed: bool) -> Finding:

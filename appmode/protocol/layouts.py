@@ -110,7 +110,7 @@ class Layout(Frozen):
     @property
     def sheet_b(self) -> bool:
         """Its B record is the sheet's: pitch, roll, yaw, battery (an `Attitude`)."""
-        return self.b_fields == VELOCITY.b_fields
+        return self.b_names == VELOCITY.b_names
 
 
 VELOCITY = Layout("velocity", profile_file.load("sheet"))

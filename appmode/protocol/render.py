@@ -163,7 +163,7 @@ def describe(event: p.Event, layout: Layout = VELOCITY) -> str:
     """A short human description of an event (an A record's fields as `layout` reads them)."""
     if isinstance(event, p.Velocity):
         return f"velocity {motion_text(event, layout)}"
-    if isinstance(event, p.Attitude) and layout.b_fields == VELOCITY.b_fields:
+    if isinstance(event, p.Attitude) and layout.sheet_b:
         return (
             f"attitude pitch={event.pitch} roll={event.roll} yaw={event.yaw} "
             f"battery={event.battery}%"
