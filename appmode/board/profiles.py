@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from types import MappingProxyType
 
@@ -263,42 +263,25 @@ if tuple(PROFILES) != PROFILE_NAMES:
 
 
 def from_file(file: ProfileFile) -> Profile:
-    """A board for a profile file: the family's byte-by-byte intake, its records and
-    parameters as the file declares them, on its shortest period; no physics."""
-    return Profile(
+    """A board for a profile file: the sheet's board with the family's byte-by-byte
+    intake, its records and parameters as the file declares them, on its shortest
+    period; no physics."""
+    return replace(
+        SHEET,
         name=file.name,
         firmware_frames=True,
-        steer_in_frames=False,
         frame_restarts=False,
         settable=frozenset(i for i, p in enumerate(file.params) if p.maximum > p.minimum),
-        stall_speed=0,
         saves=file.saves,
         defaults=tuple(p.default for p in file.params),
         drive_types=False,
         c_saturates=True,
-        buttons=BUTTON_PAGE,
         numeric_buttons=False,
-        sticky_rotation=False,
-        ramp=None,
-        coast=1.0,
-        float32=False,
-        dead_time=0.0,
         a_layout=layouts.Layout(file.name, file),
         truncate=True,
-        yaw_low=-180,
-        battery_floor=True,
         period_ms=file.period_ms[0],
-        pause_ms=0,
-        pause_step_ms=5,
         byte_ms=10_000 / file.baud,
-        first_record="A",
-        read_lost_in_c=False,
-        startup_text=b"",
-        startup_ms=0,
-        first_record_ms=0,
-        takeover_byte=10,
         control_modes=SHEET.control_modes if file.control_port else frozenset(),
-        firmware_uart2=False,
         file=file,
     )
 
