@@ -44,6 +44,11 @@ class AppPort:
     def _apply(self, event: app.HostEvent, now: float, port: str, framed: bool = False) -> None:
         core = self.core
         shown = escape(event.raw)
+        keys = core.profile.file.speed_keys if core.profile.file is not None else {}
+        if not framed and event.raw.decode("latin-1") in keys:  # a data profile's speed key
+            core.speed_change += keys[event.raw.decode("latin-1")]
+            core.note(now, "applied", f"{shown}: speed {core.max_speed:g}", port)
+            return
         if isinstance(event, (app.Move, app.Stop, app.SwitchPage, app.Noise)):
             if isinstance(event, app.Noise):
                 core.errors += not framed

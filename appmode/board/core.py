@@ -69,6 +69,8 @@ class Core:
         """A rotation held apart from the direction (sticky_rotation)."""
         self.errors = 0
         self.warnings = 0
+        self.speed_change = 0
+        """What a data profile's speed keys (`X`, `Y` on some firmware) added to its speed."""
         # the control port (§8–§12)
         self.uart2_control = False
         """UART2 has taken over the motion (§8.3)."""
@@ -99,9 +101,10 @@ class Core:
 
     @property
     def max_speed(self) -> float:
-        """The speed a direction drives at: max_speed, or a data profile's DATA_SPEED."""
+        """The speed a direction drives at: max_speed, or a data profile's DATA_SPEED and
+        what its speed keys changed."""
         if self.profile.file is not None:
-            return DATA_SPEED
+            return max(0.0, DATA_SPEED + self.speed_change)
         return self.params[params.MAX_SPEED]
 
     def mode(self, name: str) -> bool:

@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from enum import Enum
 
+from appmode.protocol import profile_file
 from appmode.protocol.slotted import Frozen
 
 LETTERS = "ABCDEFGH"
@@ -23,7 +24,8 @@ class Page(Enum):
 
 
 PAGE_LETTERS: dict[str, Page] = {"I": Page.DIRECTION, "J": Page.DIRECTION, "K": Page.BUTTON}
-PAGE_NAMES: dict[str, str] = {"I": "gravity", "J": "joystick", "K": "button"}
+PAGE_NAMES: dict[str, str] = dict(profile_file.load("sheet").pages)
+"""The app's page each letter switches to, as the sheet's profile file names them."""
 STOP_LETTER = "Z"
 
 

@@ -7,7 +7,7 @@ blocks: parameter reads and sets run as queries whose outcome arrives with `tick
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import ClassVar
 
 from appmode.errors import AppmodeError
@@ -36,7 +36,7 @@ from appmode.session.base import (
     BaseSession,
 )
 from appmode.session.hold import HoldToDrive
-from appmode.session.instruments import Instruments
+from appmode.session.instruments import Instruments, Value
 from appmode.session.status import GLYPHS, Row, Span, hold_mode, link_rows, telemetry
 
 KEYS_HELP = (
@@ -187,9 +187,15 @@ class Session(BaseSession):
                 self.page = PAGE_LETTERS[event.letter]
                 self.page_letter = event.letter
                 self.in_force = STOP_LETTER
-            elif isinstance(event, (Stop, Noise)):
+            elif isinstance(event, Stop) or (
+                isinstance(event, Noise) and event.raw.decode("latin-1") not in self._speed_keys
+            ):  # a firmware's own speed letter (`X`) changes the speed, not the motion
                 self.in_force = STOP_LETTER
         return True
+
+    @property
+    def _speed_keys(self) -> Mapping[str, int]:
+        return self.host.state.layout.profile.speed_keys
 
     @property
     def in_force_text(self) -> str:
@@ -197,7 +203,13 @@ class Session(BaseSession):
 
     @property
     def page_text(self) -> str:
-        return f"{self.page.value} ({self.page_letter} {PAGE_NAMES[self.page_letter]})"
+        return f"{self.page.value} ({self.page_letter} {self.page_name})"
+
+    @property
+    def page_name(self) -> str:
+        """The app's page the board is on, as its profile names it."""
+        pages = self.host.state.layout.profile.pages
+        return pages.get(self.page_letter, PAGE_NAMES[self.page_letter])
 
     # ------------------------------------------------------------ what it shows
 
@@ -248,14 +260,13 @@ class Session(BaseSession):
             if old != new
         ]
         values = instruments.values(table, read, unsaved, [p.scale for p in specs])
-        speed = state.layout.speed_index
         return Instruments(
             link=instruments.link(host.connected, state.stats, now),
             telemetry=instruments.telemetry(state, now),
             in_force="stopped" if not self.moving else letter_name(self.page, self.in_force),
             moving=self.moving,
-            page=PAGE_NAMES[self.page_letter],
-            speed=None if speed is None else values[speed],
+            page=self.page_name,
+            speed=self._speed_value(values),
             values=values,
             values_read=state.params is not None,
             wheels=None,
@@ -313,6 +324,15 @@ class Session(BaseSession):
         param_values.check(self.specs, index, value)
         self._query(ParamQuery((index, value), where=self.url, specs=self.specs))
 
+    def _speed_value(self, values: tuple[Value, ...]) -> Value | None:
+        """What the speed keys change: the speed parameter, or (a firmware whose letters
+        change its speed) those letters, whose speed no record shows; None: nothing."""
+        layout = self.host.state.layout
+        if layout.speed_index is not None:
+            return values[layout.speed_index]
+        keys = self._speed_keys
+        return Value(f"speed ({'/'.join(keys)})", None, 0, 0) if keys else None
+
     def _speed_index(self) -> int:
         index = self.host.state.layout.speed_index
         if index is None:
@@ -321,6 +341,10 @@ class Session(BaseSession):
         return index
 
     def change_speed(self, delta: int) -> None:
+        keys = self._speed_keys
+        if self.host.state.layout.speed_index is None and keys:
+            self._speed_key(delta, keys)
+            return
         index = self._speed_index()
         current = self.host.state.params
         if current is None:
@@ -335,6 +359,14 @@ class Session(BaseSession):
                 f"{spec.name} {wanted} is out of {spec.minimum}–{spec.maximum}: setting {value}"
             )
         self.set_param(index, value)
+
+    def _speed_key(self, delta: int, keys: Mapping[str, int]) -> None:
+        """Send the firmware's own speed letter for a change of `delta` (`X`: +100)."""
+        letter = next((k for k, step in keys.items() if (step > 0) == (delta > 0)), None)
+        if letter is None or delta == 0:
+            raise AppmodeError(f"this firmware's speed letters ({', '.join(keys)}) go one way")
+        if self._send(letter.encode()):
+            self.say(f"sent {letter}: this firmware's speed {keys[letter]:+d}")
 
     def save(self) -> None:
         if self._send(b"{Q:W}"):

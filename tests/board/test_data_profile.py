@@ -172,3 +172,32 @@ def test_a_profile_without_a_control_port_refuses_uart2() -> None:
             "appmode: error: the balance profile has no control port (UART2): drive its "
             "APP port (leave out --uart2)"
         )
+
+
+def test_a_firmware_s_own_speed_letters_and_page_names(tmp_path: Path) -> None:
+    """Issue 53: a line-following variant whose `K` is a steering page and whose `X`, `Y`
+    change the speed by ±100: the speed keys send those letters (and the car goes on in
+    the direction in force, as the view says), the page is named as the file names it."""
+    own = tmp_path / "follower.toml"
+    own.write_text(
+        'name = "follower"\ndescription = "a line follower"\nsource = "its APP_Show"\n'
+        'like = "balance"\n[pages]\nJ = "joystick"\nK = "steering"\n'
+        "[speed_keys]\nX = 100\nY = -100\n"
+    )
+    record = tmp_path / "s.transcript"
+    script = b"drive A\nwait 0.8\nspeed +100\nwait 0.8\nstatus\npage button\nstatus\nquit\n"
+    done = run("drive", f"sim://?profile={own}", "--record", str(record), stdin=script)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    assert "sent X: this firmware's speed +100" in out
+    after_x = out.split("sent X", 1)[1]
+    assert "in force  A forward" in after_x, "X changed the speed, not the motion"
+    assert "(K steering)" in out
+    entries = read_transcript(record).entries
+    speeds = [
+        int(e.text[2:].split(":")[0])
+        for e in entries
+        if e.direction == "<" and e.text.startswith("{A")
+    ]
+    assert max(speeds) > 200, "twice the data board's speed after X, ×1.1"
+    assert [e.text for e in entries if e.direction == ">"][-1] == "Z"
