@@ -72,7 +72,7 @@ def shown(profile: ProfileFile) -> str:
         f"{'{Q:W} saves' if profile.saves else '{Q:W} saves nothing'}; "
         f"{'a control port (UART2)' if profile.control_port else 'no control port'}",
         f"  pages: {pages}" + (f"; also sends {' '.join(profile.replies)}" * bool(profile.replies)),
-        f"  the speed keys (+, −) change: {profile.speed_param or 'nothing (no speed parameter)'}",
+        f"  the speed keys (+, −) change: {_speed(profile)}",
         "",
     ]
     for kind, fields in (("A", profile.a), ("B", profile.b)):
@@ -87,6 +87,15 @@ def shown(profile: ProfileFile) -> str:
         span, default = param_values.range_text(p), param_values.to_user(p, p.default)
         lines.append(f"  {i:2d}  {p.name:<18}  {span:<24}  {default:>10}  {scale}")
     return "\n".join(lines) + "\n"
+
+
+def _speed(profile: ProfileFile) -> str:
+    if profile.speed_param:
+        return profile.speed_param
+    if profile.speed_keys:
+        keys = ", ".join(f"{k} {v:+d}" for k, v in profile.speed_keys.items())
+        return f"the speed, with its own letters ({keys})"
+    return "nothing (no speed parameter)"
 
 
 def _field(index: int, field: Field) -> str:
