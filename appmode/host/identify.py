@@ -4,10 +4,11 @@ judgement, against the shipped profiles' files.
 Each profile is held to what was heard: the field count of each record kind, the
 values its fields may take (a magnitude is never negative, a wrapped field stays under
 its wrap, a battery is at most 100 % and the same in the A and B records when both
-carry it), the record period, the start-up text (`boot`) and the extra replies (`##$`). A profile
-that something heard contradicts is out; among the rest the one with the most positive
-evidence wins (the order of `SHIPPED` breaks a tie). The period only counts against a
-profile when it is far off: a loaded host delivers records late, in bursts.
+carry it), the record period (when the records came evenly), the start-up text
+(`boot`) and the extra replies (`##$`). A profile that something heard contradicts is
+out; among the rest the one with the most positive evidence wins (the order of
+`SHIPPED` breaks a tie). The period only counts against a profile when it is far off,
+and not at all when the records came in bursts (a loaded host delivers them late).
 """
 
 from __future__ import annotations
@@ -35,6 +36,9 @@ class Sent(NamedTuple):
     records: Sequence[tuple[str, tuple[int, ...]]]
     period_ms: float | None
     text: bytes
+    steady: bool = True
+    """The records came evenly (no burst of late ones: a loaded host's), so that the
+    period says something."""
 
 
 class Judgement(NamedTuple):
@@ -85,7 +89,7 @@ def _judge(profile: ProfileFile, sent: Sent) -> Judgement:
             if field.battery and column:
                 batteries[letter] = column
     score += _battery_evidence(batteries, against)
-    score += _period_evidence(profile, sent.period_ms, against)
+    score += _period_evidence(profile, sent.period_ms if sent.steady else None, against)
     if profile.boot and profile.boot.encode() in sent.text:
         score += 3
     for reply in profile.replies:

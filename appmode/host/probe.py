@@ -12,6 +12,7 @@ firmware is told from what it sends, against the shipped profiles (`identify`).
 from __future__ import annotations
 
 import contextlib
+import itertools
 import shlex
 import threading
 import time
@@ -52,6 +53,8 @@ reference firmware sends one after each record (about 17 a second); a device tha
 streams `00 FF` without pause makes thousands."""
 SAMPLE = 48
 """Bytes of text kept to show what a port that is not a board sent."""
+BURST = 0.3
+"""Records closer than this fraction of the mean period came in a burst."""
 TEXT = 4096
 """Bytes of text kept for firmware identification (a start-up text is about 400)."""
 
@@ -82,7 +85,16 @@ class Heard:
     @property
     def sent(self) -> identify.Sent:
         """What firmware identification reads of it."""
-        return identify.Sent(self.shapes, self.period_ms, bytes(self.said))
+        return identify.Sent(self.shapes, self.period_ms, bytes(self.said), self.steady)
+
+    @property
+    def steady(self) -> bool:
+        """No two records came much closer than the mean period (a burst of records held
+        up and delivered at once: the measured period is the host's, not the board's)."""
+        times, period = self.record_times, self.period_ms
+        if period is None:
+            return False
+        return all(b - a >= BURST * period / 1000 for a, b in itertools.pairwise(times))
 
     @property
     def records(self) -> int:

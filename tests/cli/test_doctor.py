@@ -238,6 +238,13 @@ def test_the_firmware_is_told_by_what_it_sends() -> None:
     # far off every period (400 ms) and records of no shipped shape
     found, _ = probe.firmware(timed_records(400, [b"{A-5:0:0:0}$", b"{B0:0}$"] * 8).sent)
     assert found is None
+    # held up and delivered in a burst (a loaded host): the period says nothing, the
+    # values still do (a battery of -740 %: the minibalance's before its motors are on)
+    dead = [b"{A0:0:-740:0}$", b"{B0:0:0:-740}$"] * 8
+    burst = timed_records(60, dead)
+    burst.record_times[:8] = [burst.record_times[7]] * 8
+    assert not burst.steady and timed_records(60, dead).steady
+    assert probe.firmware(burst.sent)[0] is MINIBALANCE
     c = app.encode(app.ParamsRecord(params.DEFAULTS))
     # a long record keeps the reference loop waiting longer (§13): still that firmware
     mixed = timed_records(MINIBALANCE.record_period_ms(len(c)), [c] * 6)
