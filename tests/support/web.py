@@ -58,15 +58,17 @@ class WebProcess:
 
 @contextmanager
 def web_process(
-    tmp_path: Path, *args: str, uart2: bool = False, bluetooth: str = ""
+    tmp_path: Path, *args: str, uart2: bool = False, bluetooth: str = "", profile: str = "sheet"
 ) -> Iterator[WebProcess]:
     """A board on a pty recording what it receives, and `appmode web` driving it (its
     data folder, where a certificate is kept, in `tmp_path`); with `uart2`, over the
     board's control port; with `bluetooth` "ble" or "spp", over that module of the board
-    behind the BlueZ stand-in."""
+    behind the BlueZ stand-in; the board and the page of `profile`."""
     record = tmp_path / "board.transcript"
     where = "--bluetooth" if bluetooth else "--pty"
-    with board_process(where, "--record", str(record), "--quiet") as board:
+    if profile != "sheet":
+        args = (*args, "--profile", profile)
+    with board_process(where, "--record", str(record), "--quiet", "--profile", profile) as board:
         bus = {"DBUS_SYSTEM_BUS_ADDRESS": board.details["bus"]} if bluetooth else {}
         if bluetooth:
             address = board.details[bluetooth].split()[0]

@@ -189,6 +189,35 @@ def test_the_params_page_sets_verified_and_save_is_only_requested(
         page.screenshot(path=str(tmp_path / "params.png"))
 
 
+def test_a_balance_car_s_page_shows_its_fields_and_sets_its_gains_scaled(
+    browser: Browser, tmp_path: Path
+) -> None:
+    """Issue 53.3: the instruments, the sliders and the speed follow the profile."""
+    with web_process(tmp_path, profile="balance") as web:
+        page = phone(browser, web)
+        motion = page.locator("#motion")
+        motion.get_by_text("left encoder").wait_for(timeout=5_000)
+        assert "|1.1 right|" in motion.inner_text() and "balance angle" in motion.inner_text()
+        assert page.locator("#dials").is_hidden(), "no pitch, roll, yaw on this car"
+        assert page.locator("#speed").inner_text() == "fixed"
+        assert page.get_by_role("button", name="speed up").is_disabled()
+        assert page.locator("#battery-text").inner_text() == "100 %"
+        page.get_by_role("button", name="Params").click()
+        names = page.locator("#values .name").all_inner_texts()
+        assert names[0] == "balance_kp (0–21474836.47)" and names[4] == "reserved_4 (0–0)"
+        assert page.get_by_label("new reserved_4").is_disabled()
+        page.get_by_label("new balance_kp").fill("0.42")
+        page.get_by_role("button", name="set balance_kp").click()
+        page.get_by_text("balance_kp = 0.42 (verified)").wait_for(timeout=10_000)
+        assert "{0:42}" in web.sent()
+        first = page.locator("#values .value").first
+        assert first.inner_text().startswith("0.42")
+        page.get_by_label("new balance_kp").fill("0.425")
+        page.get_by_role("button", name="set balance_kp").click()
+        page.get_by_text("balance_kp takes steps of 0.01").wait_for(timeout=5_000)
+        page.screenshot(path=str(tmp_path / "balance-params.png"))
+
+
 def test_the_waves_page_draws_the_telemetry(browser: Browser, tmp_path: Path) -> None:
     with web_process(tmp_path) as web:
         page = phone(browser, web)
