@@ -13,6 +13,7 @@ and not at all when the records came in bursts (a loaded host delivers them late
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -67,6 +68,7 @@ def _judge(profile: ProfileFile, sent: Sent) -> Judgement:
     score = 0
     by_kind = {"A": profile.a, "B": profile.b}
     columns: dict[str, list[tuple[int, ...]]] = {"A": [], "B": []}
+    readings: list[tuple[str, int]] = []  # the battery, in the order the records came
     for letter, values in sent.records:
         fields = by_kind.get(letter)
         if letter == "C" and len(values) != len(profile.params):
@@ -77,18 +79,16 @@ def _judge(profile: ProfileFile, sent: Sent) -> Judgement:
             against.append(f"{letter} records of {len(values)} fields ({len(fields)} here)")
             continue
         columns[letter].append(values)
+        held = [v for f, v in zip(fields, values, strict=True) if f.battery]
+        readings += [(letter, held[0])] if held else []
     if columns["B"]:
         score += 1  # its B records have this profile's field count
-    batteries: dict[str, list[int]] = {}
     for letter, rows in columns.items():
         for i, field in enumerate(by_kind[letter]):
-            column = [row[i] for row in rows]
-            problem = _field_problem(field, column)
+            problem = _field_problem(field, [row[i] for row in rows])
             if problem:
                 against.append(f"{letter} field {i + 1} {problem} ({field.name} here)")
-            if field.battery and column:
-                batteries[letter] = column
-    score += _battery_evidence(batteries, against)
+    score += _battery_evidence(readings, against)
     score += _period_evidence(profile, sent.period_ms if sent.steady else None, against)
     if profile.boot and profile.boot.encode() in sent.text:
         score += 3
@@ -112,16 +112,22 @@ def _field_problem(field: Field, column: list[int]) -> str:
     return ""
 
 
-def _battery_evidence(batteries: dict[str, list[int]], against: list[str]) -> int:
-    """A battery field that reads as one is evidence; two that disagree are against."""
-    if len(batteries) == 2:
-        a, b = batteries["A"], batteries["B"]
-        if abs(sum(a) / len(a) - sum(b) / len(b)) > BATTERY_AGREES:
-            against.append(f"its A and B records' battery fields differ ({a[-1]}, {b[-1]})")
+def _battery_evidence(readings: list[tuple[str, int]], against: list[str]) -> int:
+    """The battery readings in the order they came: where the A and B records both carry
+    it, neighbours must mostly agree (the level may change between two, as when a board's
+    motors come on) and agreeing on a charge is evidence; one record's battery that reads
+    as one, steadily, is some."""
+    pairs = [(x, y) for (first, x), (second, y) in itertools.pairwise(readings) if first != second]
+    if pairs:
+        agree = [x for x, y in pairs if abs(x - y) <= BATTERY_AGREES]
+        if 2 * len(agree) < len(pairs):
+            x, y = pairs[-1]
+            against.append(f"its A and B records' battery fields differ ({x}, {y})")
             return 0
-        return 2 if max(a) > 0 else 0
-    column = next(iter(batteries.values()), [])
-    return 1 if column and min(column) > 0 and max(column) - min(column) <= BATTERY_AGREES else 0
+        return 2 if max(agree) > 0 else 0
+    values = [value for _, value in readings]
+    steady = values and min(values) > 0 and max(values) - min(values) <= BATTERY_AGREES
+    return 1 if steady else 0
 
 
 def _period_evidence(profile: ProfileFile, period: float | None, against: list[str]) -> int:

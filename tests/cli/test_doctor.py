@@ -245,6 +245,9 @@ def test_the_firmware_is_told_by_what_it_sends() -> None:
     burst.record_times[:8] = [burst.record_times[7]] * 8
     assert not burst.steady and timed_records(60, dead).steady
     assert probe.firmware(burst.sent)[0] is MINIBALANCE
+    # its motors come on while it is heard: the battery changes between an A and a B
+    waking = dead[:5] + [mini_a, b"{B0:0:0:100}$"] * 6
+    assert probe.firmware(timed_records(60, waking).sent)[0] is MINIBALANCE
     c = app.encode(app.ParamsRecord(params.DEFAULTS))
     # a long record keeps the reference loop waiting longer (§13): still that firmware
     mixed = timed_records(MINIBALANCE.record_period_ms(len(c)), [c] * 6)
