@@ -499,6 +499,9 @@ function showParams(values, read) {
   if (box.dataset.names !== values.map((v) => v.name).join()) {
     box.dataset.names = values.map((v) => v.name).join();
     box.replaceChildren(...values.map((v) => paramRow(v)));
+    const first = values[0]; // the command line's example, in this board's own names
+    const example = first && first.value !== null ? user(first.value, first.scale) : "";
+    if (first) $("line").placeholder = `set ${first.name} ${example} · save · help`;
   }
   values.forEach((v, i) => {
     const row = box.children[i];
