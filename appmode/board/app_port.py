@@ -45,8 +45,9 @@ class AppPort:
         core = self.core
         shown = escape(event.raw)
         keys = core.profile.file.speed_keys if core.profile.file is not None else {}
-        if not framed and event.raw.decode("latin-1") in keys:  # a data profile's speed key
-            core.speed_change += keys[event.raw.decode("latin-1")]
+        letter = event.raw.decode("latin-1")
+        if not framed and letter in keys:  # a data profile's speed key
+            core.speed_change += keys[letter]
             core.note(now, "applied", f"{shown}: speed {core.max_speed:g}", port)
             return
         if isinstance(event, (app.Move, app.Stop, app.SwitchPage, app.Noise)):

@@ -138,4 +138,6 @@ class Core:
             self.errors += 1
             self.note(now, "rejected", f"{shown}: save failed: {exc}", port)
             return
-        self.note(now, "applied", f"{shown}: saved {values} (gyro calibration {saved[-1]})", port)
+        self.note(
+            now, "applied", f"{shown}: saved {list(kept)} (gyro calibration {saved[-1]})", port
+        )

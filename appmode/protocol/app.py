@@ -205,21 +205,6 @@ class ParamsRecord(Slotted):
         self.terminated = terminated
         self.raw = raw
 
-    def as_dict(self) -> dict[str, int]:
-        return {p.name: v for p, v in zip(params.PARAMS, self.values, strict=True)}
-
-    @property
-    def out_of_range(self) -> tuple[str, ...]:
-        """The names of the values outside the sheet's ranges: a real firmware takes any
-        value it is sent, so a board can hold them (they are shown, flagged)."""
-        if len(self.values) != params.PARAM_COUNT or params.values_error(self.values) is None:
-            return ()
-        return tuple(
-            p.name
-            for p, v in zip(params.PARAMS, self.values, strict=True)
-            if params.value_error(p.index, v) is not None
-        )
-
 
 class OtherRecord(Slotted):
     """A well-formed record whose letter this protocol does not define."""

@@ -31,6 +31,11 @@ class Layout(Frozen):
         "scale",
         "signed",
         "battery",
+        "b_names",
+        "param_names",
+        "extra_a",
+        "speed_index",
+        "sheet_b",
     )
     name: str
     profile: ProfileFile
@@ -54,11 +59,24 @@ class Layout(Frozen):
     """Whether the motion fields carry a sign (else they are magnitudes)."""
     battery: int | None
     """The A field holding the battery percentage, if any."""
+    b_names: tuple[str, ...]
+    param_names: tuple[str, ...]
+    extra_a: tuple[int, ...]
+    """The A fields shown besides the motion and the battery: those with a unit (the
+    balance car's angle; not the sheet's `extra`)."""
+    speed_index: int | None
+    """The parameter the speed keys change (max_speed), or None: the profile has none."""
+    sheet_b: bool
+    """Its B record is the sheet's: pitch, roll, yaw, battery (an `Attitude`)."""
 
     def __init__(self, name: str, profile: ProfileFile) -> None:
         a = profile.a
         motion = tuple(i for i, field in enumerate(a) if field.motion)
         first = a[motion[0]] if motion else a[0]
+        battery = next((i for i, field in enumerate(a) if field.battery), None)
+        b_names = tuple(field.name for field in profile.b)
+        param_names = tuple(param.name for param in profile.params)
+        speed = profile.speed_param
         self._fill(name, profile)
         derived = {
             "a_fields": a,
@@ -70,7 +88,14 @@ class Layout(Frozen):
             "motion": motion,
             "scale": first.scale,
             "signed": first.signed,
-            "battery": next((i for i, field in enumerate(a) if field.battery), None),
+            "battery": battery,
+            "b_names": b_names,
+            "param_names": param_names,
+            "extra_a": tuple(
+                i for i, field in enumerate(a) if field.unit and i not in motion and i != battery
+            ),
+            "speed_index": None if speed is None else param_names.index(speed),
+            "sheet_b": b_names == tuple(f.name for f in profile_file.load("sheet").b),
         }
         for key, value in derived.items():
             object.__setattr__(self, key, value)
@@ -83,35 +108,6 @@ class Layout(Frozen):
         """A decoder of the board's records with this layout's field counts."""
         return BoardDecoder(len(self.b_fields), len(self.params))
 
-    @property
-    def b_names(self) -> tuple[str, ...]:
-        return tuple(field.name for field in self.b_fields)
-
-    @property
-    def param_names(self) -> tuple[str, ...]:
-        return tuple(param.name for param in self.params)
-
-    @property
-    def extra_a(self) -> tuple[int, ...]:
-        """The A fields shown besides the motion and the battery: those with a unit (the
-        balance car's angle; not the sheet's `extra`)."""
-        return tuple(
-            i
-            for i, field in enumerate(self.a_fields)
-            if field.unit and i not in self.motion and i != self.battery
-        )
-
-    @property
-    def speed_index(self) -> int | None:
-        """The parameter the speed keys change (max_speed), or None: the profile has none."""
-        wanted = self.profile.speed_param
-        return None if wanted is None else self.param_names.index(wanted)
-
-    @property
-    def sheet_b(self) -> bool:
-        """Its B record is the sheet's: pitch, roll, yaw, battery (an `Attitude`)."""
-        return self.b_names == VELOCITY.b_names
-
 
 VELOCITY = Layout("velocity", profile_file.load("sheet"))
 SCALED = Layout("scaled", profile_file.load("minibalance"))
@@ -122,4 +118,7 @@ A_LAYOUTS: dict[str, Layout] = {layout.name: layout for layout in (VELOCITY, SCA
 def named(profile: str) -> Layout:
     """The layout of a profile by name or file (ProfileError when it does not read)."""
     shipped = {"sheet": VELOCITY, "minibalance": SCALED}
-    return shipped.get(profile) or Layout(profile, profile_file.load(profile))
+    if profile in shipped:
+        return shipped[profile]
+    loaded = profile_file.load(profile)
+    return Layout(loaded.name, loaded)

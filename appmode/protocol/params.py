@@ -42,7 +42,6 @@ PARAMS: tuple[Param, ...] = tuple(
 """The sheet's nine, read from its profile file (`protocol/profiles/sheet.toml`)."""
 PARAM_COUNT = len(PARAMS)
 BY_NAME: dict[str, Param] = {p.name: p for p in PARAMS}
-NAMES: tuple[str, ...] = tuple(BY_NAME)
 DEFAULTS: tuple[int, ...] = tuple(p.default for p in PARAMS)
 MAX_SPEED = BY_NAME["max_speed"].index
 SYSTEM_MODE = BY_NAME["system_mode"].index
@@ -127,11 +126,6 @@ def value_error(index: int, value: int) -> str | None:
     return None
 
 
-def changes(old: Sequence[int], new: Sequence[int]) -> list[str]:
-    """`name old → new` for each parameter that differs."""
-    return [f"{p.name} {a} → {b}" for p, a, b in zip(PARAMS, old, new, strict=True) if a != b]
-
-
 def check_value(index: int, value: int) -> None:
     """Raise ValueError naming the parameter and its range when `value` is not allowed."""
     error = value_error(index, value)
@@ -146,18 +140,6 @@ def whole(text: str) -> int | None:
     if text.isascii() and text.isdigit() and len(text) <= 4000:
         return int(text)
     return None
-
-
-def lookup(key: str | int) -> Param:
-    """A parameter by name or index (as text or int); ValueError lists the valid names."""
-    index = key if isinstance(key, int) else whole(key)
-    if index is not None:
-        if 0 <= index < PARAM_COUNT:
-            return PARAMS[index]
-    elif key in BY_NAME:
-        return BY_NAME[key]
-    names = ", ".join(p.name for p in PARAMS)
-    raise InvalidValue(f"unknown parameter {key!r}: use 0–{PARAM_COUNT - 1} or one of {names}")
 
 
 _BOUNDS = tuple((p.minimum, p.maximum) for p in PARAMS)

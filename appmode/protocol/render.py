@@ -119,9 +119,8 @@ def json_line(event: p.Event, layout: Layout = VELOCITY) -> str:
     """`to_json(event, layout)` as `json.dumps(…, ensure_ascii=False)` writes it. Whole A
     and B records whose text needs no JSON escaping are formatted directly: `appmode
     decode` spends its time here."""
-    if layout is not VELOCITY:
-        return _JSON(to_json(event, layout))
-    if isinstance(event, (p.Velocity, p.Attitude)) and event.terminated:
+    fast = layout is VELOCITY or (layout.sheet_b and isinstance(event, p.Attitude))
+    if fast and isinstance(event, (p.Velocity, p.Attitude)) and event.terminated:
         raw = escape(event.raw)
         if '"' not in raw and "\\" not in raw:
             if isinstance(event, p.Velocity):

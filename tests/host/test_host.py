@@ -13,6 +13,7 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.state import HostState, LinkStatus
 from appmode.protocol.app import Attitude, ParamsRecord, Velocity
+from appmode.protocol.render import out_of_range
 from tests.support.processes import BoardProcess, board_process
 
 
@@ -118,7 +119,7 @@ def test_a_board_holding_values_out_of_range_is_read_and_shown() -> None:
         host.send(b"{C500:10000:20:-25:10:10:10:0:7}$")
         events = host.poll(0.5) + host.poll(0.1)
         [record] = [e for e in events if isinstance(e, ParamsRecord)]
-        assert record.out_of_range == ("position_ki", "system_mode")
+        assert out_of_range(record.values) == ("position_ki", "system_mode")
         assert host.state.params == record
 
 

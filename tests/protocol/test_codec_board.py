@@ -17,6 +17,7 @@ from appmode.protocol.app import (
     encode,
 )
 from appmode.protocol.app_decoders import BoardDecoder
+from appmode.protocol.render import out_of_range, to_json
 from tests.support.decoders import assert_any_bytes_ok, assert_split_invariant, decode_whole
 
 C_DEFAULT = b"{C500:10000:20:0:10:10:10:0:0}$"
@@ -36,7 +37,7 @@ def test_s3_3_c_record_nine_parameters() -> None:
     record = ParamsRecord(params.DEFAULTS)
     assert encode(record) == C_DEFAULT
     [decoded] = decode_whole(BoardDecoder, C_DEFAULT)
-    assert decoded == record and decoded.as_dict()["max_position"] == 10000
+    assert decoded == record and to_json(decoded)["max_position"] == 10000
 
 
 def test_s3_3_c_record_with_wrong_count_is_malformed() -> None:
@@ -52,7 +53,7 @@ def test_s3_3_c_record_out_of_range_is_read_and_flagged() -> None:
     ):
         [event] = decode_whole(BoardDecoder, raw)
         assert isinstance(event, ParamsRecord) and event.raw == raw
-        assert event.out_of_range == odd
+        assert out_of_range(event.values) == odd
 
 
 def test_s3_missing_dollar_is_tolerated() -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from appmode.protocol import params
+from appmode.protocol import param_values, params
 
 
 def test_s5_nine_parameters_in_index_order_with_ranges_and_defaults() -> None:
@@ -60,7 +60,7 @@ def test_s6_named_bits() -> None:
 
 
 def test_lookup_by_name_or_index() -> None:
-    assert params.lookup("max_speed").index == 0
-    assert params.lookup("8").name == "system_mode"
+    assert param_values.lookup(param_values.SHEET, "max_speed") == 0
+    assert param_values.lookup(param_values.SHEET, "8") == params.SYSTEM_MODE
     with pytest.raises(ValueError, match="unknown parameter 'speed'"):
-        params.lookup("speed")
+        param_values.lookup(param_values.SHEET, "speed")
