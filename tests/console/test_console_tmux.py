@@ -18,20 +18,26 @@ from appmode.protocol import params
 from tests.support.processes import ROOT, board_process, board_state, sent_lines, wait_for
 
 SESSION = "appmode-test"
-TMUX = ["tmux", "-L", f"appmode-tests-{os.getpid()}"]
+PREFIX = f"appmode-tests-{os.getpid()}"
+TMUX = ["tmux", "-L", f"{PREFIX}-0"]
 """A tmux server of this test process's own: the user's server and its environment, and
-another test run's, stay apart."""
+another test run's, stay apart. Each test gets a server of its own (tests/console/
+conftest.py names it `PREFIX-N`): a server exits with its last session, and a
+`new-session` that meets the previous test's server exiting fails ("server exited
+unexpectedly"); one kept up between tests instead left its panes' processes unreaped."""
 
 
 WATCHDOG = """\
-import os, subprocess, sys, time
+import glob, os, subprocess, sys, time
 while os.getppid() == int(sys.argv[1]):
     time.sleep(0.5)
-subprocess.run(sys.argv[2:] + ["kill-server"], capture_output=True)
+folder = os.path.join(os.environ.get("TMUX_TMPDIR", "/tmp"), f"tmux-{os.getuid()}")
+for socket in glob.glob(os.path.join(folder, sys.argv[2] + "-*")):
+    subprocess.run(["tmux", "-L", os.path.basename(socket), "kill-server"], capture_output=True)
 """
-"""`WATCHDOG PID TMUX…` ends the tmux server once its parent, process PID (the test
-process), has ended: then it is another's child (PID is given, as the test may end
-before the watchdog has started)."""
+"""`WATCHDOG PID PREFIX` ends the tmux servers named PREFIX-… once their parent, process
+PID (the test process), has ended: then it is another's child (PID is given, as the test
+may end before the watchdog has started)."""
 _watchdogs: list[subprocess.Popen[bytes]] = []
 
 
@@ -42,14 +48,16 @@ def tmux(*args: str) -> str:
         # its consoles would run on, retrying their port (a path the next pty reuses)
         _watchdogs.append(
             subprocess.Popen(
-                [sys.executable, "-c", WATCHDOG, str(os.getpid()), *TMUX],
+                [sys.executable, "-c", WATCHDOG, str(os.getpid()), PREFIX],
                 stdin=subprocess.DEVNULL,
                 stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL,
                 start_new_session=True,  # outlives a kill of this test's process group
             )
         )
-    return subprocess.run([*TMUX, *args], capture_output=True, text=True, check=True).stdout
+    done = subprocess.run([*TMUX, *args], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, f"tmux {args[0]}: {done.stderr.strip()}"
+    return done.stdout
 
 
 def appmode_in_tmux(args: str) -> str:
