@@ -41,7 +41,12 @@ def run_console(
     with create_pipe_input() as pipe:
 
         def typist() -> None:
-            time.sleep(0.5)
+            # as a person does: types once the console has read the parameters (on a
+            # loaded machine that took past the 0.5 s this waited, and a `set` was busy)
+            ready = time.monotonic() + 10
+            while "parameters read" not in session.messages and time.monotonic() < ready:
+                time.sleep(0.01)
+            time.sleep(0.1)
             for text, pause in keys:
                 typed_at.append(session.host.now())
                 pipe.send_text(text)
