@@ -16,6 +16,7 @@ from appmode.ports.sim import SimSerial
 from appmode.protocol import params
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.transcript import parse_transcript, read_transcript
+from appmode.transcript import runner
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, board_process, board_state, run
 
@@ -305,4 +306,22 @@ def test_a_recording_of_a_simulated_session_has_the_times_the_board_took_its_byt
     first = next(entry for entry in transcript.entries if entry.direction == "<")
     assert first.time < 0.012, "a record's time is its arrival, not its reading"
     result = run_virtual(transcript)
+    assert result.passed, result.failure
+
+
+def test_a_power_up_transcript_keeps_a_simulated_board_s_time_however_slow_the_host(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """`conform --board sim://` counted a power-up transcript's time from after the host's
+    first steps, not from the board's boot: a host 0.3 s slow to start (a loaded machine)
+    saw the board's records 0.3 s early, and failed them."""
+
+    class SlowHost(Host):
+        def __enter__(self) -> SlowHost:
+            time.sleep(0.3)
+            return self
+
+    monkeypatch.setattr(runner, "Host", SlowHost)
+    transcript = read_transcript(SUITE_DIR / "minibalance" / "s13_power_up.transcript")
+    result = run_live(transcript, "sim://?profile=minibalance")
     assert result.passed, result.failure
