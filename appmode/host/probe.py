@@ -282,6 +282,10 @@ def _probe(url: str, stop: threading.Event, progress: Progress) -> Finding:
         if len(heard) == 2 and not any(h.size for h in heard):
             break  # silent at the APP port's rate and at the control port's
     uart2 = next((h for h in heard if h.carries_uart2), None)  # at a rate of its own
+    if uart2 is not None and uart2.baud != UART2_BAUD:
+        # its bursts came at the control port's rate too, if fewer in a loaded moment: a
+        # link with no rate of its own (a pty), read at any; the control port's it is
+        uart2 = next((h for h in heard if h.baud == UART2_BAUD and h.uart2_bursts), uart2)
     if uart2 is not None:
         return _control_port(path, uart2, heard, fixed)
     return _no_board(url, heard, fixed)

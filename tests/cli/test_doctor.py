@@ -350,3 +350,22 @@ def test_a_balance_car_is_named_and_a_car_of_no_shipped_profile_is_told_how_to_w
         "(3 here)): write one for it, starting from appmode profile show balance --toml"
     )
     assert unknown["fix"].endswith(f"appmode drive {unknown_url} --profile mycar.toml")
+
+
+def test_bursts_heard_at_every_rate_are_the_control_port_s_at_its_own(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A pty has no rate: a control port on one is read clean at 9600 too. Its bursts at
+    115200 were fewer than ENOUGH in a loaded moment, and doctor said UART2 at 9600."""
+    bursts = {probe.APP_BAUD: 16, probe.UART2_BAUD: 2, 38400: 0}
+
+    def listen(
+        url: str, baud: int, seconds: float, stop: threading.Event
+    ) -> tuple[probe.Heard, serial.SerialBase]:
+        count = bursts.get(baud, 0)
+        heard = probe.Heard(baud, seconds, 3 * count, uart2_bytes=3 * count, uart2_bursts=count)
+        return heard, serial.serial_for_url("loop://")
+
+    monkeypatch.setattr(probe, "listen", listen)
+    finding = probe.probe("/dev/ttyUSB7", threading.Event(), lambda text: None)
+    assert finding.kind == "uart2" and finding.baud == probe.UART2_BAUD, finding
