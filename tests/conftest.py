@@ -29,11 +29,13 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     no load of this run's own (a starved board applies commands late, and the suite in
     real time holds it to ±0.3 s), and the browsers, whose heartbeats a burst of boards
     starves past the page's 0.25-s lease (a held direction then stops, as it must), are
-    done before it (they came last by name, beside it)."""
+    done before it (they came last by name, beside it). Within each, the long ones
+    (`slow`) first: a long test handed out last keeps the run going after the rest."""
     items.sort(
         key=lambda item: (
             item.get_closest_marker("alone") is not None,
             not item.nodeid.startswith("tests/web/"),
+            item.get_closest_marker("slow") is None,
         )
     )
 

@@ -80,6 +80,7 @@ def _dump_peak(path: Path, lines: int) -> int:
         tracemalloc.stop()
 
 
+@pytest.mark.slow  # 30,000 records under tracemalloc: 8–12 s
 def test_dump_streams_in_constant_memory(tmp_path: Path) -> None:
     """A dump holds no record it has written: for 30,000 records (a file of 750 kB) it
     holds less than the file's size, and under 1 MB (it held 290 kB here)."""
