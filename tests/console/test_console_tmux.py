@@ -107,7 +107,12 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
                     moving_after = time.monotonic() - pressed
                 time.sleep(0.03)
             released = time.monotonic()
-            assert moving_after is not None and moving_after < 0.3, moving_after
+            assert moving_after is not None and moving_after < 0.3, (
+                moving_after,
+                sent_lines(record)[:8],  # what the board took, and when it got the first A
+                next((line for line in record.read_text().splitlines() if " > A" in line), None),
+                screen(),
+            )
             wait_screen(r"in force\s+Z stop", timeout=2)
             stopped_after = time.monotonic() - released
             assert stopped_after < 0.5, stopped_after
