@@ -7,10 +7,20 @@ Every test runs with its own data folder: the console's history never touches th
 
 from __future__ import annotations
 
+import compileall
 import os
 from pathlib import Path
 
 import pytest
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The package's bytecode, brought up to date once before the run (by the controller,
+    not each worker): the suite starts appmode some 800 times, and where
+    PYTHONDONTWRITEBYTECODE is set (as on this machine's image) each start compiled every
+    module again, 0.12 s of its 0.4 s."""
+    if not hasattr(config, "workerinput"):
+        compileall.compile_dir(Path(__file__).parents[1] / "appmode", quiet=2)
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
