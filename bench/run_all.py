@@ -52,6 +52,8 @@ from common import (
 )
 
 from appmode.board.firmware import TICK, Board
+from appmode.protocol.transcript import read_transcript
+from appmode.transcript.runner import SUITE, collect, run_virtual
 
 TICKS = os.sysconf("SC_CLK_TCK")
 
@@ -489,6 +491,27 @@ def bench_conform_timing(sends: int) -> list[Row]:
     ]
 
 
+def bench_conform_virtual(runs: int) -> list[Row]:
+    """`appmode conform` with no board: the shipped suite on virtual time, in process."""
+    transcripts = [read_transcript(path) for path in collect([str(SUITE)])]
+    walls, virtual = [], 0.0
+    for _ in range(runs):
+        started = time.perf_counter()
+        results = [run_virtual(transcript) for transcript in transcripts]
+        walls.append(time.perf_counter() - started)
+        virtual = sum(result.seconds for result in results)
+    best = min(walls)
+    return [
+        Row(
+            f"conform on virtual time: the suite ({len(transcripts)} transcripts)",
+            f"{virtual:.0f} s of board time in {best:.2f} s (best of {runs}), "
+            f"median {statistics.median(walls):.2f} s",
+            "< 1 s",
+            best < 1,
+        )
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="shorter runs (about 2 min)")
@@ -519,6 +542,7 @@ def main() -> None:
             ],
         ),
         ("replay", lambda: bench_replay(1000 if quick else 10_000)),
+        ("conform virtual", lambda: bench_conform_virtual(3 if quick else 10)),
         ("conform timing", lambda: bench_conform_timing(200 if quick else 600)),
         ("minibalance", lambda: minibalance.rows(30 if quick else 100)),
         ("uart2", lambda: uart2.rows(quick)),

@@ -24,13 +24,11 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers for two cores. Most tests wait on boards, ptys and
-    processes in real time, so more workers than cores keep the cores busy (5 min 2 s of
-    CPU in a 5 min 17 s run). Four took 4 min 6 s to 5 min 17 s, but starved the page's
-    heartbeats on a clean CI run (the car stopped for a lapse over 0.25 s mid-hold, as it
-    must): three it stays."""
-    cores = os.cpu_count() or 1
-    return cores + cores // 2
+    """`-n auto`: two workers a core. Most tests wait on boards, ptys and processes in
+    real time: with the package's bytecode cached (pytest_configure) four used 1.2 cores
+    and ran the suite in 3 min 54 s idle here, three in 4 min 56 s. (Before the bytecode
+    was cached, four starved the page's heartbeats on a CI run: three it was.)"""
+    return 2 * (os.cpu_count() or 1)
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -46,12 +46,17 @@ def test_suite_passes_against_the_simulated_board(path: Path) -> None:
     assert result.passed, result.failure
 
 
-def test_whole_suite_runs_in_well_under_a_second() -> None:
+def test_the_whole_suite_runs_on_virtual_time_without_waiting() -> None:
+    """No board's time is waited for: the suite's wall time is a small fraction of the
+    time its boards live (157 s of board time in 0.34 s here; a run that waited would
+    take the 157 s). How fast it is belongs to bench/run_all.py ("conform virtual")."""
     done = run("conform", "transcripts/suite")
     assert done.returncode == 0, done.stdout
     assert done.stdout.count("PASS") == len(SUITE)
-    walls = [float(m) for m in re.findall(r"virtual time in ([\d.]+) s", done.stdout)]
-    assert len(walls) == len(SUITE) and sum(walls) < 1.0
+    timings = re.findall(r"([\d.]+) s of virtual time in ([\d.]+) s", done.stdout)
+    assert len(timings) == len(SUITE)
+    board_time, wall = (sum(float(t[k]) for t in timings) for k in (0, 1))
+    assert wall * 50 < board_time, f"{board_time:.1f} s of board time took {wall:.2f} s"
 
 
 @pytest.mark.parametrize("path", SUITE, ids=lambda p: p.name)
