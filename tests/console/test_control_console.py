@@ -57,7 +57,7 @@ def test_script_mode_drives_turns_and_sets_over_the_embedded_control_port(tmp_pa
     out = done.stdout
     assert "SIMULATED BOARD" in out and "sim://?port=uart2" in out
     assert re.search(r"control\s+UART2\s+drives", out) and "drive omni" in out
-    assert re.search(r"in force\s+forward", out)
+    assert re.search(r"in force\s+forward", out), (out, done.stderr)
     wheel_a = re.search(r"wheels\s+A (-?\d+)/(-?\d+)", out)
     assert wheel_a and int(wheel_a.group(1)) == 260 and int(wheel_a.group(2)) > 200, out
     assert "set max_speed = 800 (verified)" in out and "max_speed = 800" in out
