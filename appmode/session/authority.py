@@ -7,7 +7,9 @@ that nothing the view blocks on can keep the car moving:
 
 - a session whose ticks stop for STALL seconds while the car moves (a view blocked on a
   terminal, a pipe, a disk) gets its port's stop from here, and the session forgets the
-  motion at its next tick;
+  motion at its next tick. Only time the process ran counts: a gap between the guard's
+  own looks of over LATE (the whole process was not scheduled, on a loaded machine)
+  counts as LATE, so a session is judged on what it did while it could tick;
 - after an ending signal (`signals.ending_since`), a session still not closed within
   GRACE seconds gets its stop from here, and the process ends (status 130): a signal
   ends the session within a second, whatever is blocked.
@@ -30,6 +32,9 @@ GRACE = 0.8
 """Seconds after an ending signal before the guard stops the car and ends the process."""
 STEP = 0.02
 """Seconds between the guard's looks."""
+LATE = 0.1
+"""The most a gap between two of the guard's looks counts towards STALL: a longer one
+means the process was not running at all (the session could not tick either)."""
 
 
 class StopGuard:
@@ -64,13 +69,21 @@ class StopGuard:
         self._closed.set()
 
     def _run(self) -> None:
+        looked = seen = self._beat
+        stalled = 0.0  # the time the process ran since the last beat the guard saw (`seen`)
         while not self._closed.wait(STEP):
             now = time.monotonic()
             ending = signals.ending_since()
             if ending is not None and now - ending > GRACE:
                 self._end_process()
                 return
-            if not self.fired and now - self._beat > STALL and self._moving():
+            beat = self._beat  # one read: `beat` writes it from the session's thread
+            if beat != seen:
+                seen, stalled = beat, min(now - beat, LATE)
+            else:
+                stalled += min(now - looked, LATE)
+            looked = now
+            if not self.fired and stalled > STALL and self._moving():
                 # first: a tick that notes it before the stop is out errs on the safe side
                 # (the view shows stopped, the stop follows), never the other way round
                 self.fired = True

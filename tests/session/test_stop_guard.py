@@ -3,6 +3,9 @@ moves gets its stop from the guard's thread, on the board's own recording."""
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -88,3 +91,40 @@ def test_after_a_signal_not_acted_on_the_guard_stops_the_car_and_ends_the_proces
     assert ended and ended[0][1] == 130
     assert authority.GRACE <= ended[0][0] - signalled < 1.0 + 0.5  # a loaded machine's margin
     assert stops and stops[0] <= ended[0][0]
+
+
+TICKING = """
+import sys, time
+from appmode.session.authority import StopGuard
+guard = StopGuard(lambda: True, lambda: print("stop", flush=True))
+guard.start()
+print("ticking", flush=True)
+end = time.monotonic() + float(sys.argv[1])
+while time.monotonic() < end:
+    guard.beat()  # the session ticks every 10 ms, whenever it runs
+    time.sleep(0.01)
+guard.close()
+print("done", flush=True)
+"""
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGSTOP"), reason="needs SIGSTOP (POSIX)")
+def test_time_the_whole_process_was_not_running_does_not_count_as_a_stall() -> None:
+    """A loaded machine that does not schedule the process (here: SIGSTOP) stalls the
+    session and its guard alike: the guard judges the ticks over the time it ran, so
+    it does not stop a session that ticks whenever it runs."""
+    process = subprocess.Popen(
+        [sys.executable, "-c", TICKING, "2.5"], stdout=subprocess.PIPE, text=True
+    )
+    assert process.stdout is not None
+    try:
+        assert process.stdout.readline() == "ticking\n"
+        for _ in range(3):
+            time.sleep(0.3)
+            process.send_signal(signal.SIGSTOP)
+            time.sleep(STALL * 3)  # neither the session nor its guard runs
+            process.send_signal(signal.SIGCONT)
+        out, _ = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert out == "done\n"
