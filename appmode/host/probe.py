@@ -55,6 +55,8 @@ SAMPLE = 48
 """Bytes of text kept to show what a port that is not a board sent."""
 BURST = 0.3
 """Records closer than this fraction of the mean period came in a burst."""
+HELD = 2.0
+"""Records further apart than this many mean periods: one was held up on the way."""
 TEXT = 4096
 """Bytes of text kept for firmware identification (a start-up text is about 400)."""
 
@@ -89,12 +91,14 @@ class Heard:
 
     @property
     def steady(self) -> bool:
-        """No two records came much closer than the mean period (a burst of records held
-        up and delivered at once: the measured period is the host's, not the board's)."""
+        """No two records came much closer than the mean period, or much further apart (a
+        burst of records held up and delivered at once, or one held up: the measured
+        period is the host's, not the board's)."""
         times, period = self.record_times, self.period_ms
         if period is None:
             return False
-        return all(b - a >= BURST * period / 1000 for a, b in itertools.pairwise(times))
+        low, high = BURST * period / 1000, HELD * period / 1000
+        return all(low <= b - a <= high for a, b in itertools.pairwise(times))
 
     @property
     def records(self) -> int:
@@ -230,12 +234,14 @@ def listen(
     start = time.monotonic()
     try:
         while not stop.is_set():
-            starting = heard.text and heard.records < STARTED
-            if time.monotonic() - start >= (STARTING if starting else seconds):
-                break
+            # read, then look at the time: a process not scheduled for the whole time
+            # (a loaded machine) still reads what came meanwhile before it judges
             data = port.read(max(1, port.in_waiting))
             if data:
                 heard.feed(data, time.monotonic() - start, app_decoder, uart2_decoder)
+            starting = heard.text and heard.records < STARTED
+            if time.monotonic() - start >= (STARTING if starting else seconds):
+                break
     except BaseException:
         close_quietly(port)
         raise
