@@ -24,14 +24,12 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers for two cores. Most tests wait on boards, ptys and
-    processes in real time, so more workers than cores keep the cores busy: with the
-    package's bytecode cached (pytest_configure) three ran the suite in 4 min 56 s idle
-    here, four in 3 min 54 s — but four failed a clean CI run again (a script's drive no
-    longer in force 0.8 s on: its process starved past the stop guard's 0.25 s), as it
-    had starved the page's heartbeats before: three it stays."""
-    cores = os.cpu_count() or 1
-    return cores + cores // 2
+    """`-n auto`: two workers a core. Most tests wait on boards, ptys and processes in
+    real time, so more workers than cores keep the cores busy: with the package's
+    bytecode cached (pytest_configure) three ran the suite in 4 min 56 s idle here, four
+    in 3 min 54 s. Four had starved a script's session past the stop guard's 0.25 s;
+    the guard now counts only time the process ran (session/authority.py)."""
+    return 2 * (os.cpu_count() or 1)
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -130,11 +130,11 @@ def test_the_console_over_uart2_in_tmux_leaves_the_stop_frame_last(tmp_path: Pat
             while time.monotonic() - pressed < 1.0:  # held: keys repeat every 30 ms
                 tmux("send-keys", "-t", SESSION, "Up")
                 time.sleep(0.03)
-            actual = wait_screen(r"wheels\s+A 300/(\d+)")
-            assert int(actual.group(1)) > 200, screen()
+            # the wheels past 200 while it is held (a loaded machine shows it later)
+            wait_screen(r"wheels\s+A 300/(20[1-9]|2[1-9]\d|[3-9]\d\d)")
             wait_screen(r"in force\s+stopped", timeout=2)  # released: the zero frame
             tmux("send-keys", "-t", SESSION, "-l", "r")
-            wait_screen(r"rotated 90° in", timeout=8)
+            wait_screen(r"rotated 90° in", timeout=15)  # the board polled for its angle left
             tmux("send-keys", "-t", SESSION, ":")
             tmux("send-keys", "-t", SESSION, "set max_speed 800", "Enter")
             wait_screen(r"set max_speed = 800 \(verified\)")

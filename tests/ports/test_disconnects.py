@@ -107,7 +107,7 @@ def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path
             second.stop()
     text = "".join(said) + out
     assert "lost" in text and "link is down: not driving" in text and "is back" in text
-    assert "in force  C right" in text
+    assert "in force  C right" in text, text
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
     assert "C" in sent and sent[-1] == "Z" and "A" not in sent
 
