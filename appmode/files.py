@@ -12,7 +12,6 @@ from __future__ import annotations
 import errno
 import os
 import re
-import secrets
 import stat
 import sys
 import time
@@ -116,7 +115,7 @@ def remove_leftovers(path: str | os.PathLike[str]) -> None:
 
 def temporary_beside(target: Path) -> Path:
     """A new name for a temporary file beside `target`, of the LEFTOVER form."""
-    return target.with_name(f".{target.name}.{secrets.token_hex(4)}.appmode-tmp")
+    return target.with_name(f".{target.name}.{os.urandom(4).hex()}.appmode-tmp")
 
 
 def _write_in_place(target: Path, data: bytes, what: str) -> None:

@@ -13,9 +13,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-from appmode.board.firmware import Board
 from appmode.line.pacing import Line
+
+if TYPE_CHECKING:  # a host that names the ports imports no board
+    from appmode.board.firmware import Board
 
 Tap = Callable[[str, float, bytes], None]
 APP, UART2 = "app", "uart2"
