@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import compileall
 import os
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -23,13 +24,44 @@ def pytest_configure(config: pytest.Config) -> None:
         compileall.compile_dir(Path(__file__).parents[1] / "appmode", quiet=2)
 
 
+RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
+"""A file per run of this suite in progress on the machine (its controller's pid)."""
+
+
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: two workers a core. Most tests wait on boards, ptys and processes in
-    real time, so more workers than cores keep the cores busy: with the package's
-    bytecode cached (pytest_configure) three ran the suite in 4 min 56 s idle here, four
-    in 3 min 54 s. Four had starved a script's session past the stop guard's 0.25 s;
-    the guard now counts only time the process ran (session/authority.py)."""
-    return 2 * (os.cpu_count() or 1)
+    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
+
+    Most tests wait on boards, ptys and processes in real time, so more workers than
+    cores keep the cores busy: with the package's bytecode cached (pytest_configure),
+    four workers ran the suite in about 4 minutes idle on 2 cores, three in 5. But the
+    tests whose feature is timing (a stop within 0.3 s, a signal obeyed within a second,
+    a page's heartbeats) need the machine to keep time: two runs of four workers side
+    by side failed several, as `make -l` would have foreseen. So, as `make -l` does, a
+    run started beside another run of this suite (RUNS), or on a machine whose load
+    average is already a core's worth a core, takes one worker a core."""
+    cores = os.cpu_count() or 1
+    RUNS.mkdir(exist_ok=True)
+    mine = RUNS / str(os.getpid())
+    mine.touch()
+    config.add_cleanup(lambda: mine.unlink(missing_ok=True))
+    others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
+    return cores if others or load >= cores else 2 * cores
+
+
+def _running(pid: str) -> bool:
+    """Whether the run of that controller is still going (a file left by a killed run
+    is not)."""
+    if not pid.isdigit() or os.name != "posix":  # os.kill(pid, 0) tests a pid on POSIX only
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        (RUNS / pid).unlink(missing_ok=True)
+        return False
+    except OSError:  # another user's: running
+        return True
+    return True
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
