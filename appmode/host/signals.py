@@ -63,6 +63,14 @@ def ending_since() -> float | None:
     return _ending.since
 
 
+def left(budget: float) -> float:
+    """Seconds of a wait of `budget` at the end of a command: all of it, or after an
+    ending signal what is left of it counted from the signal (a loaded machine that
+    acts on the signal late does not make the end later still)."""
+    since = _ending.since
+    return budget if since is None else max(0.0, since + budget - time.monotonic())
+
+
 def _handle(signum: int, frame: object) -> None:
     if _ending.since is None:
         _ending.since = time.monotonic()

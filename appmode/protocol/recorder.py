@@ -22,7 +22,7 @@ from appmode.protocol.transcript import (
     UART2_DIRECTIONS,
     uart2_payload,
 )
-from appmode.writer import BoundedWriter, reason
+from appmode.writer import CLOSE_WAIT, BoundedWriter, reason
 
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
 HEADER_WAIT = 0.1
@@ -220,10 +220,11 @@ class Recorder:
             self._failed = True
             raise AppmodeError(f"cannot write transcript {self.name}: {reason(exc)}") from None
 
-    def close(self) -> None:
+    def close(self, wait: float = CLOSE_WAIT) -> None:
         """Write what the decoders still hold, and close the file (if it opened it),
-        waiting at most CLOSE_WAIT for its writer; AppmodeError if the recording is not
-        whole. After a failed write it only closes the file: that failure was reported."""
+        waiting at most `wait` seconds for its writer; AppmodeError if the recording is
+        not whole. After a failed write it only closes the file: that failure was
+        reported."""
         if self._closed:
             return
         self._closed = True
@@ -235,7 +236,7 @@ class Recorder:
             except AppmodeError as exc:
                 error = exc
         if isinstance(self._out, BoundedWriter):
-            if not self._out.close() and not failed_before:
+            if not self._out.close(wait) and not failed_before:
                 raise AppmodeError(f"cannot write transcript {self.name}: {self._out.failure}")
             return
         if self._closes:

@@ -15,12 +15,14 @@ from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 from appmode.errors import AppmodeError
 from appmode.files import new_recording, recordings_folder
+from appmode.host import signals
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.target import Target, as_target
 from appmode.protocol.recorder import Recorder
 from appmode.session.authority import STALL, StopGuard
 from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped
+from appmode.writer import CLOSE_WAIT
 
 if TYPE_CHECKING:
     from appmode.host.client import Host
@@ -362,7 +364,7 @@ class BaseSession(ABC):
         if recorder is None:
             return
         try:
-            recorder.close()
+            recorder.close(signals.left(CLOSE_WAIT))
         except AppmodeError as exc:
             self._recording_failed(str(exc))
 

@@ -3,6 +3,7 @@ moves gets its stop from the guard's thread, on the board's own recording."""
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -128,3 +129,29 @@ def test_time_the_whole_process_was_not_running_does_not_count_as_a_stall() -> N
     finally:
         process.kill()
     assert out == "done\n"
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+def test_the_wait_for_a_recording_s_reader_counts_from_the_ending_signal(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A recording to a FIFO nobody opened waits CLOSE_WAIT for a reader at the end;
+    after an ending signal, only what is left of it since the signal: a machine that
+    acted on the signal late (here 0.4 s) does not end later still."""
+    from appmode.host import signals
+    from appmode.writer import CLOSE_WAIT
+
+    fifo = tmp_path / "rec"
+    os.mkfifo(fifo)
+    session = Session("sim://", HoldToDrive(latched=True), record=str(fifo))
+    session.start()
+    monkeypatch.setattr(signals._ending, "since", time.monotonic() - 0.4)
+    closing = time.monotonic()
+    session.close()
+    took = time.monotonic() - closing
+    assert took < CLOSE_WAIT - 0.4 + 0.25, took  # 0.1 s left of it, and a margin
+    assert session.recording_failure is not None
+    assert "no program opened it to read" in session.recording_failure
+    assert signals.left(CLOSE_WAIT) == 0.0
+    monkeypatch.setattr(signals._ending, "since", None)
+    assert signals.left(CLOSE_WAIT) == CLOSE_WAIT
