@@ -75,13 +75,13 @@ def install() -> tuple[Outlet, Outlet] | None:
 
 def finish(outlets: tuple[Outlet, Outlet]) -> str | None:
     """Let the outlets write what they hold and put the streams back: waiting as a
-    plain stream would (a signal ends the wait), or at most until CLOSE_WAIT after an
-    ending signal; why output was lost, if it was (a reader that left, as `cat`, loses
+    plain stream would (a signal ends the wait), or at most CLOSE_WAIT after an ending
+    signal; why output was lost, if it was (a reader that left, as `cat`, loses
     nothing worth saying)."""
     writer = outlets[0].writer
     while writer.pending and writer.failure is None and signals.ending_since() is None:
         writer.drained(STEP)
-    writer.close(signals.left(CLOSE_WAIT))
+    writer.close(CLOSE_WAIT)
     sys.stdout, sys.stderr = sys.__stdout__, sys.__stderr__
     error = writer.error
     if writer.failure is None or (error is not None and error.errno == errno.EPIPE):

@@ -63,12 +63,18 @@ def ending_since() -> float | None:
     return _ending.since
 
 
+LAST_WAIT = 0.1
+"""Seconds a wait at the end of a command has at least, even when an ending signal's
+budget is spent: a reader that reads (a pipe, a FIFO with a reader) gets what is left."""
+
+
 def left(budget: float) -> float:
-    """Seconds of a wait of `budget` at the end of a command: all of it, or after an
-    ending signal what is left of it counted from the signal (a loaded machine that
-    acts on the signal late does not make the end later still)."""
+    """Seconds of a wait of `budget` for a reader at the end of a command: all of it, or
+    after an ending signal what is left of it counted from the signal, and LAST_WAIT at
+    least (a loaded machine that acts on the signal late does not make the end later
+    still by a whole budget)."""
     since = _ending.since
-    return budget if since is None else max(0.0, since + budget - time.monotonic())
+    return budget if since is None else max(LAST_WAIT, since + budget - time.monotonic())
 
 
 def _handle(signum: int, frame: object) -> None:

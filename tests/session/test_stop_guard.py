@@ -145,13 +145,13 @@ def test_the_wait_for_a_recording_s_reader_counts_from_the_ending_signal(
     os.mkfifo(fifo)
     session = Session("sim://", HoldToDrive(latched=True), record=str(fifo))
     session.start()
-    monkeypatch.setattr(signals._ending, "since", time.monotonic() - 0.4)
+    monkeypatch.setattr(signals._ending, "since", time.monotonic() - 0.45)
     closing = time.monotonic()
     session.close()
     took = time.monotonic() - closing
-    assert took < CLOSE_WAIT - 0.4 + 0.25, took  # 0.1 s left of it, and a margin
+    assert took < signals.LAST_WAIT + 0.25, took  # 0.05 s left of it: LAST_WAIT, and a margin
     assert session.recording_failure is not None
     assert "no program opened it to read" in session.recording_failure
-    assert signals.left(CLOSE_WAIT) == 0.0
+    assert signals.left(CLOSE_WAIT) == signals.LAST_WAIT
     monkeypatch.setattr(signals._ending, "since", None)
     assert signals.left(CLOSE_WAIT) == CLOSE_WAIT
