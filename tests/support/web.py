@@ -45,10 +45,15 @@ class WebProcess:
 
     def frames(self) -> list[str]:
         """What the board received on its control port, a frame a line (hex)."""
+        return [frame for _, frame in self.timed_frames()]
+
+    def timed_frames(self) -> list[tuple[float, str]]:
+        """The frames with the board's times of them (seconds)."""
         if not self.record.exists():
             return []
         lines = self.record.read_text().splitlines()
-        return [line.split(" ", 2)[2] for line in lines if " 2> " in line]
+        split = [line.split(" ", 2) for line in lines if " 2> " in line]
+        return [(float(when), frame) for when, _, frame in split]
 
     def stop(self, sig: int = signal.SIGTERM) -> tuple[int, str]:
         """Stop it (SIGTERM by default): its exit status and stderr."""

@@ -279,9 +279,10 @@ def test_a_stick_that_goes_quiet_stops_the_car_and_the_app_port_takes_none(
             await ready(socket, "settings read")
             await socket.send_json({"t": "stick", "x": 0.5, "y": 1})
             wait_frame(web, "FF FE 01 00 96 01 2C")  # x 150, y 300
-            pushed = time.monotonic()
             wait_frame(web, "FF FE 01 00 00 00 00 00 00 00", timeout=3)
-            stopped = time.monotonic() - pushed
+            timed = web.timed_frames()  # on the board's clock: when each frame came
+            pushed = max(t for t, frame in timed if frame.startswith("FF FE 01 00 96 01 2C"))
+            stopped = timed[-1][0] - pushed
             for bad in ({"x": 2, "y": 0}, {"x": True, "y": 0}, {"x": "1", "y": 0}, {}):
                 await socket.send_json({"t": "stick", **bad})
                 assert "−1…1" in await error(socket)
