@@ -29,8 +29,14 @@ def test_s13_a_set_whose_read_is_lost_during_a_c_record_is_still_verified() -> N
         sim = host.link
         assert isinstance(sim, SimSerial) and sim.board is not None
         board = sim.board
+        deadline = time.monotonic() + 10
+        before = board._c_on_wire_until
         host.send(b"{Q:P}")
         while not board._c_on_wire_until > sim._now():  # wait for the C to start going out
+            assert time.monotonic() < deadline, "no C record went out"
+            if board._c_on_wire_until != before:  # it went out between two looks (a host
+                before = board._c_on_wire_until  # not scheduled meanwhile): ask again
+                host.send(b"{Q:P}")
             host.poll(0.0005)
         values = host.set_param(0, 100)  # its {Q:P} arrives while that C is on the wire
         notes = [n.text for n in board.take_notes()]
