@@ -12,7 +12,7 @@ import pytest
 from appmode.testing.served import ServedBoard
 from tests.support.processes import run
 from tests.support.web import WebProcess, wait_sent, web_process
-from tests.web.test_server import page, ready
+from tests.web.test_server import beat_until_sent, page, ready
 
 SUITE = Path(__file__).resolve().parents[2] / "transcripts" / "suite"
 SOME = ("s2_2_read_params", "s2_2_q_separator", "s5_save")
@@ -27,11 +27,11 @@ def test_the_page_drives_the_car_over_the_module(tmp_path: Path, which: str) -> 
             socket = await page(session, web)
             await ready(socket)
             await socket.send_json({"t": "press", "key": "forward"})
-            wait_sent(web, "A")
+            await beat_until_sent(socket, web, "A")
             await socket.send_json({"t": "release"})
             wait_sent(web, "Z")
             await socket.send_json({"t": "press", "key": "left"})
-            wait_sent(web, "G")
+            await beat_until_sent(socket, web, "G")
             await socket.close()  # a closed page stops the car
             wait_sent(web, "Z")
 

@@ -19,7 +19,7 @@ import aiohttp
 import pytest
 
 from tests.support.web import WebProcess, wait_frame, wait_sent, web_process
-from tests.web.test_server import page, ready, status
+from tests.web.test_server import beat_until_sent, page, ready, status
 
 QUIET_STOP = 1.0
 """The lease is 0.25 s; the board's clock sees it within this on a loaded machine."""
@@ -78,7 +78,7 @@ def test_a_page_that_keeps_beating_keeps_a_latched_direction(tmp_path: Path) -> 
             await ready(socket)
             await socket.send_json({"t": "command", "line": "latch on"})
             await socket.send_json({"t": "press", "key": "forward"})
-            wait_sent(web, "A")
+            await beat_until_sent(socket, web, "A")
             for _ in range(15):
                 await socket.send_json({"t": "alive"})
                 await asyncio.sleep(0.1)
@@ -147,7 +147,7 @@ def test_a_recording_fifo_nobody_reads_never_holds_the_page_s_stop(tmp_path: Pat
             socket = await page(session, web)
             await ready(socket)
             await socket.send_json({"t": "press", "key": "forward"})
-            wait_sent(web, "A")
+            await beat_until_sent(socket, web, "A")
             await socket.send_json({"t": "release"})
             wait_sent(web, "Z", timeout=2)
             await socket.close()

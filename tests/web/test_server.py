@@ -69,6 +69,22 @@ async def ready(
         assert time.monotonic() < deadline, f"no {said!r} in {timeout:g} s: {shown['messages']}"
 
 
+async def beat_until_sent(
+    socket: aiohttp.ClientWebSocketResponse, web: WebProcess, wanted: str, timeout: float = 5.0
+) -> None:
+    """Wait until the board has received `wanted` last, beating meanwhile as a page does
+    (a page that went quiet for the 0.25-s lease while a loaded machine was slow to show
+    the board's recording would have had its car stopped, rightly)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        sent = web.sent()
+        if sent and sent[-1] == wanted:
+            return
+        await socket.send_json({"t": "alive"})
+        await asyncio.sleep(0.05)
+    raise AssertionError(f"the board's last unit is not {wanted!r}: {web.sent()[-8:]}")
+
+
 async def error(socket: aiohttp.ClientWebSocketResponse) -> str:
     while True:
         message = json.loads((await socket.receive(timeout=5)).data)
