@@ -36,15 +36,18 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     four workers ran the suite in about 4 minutes idle on 2 cores, three in 5. But the
     tests whose feature is timing (a stop within 0.3 s, a signal obeyed within a second,
     a page's heartbeats) need the machine to keep time: two runs of four workers side
-    by side failed several, as `make -l` would have foreseen. So, as `make -l` does, a
-    run started beside another run of this suite (RUNS), or on a machine whose load
-    average is already a core's worth a core, takes one worker a core."""
+    by side failed several. So, as `make -l` does, a run started beside another run of
+    this suite (RUNS), or on a machine whose load average is already a core's worth a
+    core, takes one worker a core."""
     cores = os.cpu_count() or 1
-    RUNS.mkdir(exist_ok=True)
     mine = RUNS / str(os.getpid())
-    mine.touch()
-    config.add_cleanup(lambda: mine.unlink(missing_ok=True))
-    others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
+    try:
+        RUNS.mkdir(exist_ok=True)
+        mine.touch()
+        config.add_cleanup(lambda: mine.unlink(missing_ok=True))
+        others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
+    except OSError:  # another user's folder: the load average alone tells
+        others = []
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
     return cores if others or load >= cores else 2 * cores
 
