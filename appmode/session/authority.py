@@ -23,6 +23,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 from appmode.host import signals
 
@@ -35,6 +36,31 @@ STEP = 0.02
 LATE = 0.1
 """The most a gap between two of the guard's looks counts towards STALL: a longer one
 means the process was not running at all (the session could not tick either)."""
+STARVED = 1.0
+"""Seconds without a tick, the car moving, after which the guard stops it even though
+the session's thread was only waiting for a CPU (a machine too busy to run it)."""
+TASKS = Path("/proc/self/task")
+"""Linux's view of this process's threads (elsewhere there is none: waits count)."""
+
+
+def thread_times(thread: int) -> tuple[float, float] | None:
+    """Seconds a thread of this process (its native id) has run, and has waited for a
+    CPU while it could run, where the system says (Linux's schedstat); else None."""
+    try:
+        ran, waited = (TASKS / str(thread) / "schedstat").read_bytes().split()[:2]
+        return int(ran) / 1e9, int(waited) / 1e9
+    except (OSError, ValueError):
+        return None
+
+
+def runnable(thread: int) -> bool:
+    """Whether a thread of this process is running or waiting for a CPU (Linux's state
+    R), rather than blocked; False where the system does not say."""
+    try:
+        fields = (TASKS / str(thread) / "stat").read_bytes().rsplit(b")", 1)[1].split()
+    except (OSError, IndexError):
+        return False
+    return fields[:1] == [b"R"]
 
 
 class StopGuard:
@@ -47,6 +73,8 @@ class StopGuard:
         """Sends the port's stop and nothing else (safe from this thread: the link's
         writes are serialised)."""
         self._beat = time.monotonic()
+        self._ticker = threading.get_native_id()
+        """The thread that ticks (the session's), whose waits for a CPU do not count."""
         self.fired = False
         """The guard sent (or is sending) a stop the session has not noted yet (`beat`)."""
         self._closed = threading.Event()
@@ -61,6 +89,7 @@ class StopGuard:
     def beat(self) -> bool:
         """The session ticks: whether the guard stopped the car since the last beat."""
         self._beat = time.monotonic()
+        self._ticker = threading.get_native_id()
         fired, self.fired = self.fired, False
         return fired
 
@@ -70,20 +99,31 @@ class StopGuard:
 
     def _run(self) -> None:
         looked = seen = self._beat
-        stalled = 0.0  # the time the process ran since the last beat the guard saw (`seen`)
+        ran = could = 0.0  # since the beat the guard saw: time the process ran; of it,
+        # time the session's thread did not wait for a CPU
+        times: tuple[int, tuple[float, float] | None] = (0, None)  # the ticker's, last look
         while not self._closed.wait(STEP):
             now = time.monotonic()
             ending = signals.ending_since()
             if ending is not None and now - ending > GRACE:
                 self._end_process()
                 return
-            beat = self._beat  # one read: `beat` writes it from the session's thread
+            beat, ticker = self._beat, self._ticker  # written by the session's thread
+            step, looked = min(now - looked, LATE), now
+            (was, then), times = times, (ticker, thread_times(ticker))
+            worked = queued = 0.0
+            if was == ticker and then is not None and times[1] is not None:
+                worked, queued = times[1][0] - then[0], times[1][1] - then[1]
             if beat != seen:
-                seen, stalled = beat, min(now - beat, LATE)
+                seen = beat
+                ran = could = min(now - beat, LATE)
             else:
-                stalled += min(now - looked, LATE)
-            looked = now
-            if not self.fired and stalled > STALL and self._moving():
+                ran += step
+                could = max(0.0, could + step - queued)  # a wait is told when it ends
+            if self.fired or (could <= STALL and ran <= STARVED):
+                continue
+            waiting = worked < step / 2 and runnable(ticker)  # a wait not yet told
+            if (ran > STARVED or not waiting) and self._moving():
                 # first: a tick that notes it before the stop is out errs on the safe side
                 # (the view shows stopped, the stop follows), never the other way round
                 self.fired = True

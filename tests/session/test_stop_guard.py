@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -14,7 +15,7 @@ import pytest
 
 from appmode.protocol.transcript import read_transcript
 from appmode.session.app_session import Session
-from appmode.session.authority import STALL, StopGuard
+from appmode.session.authority import STALL, STARVED, TASKS, StopGuard, runnable, thread_times
 from appmode.session.hold import HoldToDrive
 
 
@@ -129,6 +130,57 @@ def test_time_the_whole_process_was_not_running_does_not_count_as_a_stall() -> N
     finally:
         process.kill()
     assert out == "done\n"
+
+
+def test_time_the_session_s_thread_waited_for_a_cpu_counts_only_up_to_starved(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A busy machine that runs the guard but keeps the session's thread waiting for a
+    CPU (Linux's schedstat says so: found beside a second suite, a script's thread 0.45
+    s in the run queue of 0.48) does not make the guard stop a session that would tick;
+    it stops the car once the session has gone STARVED seconds without a tick."""
+    from appmode.session import authority
+
+    started = time.monotonic()
+    monkeypatch.setattr(authority, "thread_times", lambda _: (0.0, time.monotonic() - started))
+    monkeypatch.setattr(authority, "runnable", lambda _: True)
+    stops: list[float] = []
+    guard = StopGuard(lambda: True, lambda: stops.append(time.monotonic()))
+    guard.start()
+    try:
+        deadline = time.monotonic() + STARVED + 2
+        while not stops and time.monotonic() < deadline:
+            time.sleep(0.01)
+    finally:
+        guard.close()
+    assert stops, "a session starved for good is stopped"
+    assert STARVED <= stops[0] - started < STARVED + 1.0  # a loaded machine's margin
+
+
+@pytest.mark.skipif(not TASKS.is_dir(), reason="needs Linux's /proc/self/task")
+def test_the_threads_times_and_state_are_read_from_the_system() -> None:
+    me = threading.get_native_id()
+    first = thread_times(me)
+    end = time.thread_time() + 0.05
+    while time.thread_time() < end:  # work
+        pass
+    later = thread_times(me)
+    assert first is not None and later is not None
+    assert later[0] - first[0] >= 0.04 and later[1] >= first[1] >= 0.0
+    assert runnable(me)  # running, this very moment
+    sleeper_id: list[int] = []
+    wake = threading.Event()
+    sleeper = threading.Thread(
+        target=lambda: (sleeper_id.append(threading.get_native_id()), wake.wait(5))
+    )
+    sleeper.start()
+    try:
+        time.sleep(0.2)
+        assert not runnable(sleeper_id[0])  # blocked: its wait counts towards STALL
+    finally:
+        wake.set()
+        sleeper.join()
+    assert thread_times(sleeper_id[0]) is None  # a thread that ended has no times
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
