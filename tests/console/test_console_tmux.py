@@ -113,9 +113,16 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
                 next((line for line in record.read_text().splitlines() if " > A" in line), None),
                 screen(),
             )
-            wait_screen(r"in force\s+Z stop", timeout=2)
-            stopped_after = time.monotonic() - released
-            assert stopped_after < 0.5, stopped_after
+            wait_screen(r"in force\s+Z stop", timeout=2)  # the view shows it
+            lines = record.read_text().splitlines()
+            times = [
+                (float(when), payload)
+                for when, _, payload in (line.split(" ", 2) for line in lines if " > " in line)
+            ]
+            last_a = max(i for i, (_, payload) in enumerate(times) if payload == "A")
+            stop_at = board.clock_after + times[last_a + 1][0]  # on the board's recording
+            assert times[last_a + 1][1] == "Z", times
+            assert stop_at - released < 0.5, (stop_at - released, times)
             tmux("send-keys", "-t", SESSION, ":")
             tmux("send-keys", "-t", SESSION, "set max_speed 800", "Enter")
             wait_screen(r"max_speed = 800 \(verified\)")

@@ -55,6 +55,10 @@ class BoardProcess:
             cwd=ROOT,
         )
         self.url = self._read_port_line()
+        self.clock_after = time.monotonic()
+        """At or after the board's clock zero (it printed the port line after it): a time
+        of its recording, t, happened at or before `clock_after + t` on this machine's
+        monotonic clock."""
         self.uart2 = self._read_uart2_line()
         self.details: dict[str, str] = {}
         """With --bluetooth: the stand-in's `bus`, `ble` and `spp` lines; with

@@ -197,8 +197,8 @@ LIVE_GROUPS = {
     "letters diff-gyro": ("s4_letters_diff_gyro*",),
 }
 """The suite in real time, cut into groups of at most about 20 s of transcripts (the
-longest transcript is 18.4 s), each run in sequence against a board of its own (as `conform --board` runs a
-suite), all at once: they mostly wait."""
+longest transcript is 18.4 s), each run in sequence against a board of its own (as
+`conform --board` runs a suite), all at once: they mostly wait."""
 
 
 def _group(patterns: tuple[str, ...]) -> list[Path]:
