@@ -29,18 +29,18 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
+    """`-n auto`: three workers for two cores on an idle machine, one a core on a busy
+    one.
 
-    Most tests wait on boards, ptys and processes in real time (the run's processes used
-    about half of two cores), so more workers than cores keep the cores busy: with the
-    package's bytecode cached (pytest_configure) four ran the suite in 3 min 49 s to
-    4 min 2 s idle on 2 cores, three in 4 min 50 s to 5 min 5 s. (Four once failed a
-    clean CI run, with a held key's motion over UART2 — that test's race is fixed — and
-    the stop guard's false stops on a loaded machine, since fixed, failed three.) As
-    `make -l` does, a run started beside another run of this suite (RUNS), or on a
-    machine whose load average is already a core's worth a core, takes one worker a
-    core: two runs of four side by side failed several of the tests whose feature is
-    timing (a stop within 0.3 s, a signal obeyed within a second, a page's heartbeats)."""
+    Most tests wait on boards, ptys and processes in real time, so more workers than
+    cores keep the cores busy: with the package's bytecode cached (pytest_configure)
+    three ran the suite in about 5 minutes idle on 2 cores, four in about 4 — but four
+    failed a clean CI run (a held key's motion over UART2, a Bluetooth module's
+    parameter read), and two runs of four side by side failed several of the tests
+    whose feature is timing (a stop within 0.3 s, a signal obeyed within a second, a
+    page's heartbeats). So three, and, as `make -l` does, a run started beside another
+    run of this suite (RUNS), or on a machine whose load average is already a core's
+    worth a core, takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -51,7 +51,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     except OSError:  # another user's folder: the load average alone tells
         others = []
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
-    return cores if others or load >= cores else 2 * cores
+    return cores if others or load >= cores else cores + cores // 2
 
 
 def _running(pid: str) -> bool:
