@@ -180,7 +180,7 @@ def test_the_threads_times_and_state_are_read_from_the_system() -> None:
     finally:
         wake.set()
         sleeper.join()
-    assert thread_times(sleeper_id[0]) is None  # a thread that ended has no times
+    assert thread_times(-1) is None and not runnable(-1)  # no such thread
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -91,15 +92,19 @@ def test_plan_speed_and_loops() -> None:
 
 def test_replay_as_host_drives_a_board_and_ends_with_z(tmp_path: Path) -> None:
     board_log = tmp_path / "board.transcript"
+
+    def took() -> list[tuple[float, str]]:
+        lines = board_log.read_text().splitlines()[1:]
+        return [(float(t), p) for t, d, p in (line.split(" ", 2) for line in lines) if d == ">"]
+
     with board_process("--listen", "0", "--quiet", "--record", str(board_log)) as board:
         done = run("replay", str(session_file(tmp_path)), "--to", board.url)
+        # the replay's bytes are out when it ends; the board records them as it reads them
+        with contextlib.suppress(AssertionError):
+            wait_for(lambda: len(took()) >= 4, timeout=5)
     assert done.returncode == 0, done.stderr
     assert "replayed 3 commands" in done.stderr
-    sent = [
-        (float(t), p)
-        for t, d, p in (line.split(" ", 2) for line in board_log.read_text().splitlines()[1:])
-        if d == ">"
-    ]
+    sent = took()
     assert [p for _, p in sent] == ["J", "A", "Z", "Z"]
     gaps = [sent[1][0] - sent[0][0], sent[2][0] - sent[1][0]]
     assert gaps == [pytest.approx(0.2, abs=0.03), pytest.approx(0.4, abs=0.03)]
