@@ -359,7 +359,7 @@ def test_a_balance_car_is_named_and_a_car_of_no_shipped_profile_is_told_how_to_w
     ):
         status, (car, unknown), _ = doctor(balance.url, unknown_url := other.url)
     assert status == 0
-    assert car["profile"] == "balance"
+    assert car["profile"] == "balance", car
     assert car["params"]["balance_kp"] == 300 and car["params"]["velocity_ki"] == 0.4
     assert car["fix"] == f"drive it with: appmode drive {balance.url} --profile balance"
     assert unknown["kind"] == "app" and unknown["profile"] is None
