@@ -131,10 +131,12 @@ class Session(BaseSession):
                 self.say(event.text)
             elif isinstance(event, QueryFailed):
                 self.fail(event.text)
+        if self.watch():  # first: a stop the guard sent is not sent again
+            return True
         if self.driving.release_due(self.host.now()):
             self._send_letter(STOP_LETTER)
             return True
-        return self.watch() or bool(events)
+        return bool(events)
 
     # ------------------------------------------------------------ driving
 

@@ -5,6 +5,9 @@ at each tick (`BaseSession.watch`): a held key's repeats (`hold.HoldToDrive`), a
 heartbeats (`lease`). This guard watches the tick itself, from a thread of its own, so
 that nothing the view blocks on can keep the car moving:
 
+- a motion whose source went quiet by its own clock (a held key's repeats, a page's
+  heartbeats: `lapsed`) over LAPSE seconds ago gets its port's stop from here, whether or
+  not the session could tick to act on it (a session that ticks acts on it first);
 - a session whose ticks stop for STALL seconds while the car moves (a view blocked on a
   terminal, a pipe, a disk) gets its port's stop from here, and the session forgets the
   motion at its next tick. Only time the process ran counts: a gap between the guard's
@@ -39,6 +42,11 @@ means the process was not running at all (the session could not tick either)."""
 STARVED = 1.0
 """Seconds without a tick, the car moving, after which the guard stops it even though
 the session's thread was only waiting for a CPU (a machine too busy to run it)."""
+LAPSE = 0.1
+"""Seconds a motion's source may be past its own deadline before the guard stops it."""
+STALLED = (
+    f"over {STALL:g} s without a tick while driving (its view or script was blocked or waiting)"
+)
 TASKS = Path("/proc/self/task")
 """Linux's view of this process's threads (elsewhere there is none: waits count)."""
 
@@ -67,11 +75,22 @@ class StopGuard:
     """A thread that stops the car when the session's ticks stall (`beat` is each tick)
     or an ending signal is not acted on."""
 
-    def __init__(self, moving: Callable[[], bool], stop: Callable[[], None]) -> None:
+    def __init__(
+        self,
+        moving: Callable[[], bool],
+        stop: Callable[[], None],
+        lapsed: Callable[[], str | None] = lambda: None,
+    ) -> None:
         self._moving = moving
         self._stop = stop
         """Sends the port's stop and nothing else (safe from this thread: the link's
         writes are serialised)."""
+        self._lapsed = lapsed
+        """What to say when the motion's source is over LAPSE past its own deadline
+        ("": nothing, as for a key let go); None while it is alive."""
+        self.why = ""
+        """Why the guard last stopped the car, for people ("" when there is nothing to
+        say)."""
         self._beat = time.monotonic()
         self._ticker = threading.get_native_id()
         """The thread that ticks (the session's), whose waits for a CPU do not count."""
@@ -120,13 +139,18 @@ class StopGuard:
             else:
                 ran += step
                 could = max(0.0, could + step - queued)  # a wait is told when it ends
-            if self.fired or (could <= STALL and ran <= STARVED):
+            if self.fired:
                 continue
-            waiting = worked < step / 2 and runnable(ticker)  # a wait not yet told
-            if (ran > STARVED or not waiting) and self._moving():
+            why = self._lapsed()
+            if why is None and could <= STALL and ran <= STARVED:
+                continue
+            if why is None:
+                waiting = worked < step / 2 and runnable(ticker)  # a wait not yet told
+                why = STALLED if ran > STARVED or not waiting else None
+            if why is not None and self._moving():
                 # first: a tick that notes it before the stop is out errs on the safe side
                 # (the view shows stopped, the stop follows), never the other way round
-                self.fired = True
+                self.why, self.fired = why, True
                 self._send_stop()
 
     def _send_stop(self) -> None:

@@ -19,7 +19,7 @@ from appmode.host import signals
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.target import Target, as_target
 from appmode.protocol.recorder import Recorder
-from appmode.session.authority import STALL, StopGuard
+from appmode.session.authority import LAPSE, StopGuard
 from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped
 from appmode.writer import CLOSE_WAIT
@@ -173,7 +173,7 @@ class BaseSession(ABC):
         view's own ticks prove it alive (the console, a script)."""
         self._alive_at = 0.0
         self._quiet_said = False
-        self.guard = StopGuard(lambda: self.moving, self._guard_stop)
+        self.guard = StopGuard(lambda: self.moving, self._guard_stop, self._lapsed)
         """The stop authority's thread: stops the car when the ticks stall."""
 
     # ------------------------------------------------------------ what a session is
@@ -240,10 +240,8 @@ class BaseSession(ABC):
         of a stop the guard sent while the ticks stalled; whether the car was stopped."""
         if self.guard.beat():
             self._forget_motion()
-            self.say(
-                f"stopped: over {STALL:g} s without a tick while driving (its view or script "
-                "was blocked or waiting)"
-            )
+            if self.guard.why:
+                self.say(f"stopped: {self.guard.why}")
             return True
         if self.lease is None or not self.moving:
             return False
@@ -255,6 +253,17 @@ class BaseSession(ABC):
             self._quiet_said = True
             self.say(f"stopped: no heartbeat from the page for {quiet:.2f} s")
         return True
+
+    def _lapsed(self) -> str | None:
+        """For the stop guard (its thread): what to say when the motion's source is over
+        LAPSE past its own deadline — a held key's repeats ("": a key let go), a page's
+        heartbeats — though the session could not tick to act on it; else None."""
+        now, hold = self.now(), self.driving
+        if not hold.latched and hold.current is not None and now - hold.deadline > LAPSE:
+            return ""
+        if self.lease is not None and (quiet := now - self._alive_at) > self.lease + LAPSE:
+            return f"no heartbeat from the page for {quiet:.2f} s"
+        return None
 
     def steer(self, x: float, y: float) -> None:
         """An analog stick (x right, y forward, each −1…1), where the port takes one."""

@@ -180,10 +180,12 @@ class ControlSession(BaseSession):
                 elif isinstance(app_event, BoardWarning):
                     self.say(f"WARNING: {app_event.text}")
         self._follow_rotation()
+        if self.watch():  # first: a stop the guard sent is not sent again
+            return True
         if self.driving.release_due(self.now()):
             self.stop()
             return True
-        return self.watch() or bool(events)
+        return bool(events)
 
     def _done(self, outcome: ReadDone) -> None:
         values = outcome.values

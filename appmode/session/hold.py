@@ -33,8 +33,8 @@ class HoldToDrive:
         if letter == self.current:
             self.deadline = now + self.repeat_timeout
             return None
+        self.deadline = now + self.first_timeout  # first: the stop guard reads both
         self.current = letter
-        self.deadline = now + self.first_timeout
         return letter
 
     def release_due(self, now: float) -> bool:

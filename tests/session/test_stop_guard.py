@@ -15,7 +15,15 @@ import pytest
 
 from appmode.protocol.transcript import read_transcript
 from appmode.session.app_session import Session
-from appmode.session.authority import STALL, STARVED, TASKS, StopGuard, runnable, thread_times
+from appmode.session.authority import (
+    LAPSE,
+    STALL,
+    STARVED,
+    TASKS,
+    StopGuard,
+    runnable,
+    thread_times,
+)
 from appmode.session.hold import HoldToDrive
 
 
@@ -155,6 +163,51 @@ def test_time_the_session_s_thread_waited_for_a_cpu_counts_only_up_to_starved(
         guard.close()
     assert stops, "a session starved for good is stopped"
     assert STARVED <= stops[0] - started < STARVED + 1.0  # a loaded machine's margin
+
+
+def test_the_guard_acts_on_a_source_gone_quiet_even_while_the_session_ticks() -> None:
+    stops: list[float] = []
+    guard = StopGuard(lambda: True, lambda: stops.append(time.monotonic()), lambda: "quiet")
+    guard.start()
+    try:
+        deadline = time.monotonic() + 2
+        while not stops and time.monotonic() < deadline:
+            guard.beat()
+            time.sleep(0.01)
+    finally:
+        guard.close()
+    assert len(stops) == 1 and guard.why == "quiet"
+
+
+def test_a_key_let_go_stops_the_car_though_the_session_waits_for_a_cpu(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The guard does not count a session's wait for a CPU as a stall (up to STARVED),
+    but a held key's repeats that stopped coming end the motion by their own clock: a
+    session starved beside a second suite drove on 0.62 s after the key was let go."""
+    from appmode.session import authority
+
+    started = time.monotonic()
+    monkeypatch.setattr(authority, "thread_times", lambda _: (0.0, time.monotonic() - started))
+    monkeypatch.setattr(authority, "runnable", lambda _: True)
+    record = tmp_path / "s.transcript"
+    session = Session("sim://", HoldToDrive(first_timeout=0.3), record=str(record))
+    try:
+        session.start()
+        session.tick()
+        session.press("A")
+        session.tick()  # the last tick: the session "waits for a CPU" from here
+        time.sleep(STARVED + 0.5)
+        session.tick()
+        assert not session.moving
+        assert not any("without a tick" in m for m in session.messages)  # a key let go
+    finally:
+        session.close()
+    sent = [e for e in read_transcript(record).entries if e.direction == ">"]
+    drive = next(i for i, e in enumerate(sent) if e.data == b"A")
+    stops = [e.time - sent[drive].time for e in sent[drive + 1 :] if e.data == b"Z"]
+    assert len(stops) == 2, stops  # the guard's, and closing's: the tick sent no other
+    assert 0.3 + LAPSE <= stops[0] < STARVED - 0.1, stops  # by the key's clock, not STARVED
 
 
 @pytest.mark.skipif(not TASKS.is_dir(), reason="needs Linux's /proc/self/task")
