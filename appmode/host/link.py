@@ -116,11 +116,17 @@ class Link(Generic[E]):
             self.refusals += 1
             exc = OSError(self.refused)
         if self._proven:  # a reopened port that never showed the board: already said
-            self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); retrying"))
+            then = (
+                "a pty that is gone never comes back (its number may be another program's "
+                "terminal next): not reopened; start again on the board's new port"
+                if self.target.numbered_pty
+                else "retrying"
+            )
+            self._pending.append(LinkStatus(False, f"link to {self.url} lost ({exc}); {then}"))
         self._tell_all_sent()  # last: a recording that fails here cannot undo the above
 
     def _reconnect(self) -> None:
-        if self.now() - self._lost_at < RETRY:
+        if self.target.numbered_pty or self.now() - self._lost_at < RETRY:
             return
         self._lost_at = self.now()
         try:

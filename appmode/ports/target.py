@@ -4,6 +4,7 @@ What a `ble://` or `bt://` address says is read by its port when it opens."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from urllib.parse import urlsplit
 
@@ -16,6 +17,8 @@ from appmode.protocol import params
 SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt")
 NETWORK_SCHEMES = ("socket", "rfc2217")
 RADIO_SCHEMES = ("ble", "bt")
+NUMBERED_PTY = re.compile(r"/dev/(pts/\d+|ttys\d+)")
+"""A pseudo-terminal named by its number (Linux, macOS)."""
 URL_HELP = (
     "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
     "rfc2217://HOST:PORT, ble://ADDRESS, bt://ADDRESS, loop:// or sim://"
@@ -53,6 +56,12 @@ class Target:
     def radio(self) -> bool:
         """A Bluetooth module reached directly (ble://, bt://)."""
         return self.scheme in RADIO_SCHEMES
+
+    @property
+    def numbered_pty(self) -> bool:
+        """A pseudo-terminal named by its number (/dev/pts/N, /dev/ttysN): once it is gone
+        it never comes back, and the number may soon name another program's terminal."""
+        return NUMBERED_PTY.fullmatch(self.path) is not None
 
     @property
     def sim_port(self) -> str:

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import socket
 import time
 from pathlib import Path
 
 import pytest
+import serial
 
 from appmode.errors import AppmodeError
 from appmode.host.client import Host
@@ -169,6 +171,52 @@ def test_a_path_that_opens_again_without_a_board_is_not_back(tmp_path: Path) -> 
                 os.close(slave)
         finally:
             host.close()
+
+
+def test_a_numbered_pty_that_is_gone_is_never_opened_again() -> None:
+    """A pty's number names the next pty made once it is gone, another program's: a host
+    that opened /dev/pts/N again wrote its closing stops (`ZZ`, `{}KJZ`) into a test's
+    terminal (CI). A link (as `board --link` keeps) may be reopened; the number is not."""
+    import pty
+    import tty
+
+    from appmode.ports.target import parse_target
+    from appmode.ports.urls import open_link
+
+    assert parse_target("/dev/pts/4").numbered_pty and parse_target("/dev/ttys004").numbered_pty
+    assert not parse_target("/dev/ttyUSB0").numbered_pty
+    assert not parse_target("/tmp/car").numbered_pty
+    master, slave = pty.openpty()
+    tty.setraw(slave)
+    path = os.ttyname(slave)
+    opened: list[str] = []
+
+    def opener(url: str) -> serial.SerialBase:
+        opened.append(url)
+        return open_link(url)
+
+    host = Host(path, opener=opener)
+    try:
+        os.write(master, b"{A0:0:0:0}$")
+        assert any(isinstance(e, Velocity) for e in host.poll(1.0))
+        os.close(master)  # the board's end: the pty is gone
+        os.close(slave)
+        others = [pty.openpty() for _ in range(4)]  # new ptys: one likely takes its number
+        try:
+            statuses = [e for e in host.events(1.5) if isinstance(e, LinkStatus)]
+            assert statuses and not statuses[0].up and "not reopened" in statuses[0].text
+            assert opened == [path], "opened once, never again"
+            assert host.close() is None  # nothing sent: the link is down
+            for other_master, _ in others:
+                os.set_blocking(other_master, False)
+                with contextlib.suppress(BlockingIOError):
+                    assert os.read(other_master, 100) == b"", "nothing written to another pty"
+        finally:
+            for fds in others:
+                for fd in fds:
+                    os.close(fd)
+    finally:
+        host.close()
 
 
 def test_a_second_client_of_a_tcp_board_is_told_it_was_refused() -> None:
