@@ -237,7 +237,8 @@ class BaseSession(ABC):
 
     def watch(self) -> bool:
         """At each tick: end motion whose source has gone quiet (`lease`), and take note
-        of a stop the guard sent while the ticks stalled; whether the car was stopped."""
+        of a stop the guard sent (the ticks stalled, or the source went quiet while the
+        session could not tick); whether the car was stopped."""
         if self.guard.beat():
             self._forget_motion()
             if self.guard.why:
@@ -258,8 +259,9 @@ class BaseSession(ABC):
         """For the stop guard (its thread): what to say when the motion's source is over
         LAPSE past its own deadline — a held key's repeats ("": a key let go), a page's
         heartbeats — though the session could not tick to act on it; else None."""
-        now, hold = self.now(), self.driving
-        if not hold.latched and hold.current is not None and now - hold.deadline > LAPSE:
+        now = self.now()
+        late = self.driving.late(now)
+        if late is not None and late > LAPSE:
             return ""
         if self.lease is not None and (quiet := now - self._alive_at) > self.lease + LAPSE:
             return f"no heartbeat from the page for {quiet:.2f} s"

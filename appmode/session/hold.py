@@ -37,9 +37,17 @@ class HoldToDrive:
         self.current = letter
         return letter
 
+    def late(self, now: float) -> float | None:
+        """Seconds a held direction is past its deadline (below 0: not yet); None when
+        none is held, or it is latched."""
+        if self.latched or self.current is None:
+            return None
+        return now - self.deadline
+
     def release_due(self, now: float) -> bool:
         """True once, when a held direction has timed out and `Z` must be sent."""
-        if self.latched or self.current is None or now < self.deadline:
+        late = self.late(now)
+        if late is None or late < 0:
             return False
         self.current = None
         return True
