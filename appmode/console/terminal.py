@@ -115,17 +115,24 @@ class Console:
         session, keys = self.session, KeyBindings()
         driving = ~self.typing
 
-        def grid(r: int, c: int) -> None:
-            session.press(session.grid_key(r, c))
+        def press(what: str) -> object:
+            # a held key repeats some 30 times a second: a repeat that changes nothing
+            # shown is not drawn again (NotImplemented tells prompt_toolkit so), which
+            # keeps the console's CPU, and so its wait for one on a busy machine, low
+            shown = _shown(session)
+            session.press(what)
+            return NotImplemented if _shown(session) == shown else None
 
         for r, row in enumerate(KEY_GRID):
             for c, key in enumerate(row):
                 for name in (key, key.upper()):
-                    keys.add(name, filter=driving)(lambda e, r=r, c=c: grid(r, c))
+                    keys.add(name, filter=driving)(
+                        lambda e, r=r, c=c: press(session.grid_key(r, c))
+                    )
         for arrow, (r, c) in ARROWS.items():
-            keys.add(arrow, filter=driving)(lambda e, r=r, c=c: grid(r, c))
+            keys.add(arrow, filter=driving)(lambda e, r=r, c=c: press(session.grid_key(r, c)))
         for key, what in session.hold_keys.items():
-            keys.add(key, filter=driving)(lambda e, what=what: session.press(what))
+            keys.add(key, filter=driving)(lambda e, what=what: press(what))
         keys.add(" ", filter=driving)(lambda e: session.stop())
         for key, line in session.keys.items():
             keys.add(key, filter=driving)(lambda e, line=line: self._key_command(line))
@@ -267,7 +274,7 @@ class Console:
                     now = time.monotonic()
                     if now - checked >= REDRAW:  # redraw only when what is shown changed
                         checked = now
-                        text = status_text(session) + "\n".join(session.messages)
+                        text = _shown(session)
                         if text != shown:
                             shown = text
                             app.invalidate()
@@ -293,6 +300,11 @@ class Console:
 
         with signals.diverted(on_signal):
             await app.run_async(pre_run=start_ticker, handle_sigint=False)
+
+
+def _shown(session: BaseSession) -> str:
+    """What the panel and the messages show, as text (to tell whether to draw again)."""
+    return status_text(session) + "\n".join(session.messages)
 
 
 def _completer(session: BaseSession) -> NestedCompleter:

@@ -14,6 +14,7 @@ from prompt_toolkit.input import create_pipe_input
 from prompt_toolkit.output import DummyOutput
 
 from appmode.console.driving import run_drive
+from appmode.console.terminal import REDRAW
 from appmode.session.app_session import Session
 from appmode.session.hold import HoldToDrive
 
@@ -31,8 +32,23 @@ def sent(record: Path) -> list[tuple[float, str]]:
     return out
 
 
+class CountedOutput(DummyOutput):  # type: ignore[misc]
+    """An output that notes when each drawing of the screen ended (a flush)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.drawn: list[float] = []
+
+    def flush(self) -> None:
+        self.drawn.append(time.monotonic())
+
+
 def run_console(
-    tmp_path: Path, keys: list[tuple[str, float]], url: str = "sim://", **driving: Any
+    tmp_path: Path,
+    keys: list[tuple[str, float]],
+    url: str = "sim://",
+    output: DummyOutput | None = None,
+    **driving: Any,
 ) -> tuple[Session, Path, list[float]]:
     """Run the console with `keys` typed (text, pause after); returns when it has quit."""
     record = tmp_path / "app.transcript"
@@ -54,7 +70,7 @@ def run_console(
 
         thread = threading.Thread(target=typist, daemon=True)
         thread.start()
-        run_drive(session, True, [], io.StringIO(), pipe, DummyOutput())
+        run_drive(session, True, [], io.StringIO(), pipe, output or DummyOutput())
         thread.join(5)
     return session, record, typed_at
 
@@ -81,6 +97,23 @@ def test_holding_up_drives_and_letting_go_stops(
     release = z_after[0] - typed[24]
     assert 0.14 <= release <= 0.35, f"stopped {release:.3f} s after the last repeat"
     assert payloads[-1] == "Z"
+
+
+def test_a_held_key_s_repeats_do_not_draw_the_screen_again(
+    tmp_path: Path, quit_key: tuple[str, float]
+) -> None:
+    """A key held repeats some 33 times a second; only the press that drives redraws at
+    once, the repeats leave the panel to its 0.1-s check (a console that drew 33 times a
+    second used three times the CPU, and waited the longer for one on a busy machine)."""
+    output = CountedOutput()
+    hold = [(UP, 0.03)] * 30
+    session, _, typed = run_console(tmp_path, [*hold, ("", 0.5), quit_key], output=output)
+    offset = session.host.now() - time.monotonic()  # the session's clock from this one's
+    during = [t + offset for t in output.drawn if typed[0] + 0.05 < t + offset < typed[29]]
+    held = typed[29] - typed[0] - 0.05
+    # the panel's check (REDRAW, 0.1 s) while telemetry changes it, and no more
+    assert len(during) <= held / REDRAW + 2, (len(during), held)
+    assert session.driving.current is None  # it drove, and stopped when let go
 
 
 def test_a_single_tap_stops_after_the_first_timeout(

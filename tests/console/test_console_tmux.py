@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -90,39 +91,95 @@ def forward_speed() -> int:
     return int(wait_screen(r"velocity\s+x\s+-?\d+\s+y\s+(-?\d+)").group(1))
 
 
+class KeyTyper:
+    """Keys typed into SESSION by one tmux control-mode client (`tmux -C`): a key costs a
+    line on its stdin, not a new tmux process, so a held key's repeats keep their pace
+    on a busy machine."""
+
+    def __init__(self) -> None:
+        self.proc = subprocess.Popen(
+            [*TMUX, "-C", "attach-session", "-t", SESSION],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+
+    def hold(self, key: str, seconds: float, every: float = 0.03) -> list[float]:
+        """Type `key` every `every` s for `seconds`, as a held key repeats: when each was
+        typed."""
+        assert self.proc.stdin is not None
+        typed: list[float] = []
+        end = time.monotonic() + seconds
+        while not typed or typed[-1] < end:
+            self.proc.stdin.write(f"send-keys -t {SESSION} {key}\n")
+            self.proc.stdin.flush()
+            typed.append(time.monotonic())
+            time.sleep(every)
+        return typed
+
+    def close(self) -> None:
+        assert self.proc.stdin is not None
+        self.proc.stdin.close()
+        try:
+            self.proc.wait(5)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+
+
+def _sent_times(record: Path) -> list[tuple[float, str]]:
+    """(time on the board's clock, payload) of each unit the board took."""
+    units = (line.split(" ", 2) for line in record.read_text().splitlines() if " > " in line)
+    return [(float(when), payload) for when, _, payload in units]
+
+
 def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
     assert shutil.which("tmux"), "tmux is required (.ci/run installs it)"
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet") as board:
         command = appmode_in_tmux(f"drive {board.url}")
         tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+        typer = KeyTyper()
         try:
             wait_screen(r"REAL BOARD")
             wait_screen(r"params\s+max_speed 500")
-            pressed = time.monotonic()
-            moving_after = None
-            while time.monotonic() - pressed < 1.2:  # hold: keys repeat every 30 ms
-                tmux("send-keys", "-t", SESSION, "Up")
-                if moving_after is None and forward_speed() > 0:
-                    moving_after = time.monotonic() - pressed
-                time.sleep(0.03)
-            released = time.monotonic()
-            assert moving_after is not None and moving_after < 0.3, (
-                moving_after,
-                sent_lines(record)[:8],  # what the board took, and when it got the first A
-                next((line for line in record.read_text().splitlines() if " > A" in line), None),
-                screen(),
-            )
-            wait_screen(r"in force\s+Z stop", timeout=2)  # the view shows it
-            lines = record.read_text().splitlines()
-            times = [
-                (float(when), payload)
-                for when, _, payload in (line.split(" ", 2) for line in lines if " > " in line)
-            ]
-            last_a = max(i for i, (_, payload) in enumerate(times) if payload == "A")
-            stop_at = board.clock_after + times[last_a + 1][0]  # on the board's recording
-            assert times[last_a + 1][1] == "Z", times
-            assert stop_at - released < 0.5, (stop_at - released, times)
+            interrupted = []
+            for _ in range(3):
+                before = len(_sent_times(record))
+                pressed = time.monotonic()
+                with ThreadPoolExecutor(1) as pool:  # hold Up for 1.2 s, repeating
+                    holding = pool.submit(typer.hold, "Up", 1.2)
+                    moving_after = None
+                    while moving_after is None and not holding.done():
+                        if forward_speed() > 0:
+                            moving_after = time.monotonic() - pressed
+                        time.sleep(0.02)
+                    typed = holding.result()
+                released = typed[-1] + 0.03  # when the next repeat would have come
+                wait_screen(r"in force\s+Z stop", timeout=2)  # the view shows it
+                times = _sent_times(record)[before:]
+                if [payload for _, payload in times].count("A") > 1:
+                    # the console stopped the car mid-hold: the repeats came late (a busy
+                    # machine) and it must stop when they do; the next one is a new press,
+                    # which lasts longer (FIRST_TIMEOUT). The release is judged on a hold
+                    # the console saw whole: this one is typed again.
+                    interrupted.append(times)
+                    continue
+                assert moving_after is not None and moving_after < 0.3, (
+                    moving_after,
+                    times[:8],  # what the board took, and when it got the A
+                    screen(),
+                )
+                letters = [payload for _, payload in times]
+                stop = letters.index("A") + 1
+                assert letters[stop] == "Z", times
+                stop_at = board.clock_after + times[stop][0]  # on the board's recording
+                assert stop_at - released < 0.5, (stop_at - released, times)
+                break
+            else:
+                raise AssertionError(f"three holds in a row were stopped midway: {interrupted}")
+            typer.close()
             tmux("send-keys", "-t", SESSION, ":")
             tmux("send-keys", "-t", SESSION, "set max_speed 800", "Enter")
             wait_screen(r"max_speed = 800 \(verified\)")
@@ -133,6 +190,7 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
                 time.sleep(0.05)
             assert not _alive(), "Ctrl-C ends the console"
         finally:
+            typer.close()
             subprocess.run([*TMUX, "kill-session", "-t", SESSION], capture_output=True, check=False)
     sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
     assert "A" in sent and "{0:800}" in sent
