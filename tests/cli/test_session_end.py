@@ -11,6 +11,8 @@ import contextlib
 import signal
 import subprocess
 import time
+from concurrent.futures import ThreadPoolExecutor
+from functools import partial
 from pathlib import Path
 
 import pytest
@@ -193,16 +195,16 @@ def test_a_signal_in_the_middle_of_a_long_write_still_stops_the_car(
         assert board_state(board.url) == (STOPPED, DEFAULTS)
 
 
-def test_two_ending_signals_at_once_still_stop_the_car(tmp_path: Path) -> None:
-    """Issue 22.2: SIGTERM and SIGHUP together (as systemd sends them), the second while
-    the first unwinds: every session still ends with its stop."""
-    record = tmp_path / "board.transcript"
-    trials = 12
+def _signal_trials(tmp_path: Path, trials: range) -> list[str]:
+    """`send … J A wait:5` against a board of its own, then SIGTERM and SIGHUP, once for
+    each trial: what went wrong."""
+    record = tmp_path / f"board-{trials.start}.transcript"
+    wrong = []
     with board_process("--pty", "--record", str(record), "--quiet") as board:
-        for trial in range(trials):
+        for count, trial in enumerate(trials):
             proc = _start(["send", board.url, "J", "A", "wait:5"])
             try:
-                wait_for(lambda n=trial: sent_lines(record).count("A") > n)
+                wait_for(lambda n=count: sent_lines(record).count("A") > n)
                 proc.send_signal(signal.SIGTERM)
                 if trial % 2:
                     time.sleep(0.001 * trial)  # the second lands at different points
@@ -213,10 +215,27 @@ def test_two_ending_signals_at_once_still_stop_the_car(tmp_path: Path) -> None:
             # the board, busy beside other work, may read the host's last bytes after it exits
             with contextlib.suppress(AssertionError):
                 wait_for(lambda: sent_lines(record)[-1] == "Z", timeout=3.0)
-            assert sent_lines(record)[-1] == "Z", f"trial {trial}: the car was left moving"
-            assert proc.returncode == 130, f"trial {trial}: exit {proc.returncode}"
-        assert board_state(board.url) == (STOPPED, DEFAULTS)
-    assert sent_lines(record).count("Z") >= trials
+            if sent_lines(record)[-1] != "Z":
+                wrong.append(f"trial {trial}: the car was left moving")
+            if proc.returncode != 130:
+                wrong.append(f"trial {trial}: exit {proc.returncode}")
+        if board_state(board.url) != (STOPPED, DEFAULTS):
+            wrong.append(f"trials {trials}: the board is not still at its defaults")
+    if sent_lines(record).count("Z") < len(trials):
+        wrong.append(f"trials {trials}: fewer stops than sessions")
+    return wrong
+
+
+def test_two_ending_signals_at_once_still_stop_the_car(tmp_path: Path) -> None:
+    """Issue 22.2: SIGTERM and SIGHUP together (as systemd sends them), the second while
+    the first unwinds: every session still ends with its stop. Twelve, on three boards at
+    once (they mostly wait)."""
+    with ThreadPoolExecutor(3) as pool:
+        wrong = pool.map(
+            partial(_signal_trials, tmp_path), (range(0, 12, 3), range(1, 12, 3), range(2, 12, 3))
+        )
+        failures = [why for whys in wrong for why in whys]
+    assert not failures, failures
 
 
 def test_tap_stopped_during_a_burst_from_the_app_leaves_the_stop_last(tmp_path: Path) -> None:
