@@ -224,7 +224,6 @@ def test_sigterm_ends_the_console_with_z_last(tmp_path: Path) -> None:
     assert "A" in sent and sent[-1] == "Z"
 
 
-@pytest.mark.slow
 def test_sigterm_ends_script_mode_with_z_last(tmp_path: Path) -> None:
     record = tmp_path / "script.transcript"
     proc = subprocess.Popen(
