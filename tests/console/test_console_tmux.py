@@ -18,7 +18,14 @@ from pathlib import Path
 import pytest
 
 from appmode.protocol import params
-from tests.support.processes import ROOT, board_process, board_state, sent_lines, wait_for
+from tests.support.processes import (
+    ROOT,
+    board_process,
+    board_state,
+    sent_lines,
+    timed_sent,
+    wait_for,
+)
 
 SESSION = "appmode-test"
 PREFIX = f"appmode-tests-{os.getpid()}"
@@ -130,12 +137,6 @@ class KeyTyper:
             self.proc.wait()
 
 
-def _sent_times(record: Path) -> list[tuple[float, str]]:
-    """(time on the board's clock, payload) of each unit the board took."""
-    units = (line.split(" ", 2) for line in record.read_text().splitlines() if " > " in line)
-    return [(float(when), payload) for when, _, payload in units]
-
-
 def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
     assert shutil.which("tmux"), "tmux is required (.ci/run installs it)"
     record = tmp_path / "board.transcript"
@@ -148,7 +149,7 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
             wait_screen(r"params\s+max_speed 500")
             interrupted = []
             for _ in range(3):
-                before = len(_sent_times(record))
+                before = len(timed_sent(record))
                 pressed = time.monotonic()
                 with ThreadPoolExecutor(1) as pool:  # hold Up for 1.2 s, repeating
                     holding = pool.submit(typer.hold, "Up", 1.2)
@@ -160,7 +161,7 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
                     typed = holding.result()
                 released = typed[-1] + 0.03  # when the next repeat would have come
                 wait_screen(r"in force\s+Z stop", timeout=2)  # the view shows it
-                times = _sent_times(record)[before:]
+                times = timed_sent(record)[before:]
                 if [payload for _, payload in times].count("A") > 1:
                     # the console stopped the car mid-hold: the repeats came late (a busy
                     # machine) and it must stop when they do; the next one is a new press,

@@ -159,4 +159,10 @@ def board_state(url: str, seconds: float = 1.5) -> tuple[tuple[int, int, int], t
 
 def sent_lines(record: Path) -> list[str]:
     """The `>` payloads of a transcript, in order."""
-    return [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " > " in line]
+    return [payload for _, payload in timed_sent(record)]
+
+
+def timed_sent(record: Path) -> list[tuple[float, str]]:
+    """The `>` lines of a transcript: (its time, on the board's clock; the payload)."""
+    units = (line.split(" ", 2) for line in record.read_text().splitlines() if " > " in line)
+    return [(float(when), payload) for when, _, payload in units]
