@@ -8,9 +8,11 @@ Every test runs with its own data folder: the console's history never touches th
 from __future__ import annotations
 
 import compileall
+import contextlib
 import os
 import tempfile
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -76,19 +78,92 @@ def _cpu_times() -> list[int]:
         return [int(field) for field in stat.readline().split()[1:]]
 
 
-def _running(pid: str) -> bool:
-    """Whether the run of that controller is still going (a file left by a killed run
-    is not)."""
+def _running(pid: str, path: Path | None = None) -> bool:
+    """Whether the process of a file named by its pid (in RUNS unless `path`) is still
+    going (a file left by a killed run is not, and goes)."""
     if not pid.isdigit() or os.name != "posix":  # os.kill(pid, 0) tests a pid on POSIX only
         return False
     try:
         os.kill(int(pid), 0)
     except ProcessLookupError:
-        (RUNS / pid).unlink(missing_ok=True)
+        (path or RUNS / pid).unlink(missing_ok=True)
         return False
     except OSError:  # another user's: running
         return True
     return True
+
+
+ALONE = RUNS / "alone"
+"""A file per test marked `alone` running, or waiting to, in any run (its worker's pid);
+beside it, `alone.lock`, which such a test holds exclusively and the tests of runs side
+by side hold shared."""
+ALONE_WAIT = 300.0
+"""Seconds a test waits for the machine before it runs anyway."""
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
+    """A test marked `alone` has the machine to itself across runs of this suite side by
+    side: it waits until the tests running in the others end, and theirs wait until it
+    has. Beside another run, the suite in real time, its boards starved, applied
+    commands later than its ±0.3 s. Alone on the machine nothing waits."""
+    alone = item.get_closest_marker("alone") is not None
+    with _machine(alone) if alone or _other_runs() else contextlib.nullcontext():
+        yield
+
+
+@contextlib.contextmanager
+def _machine(alone: bool) -> Iterator[None]:
+    try:
+        import fcntl
+    except ImportError:  # Windows: no runs side by side are told apart
+        yield
+        return
+    mine = ALONE / str(os.getpid())
+    try:
+        ALONE.mkdir(parents=True, exist_ok=True)
+        lock = (RUNS / "alone.lock").open("a")
+    except OSError:  # another user's folder
+        yield
+        return
+    with lock:
+        if alone:
+            mine.touch()
+        else:  # a test marked alone, running or waiting to, goes first
+            _wait(lambda: not any(_running(path.name, path) for path in ALONE.iterdir()))
+        try:
+            kind = fcntl.LOCK_EX if alone else fcntl.LOCK_SH
+            _wait(lambda: _locked(lock.fileno(), kind | fcntl.LOCK_NB))
+            yield
+        finally:
+            mine.unlink(missing_ok=True)
+    # closing the file let the lock go
+
+
+def _locked(fd: int, how: int) -> bool:
+    import fcntl
+
+    try:
+        fcntl.flock(fd, how)
+    except BlockingIOError:
+        return False
+    return True
+
+
+def _wait(done: Callable[[], bool]) -> None:
+    end = time.monotonic() + ALONE_WAIT
+    while not done() and time.monotonic() < end:
+        time.sleep(0.05)
+
+
+def _other_runs() -> bool:
+    """Whether another run of this suite is going on the machine (a worker's run is its
+    controller's, its parent)."""
+    run = str(os.getppid() if os.environ.get("PYTEST_XDIST_WORKER") else os.getpid())
+    try:
+        return any(path.name != run and _running(path.name) for path in RUNS.iterdir())
+    except OSError:
+        return False
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

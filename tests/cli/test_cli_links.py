@@ -305,8 +305,11 @@ def test_a_car_still_moving_after_a_stop_is_said_loudly() -> None:
         obeyed_too_soon, ignored = pool.map(send, ["wait:0.5", "wait:1.5"])
     assert "WARNING" not in obeyed_too_soon.stderr  # a car needs time to stop
     assert ignored.stderr.count("WARNING") == 1
-    assert re.search(  # the first A record at or after 1 s (they come every 50 ms)
-        r"appmode: WARNING: the car still moves 1\.[01] s after it was told to stop",
+    # the first A record read at or after 1 s (they come every 50 ms), within the wait:
+    # read 1.2 s after on a machine running two suites, a record that came late
+    moves = re.search(
+        r"appmode: WARNING: the car still moves (\d+\.\d) s after it was told to stop",
         ignored.stderr,
     )
+    assert moves and 1.0 <= float(moves.group(1)) <= 1.5, ignored.stderr
     assert "x=0 y=300 z=0" in ignored.stderr and "another program or port" in ignored.stderr
