@@ -49,6 +49,7 @@ class BoundedWriter:
         self._held = 0  # bytes queued and not yet written
         self._closing = False
         self._opened = False  # the opener has returned
+        self._ran = threading.Event()  # the opener has returned or failed
         self._done = threading.Event()  # the thread has ended
         self._lock = threading.Condition()
         self._thread = threading.Thread(target=self._run, name=f"writer {name}", daemon=True)
@@ -72,6 +73,12 @@ class BoundedWriter:
     def pending(self) -> int:
         """Bytes queued and not yet written."""
         return self._held
+
+    def ran(self, wait: float) -> bool:
+        """Wait at most `wait` seconds for the writer's thread to have opened its file,
+        or failed to; whether it has (a thread not yet scheduled, on a busy machine, has
+        not)."""
+        return self._ran.wait(wait)
 
     def drained(self, wait: float = CLOSE_WAIT) -> bool:
         """Wait at most `wait` seconds for what is queued to be written; whether it was
@@ -111,8 +118,10 @@ class BoundedWriter:
             with self._lock:
                 self.error = exc
                 self._fail(reason(exc))
+            self._ran.set()
             self._done.set()
             return
+        self._ran.set()
         try:
             self._drain(fd)
         finally:

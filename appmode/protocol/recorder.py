@@ -26,8 +26,12 @@ from appmode.writer import CLOSE_WAIT, BoundedWriter, reason
 
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
 HEADER_WAIT = 0.1
-"""Seconds `Recorder.create` waits to see a file take its header (a file or device
-takes it at once; a full one fails then, and the caller is told)."""
+"""Seconds `Recorder.create` waits to see a file take its header once its writer's
+thread has run (a file or device takes it at once; a full one fails then, and the
+caller is told)."""
+THREAD_WAIT = 5.0
+"""Seconds `Recorder.create` waits for that thread to run at all: on a busy machine one
+not scheduled for 0.1 s had its empty file refused as if full."""
 HOLD = 0.5
 """Seconds a recorder waits for a unit to end before writing it as far as it goes (the
 lines after it wait too: the file stays in time order)."""
@@ -147,9 +151,11 @@ class Recorder:
             recorder = cls(BoundedWriter(lambda: fd, shown), origin, directives)
             writer = recorder._out
             assert isinstance(writer, BoundedWriter)
+            writer.ran(THREAD_WAIT)
             if not writer.drained(HEADER_WAIT):  # not even the header fits (a full disk)
+                why = writer.failure or f"its first line unwritten after {HEADER_WAIT:g} s"
                 writer.close(0.0)
-                raise AppmodeError(f"cannot write transcript {shown}: {writer.failure}")
+                raise AppmodeError(f"cannot write transcript {shown}: {why}")
         except AppmodeError:
             if new:  # leave nothing
                 with contextlib.suppress(OSError):

@@ -7,13 +7,17 @@ from __future__ import annotations
 import io
 import resource
 import signal
+import time
 import tracemalloc
 from pathlib import Path
 
 import pytest
 
+from appmode.errors import AppmodeError
+from appmode.protocol.recorder import Recorder
 from appmode.protocol.transcript import TranscriptError, parse_transcript, read_transcript
 from appmode.transcript.dump import run_dump
+from appmode.writer import BoundedWriter
 from tests.support.processes import run
 
 WHOLE = "# appmode transcript v1\n0.000 > J\n0.050 > A\n0.400 < {A0:1..500:0:0}$\n1.000 > Z\n"
@@ -64,6 +68,27 @@ def test_a_recording_on_a_disk_already_full_leaves_no_empty_file(tmp_path: Path)
     assert done.returncode == 2
     assert "cannot write transcript" in done.stderr
     assert not record.exists()
+
+
+def test_a_recording_s_writer_scheduled_late_is_no_full_disk(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A writer's thread that runs only 0.3 s after it was started (a busy machine) still
+    writes the recording's first line: its file was refused as full when the thread was
+    not scheduled within 0.1 s (a suite beside a second one). A full one still fails."""
+    run_at_once = BoundedWriter._run
+
+    def late(writer: BoundedWriter) -> None:
+        time.sleep(0.3)
+        run_at_once(writer)
+
+    monkeypatch.setattr(BoundedWriter, "_run", late)
+    path = tmp_path / "late.transcript"
+    recorder = Recorder.create(path)
+    recorder.close()
+    assert path.read_text().startswith("# appmode transcript v1\n")
+    with pytest.raises(AppmodeError, match="No space left on device"):
+        Recorder.create("/dev/full")
 
 
 def _dump_peak(path: Path, lines: int) -> int:
