@@ -94,9 +94,9 @@ def _running(pid: str, path: Path | None = None) -> bool:
 
 
 ALONE = RUNS / "alone"
-"""A file per test marked `alone` running, or waiting to, in any run (its worker's pid);
-beside it, `alone.lock`, which such a test holds exclusively and the tests of runs side
-by side hold shared."""
+"""Per run of the suite going beside another: `RUN.lock`, which its tests hold shared
+and a test marked `alone` of another run exclusively, and `RUN-PID.wants`, such a test
+(its worker's pid) running or waiting to."""
 ALONE_WAIT = 300.0
 """Seconds a test waits for the machine before it runs anyway."""
 
@@ -106,38 +106,55 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
     """A test marked `alone` has the machine to itself across runs of this suite side by
     side: it waits until the tests running in the others end, and theirs wait until it
     has. Beside another run, the suite in real time, its boards starved, applied
-    commands later than its ±0.3 s. Alone on the machine nothing waits."""
+    commands later than its ±0.3 s. In a run alone on the machine nothing waits (its
+    tests marked `alone` run beside each other, last)."""
+    others = _other_runs()
     alone = item.get_closest_marker("alone") is not None
-    with _machine(alone) if alone or _other_runs() else contextlib.nullcontext():
+    with _machine(alone, others) if others else contextlib.nullcontext():
         yield
 
 
 @contextlib.contextmanager
-def _machine(alone: bool) -> Iterator[None]:
+def _machine(alone: bool, others: list[str]) -> Iterator[None]:
     try:
         import fcntl
     except ImportError:  # Windows: no runs side by side are told apart
         yield
         return
-    mine = ALONE / str(os.getpid())
-    try:
-        ALONE.mkdir(parents=True, exist_ok=True)
-        lock = (RUNS / "alone.lock").open("a")
-    except OSError:  # another user's folder
-        yield
-        return
-    with lock:
-        if alone:
-            mine.touch()
-        else:  # a test marked alone, running or waiting to, goes first
-            _wait(lambda: not any(_running(path.name, path) for path in ALONE.iterdir()))
+    run = _run()
+    with contextlib.ExitStack() as held:
         try:
-            kind = fcntl.LOCK_EX if alone else fcntl.LOCK_SH
-            _wait(lambda: _locked(lock.fileno(), kind | fcntl.LOCK_NB))
-            yield
-        finally:
-            mine.unlink(missing_ok=True)
-    # closing the file let the lock go
+            ALONE.mkdir(parents=True, exist_ok=True)
+            if alone:
+                wants = ALONE / f"{run}-{os.getpid()}.wants"
+                wants.touch()
+                held.callback(wants.unlink, missing_ok=True)
+                locks = [held.enter_context((ALONE / f"{o}.lock").open("a")) for o in others]
+            else:
+                _wait(lambda: not _wanted(run))  # another run's test marked alone goes first
+                locks = [held.enter_context((ALONE / f"{run}.lock").open("a"))]
+        except OSError:  # another user's folder
+            locks = []
+        kind = fcntl.LOCK_EX if alone else fcntl.LOCK_SH
+        for lock in locks:
+            _wait(lambda lock=lock: _locked(lock.fileno(), kind | fcntl.LOCK_NB))
+        yield
+    # closing the files let the locks go
+
+
+def _wanted(run: str) -> bool:
+    """Whether a test marked alone of another run than `run` runs, or waits to."""
+    for path in ALONE.glob("*.wants"):
+        other, _, pid = path.stem.partition("-")
+        if other != run and _running(pid, path):
+            return True
+    return False
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """The run's lock file goes with it (its controller's)."""
+    if not hasattr(config, "workerinput"):
+        (ALONE / f"{os.getpid()}.lock").unlink(missing_ok=True)
 
 
 def _locked(fd: int, how: int) -> bool:
@@ -156,14 +173,18 @@ def _wait(done: Callable[[], bool]) -> None:
         time.sleep(0.05)
 
 
-def _other_runs() -> bool:
-    """Whether another run of this suite is going on the machine (a worker's run is its
-    controller's, its parent)."""
-    run = str(os.getppid() if os.environ.get("PYTEST_XDIST_WORKER") else os.getpid())
+def _run() -> str:
+    """This run's name in RUNS: its controller's pid (a worker's parent)."""
+    return str(os.getppid() if os.environ.get("PYTEST_XDIST_WORKER") else os.getpid())
+
+
+def _other_runs() -> list[str]:
+    """The other runs of this suite going on the machine."""
+    mine = _run()
     try:
-        return any(path.name != run and _running(path.name) for path in RUNS.iterdir())
+        return [path.name for path in RUNS.iterdir() if path.name != mine and _running(path.name)]
     except OSError:
-        return False
+        return []
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
