@@ -67,6 +67,7 @@ def silent_pty() -> Iterator[str]:
         os.close(slave)
 
 
+@pytest.mark.timing
 def test_a_minibalance_car_a_car_at_the_wrong_rate_and_a_silent_port_in_under_10_s() -> None:
     with (
         board_process("--pty", "--profile", "minibalance", "-q") as mini,

@@ -54,6 +54,7 @@ def test_a_recording_to_a_fifo_nobody_reads_never_holds_the_car(tmp_path: Path) 
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+@pytest.mark.timing
 def test_signals_end_a_session_recording_to_a_fifo_nobody_reads(tmp_path: Path) -> None:
     """The tester's SIGINT, SIGTERM and SIGHUP did nothing: the session was stuck in a
     write to the FIFO, inside a step no signal may cut."""
@@ -82,6 +83,7 @@ def test_signals_end_a_session_recording_to_a_fifo_nobody_reads(tmp_path: Path) 
     assert received(board_record)[-1][1] == "Z"
 
 
+@pytest.mark.timing
 def test_send_s_stop_never_waits_for_its_output(tmp_path: Path) -> None:
     """`send P J A wait:3` into a 4 KiB pipe nobody reads: the car drove on past the
     wait (the tester's `Z` came only with SIGINT)."""

@@ -80,6 +80,7 @@ def quit_key() -> Iterator[tuple[str, float]]:
     yield (CTRL_C, 0.0)
 
 
+@pytest.mark.timing
 def test_holding_up_drives_and_letting_go_stops(
     tmp_path: Path, quit_key: tuple[str, float]
 ) -> None:
@@ -116,6 +117,7 @@ def test_a_held_key_s_repeats_do_not_draw_the_screen_again(
     assert session.driving.current is None  # it drove, and stopped when let go
 
 
+@pytest.mark.timing
 def test_a_single_tap_stops_after_the_first_timeout(
     tmp_path: Path, quit_key: tuple[str, float]
 ) -> None:

@@ -137,6 +137,7 @@ class KeyTyper:
             self.proc.wait()
 
 
+@pytest.mark.timing
 def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
     assert shutil.which("tmux"), "tmux is required (.ci/run installs it)"
     record = tmp_path / "board.transcript"

@@ -7,6 +7,7 @@ import re
 import time
 from pathlib import Path
 
+import pytest
 from prompt_toolkit.utils import get_cwidth
 
 from appmode.console.panel import status_fragments
@@ -117,6 +118,7 @@ def test_the_app_console_says_when_its_letters_are_not_followed() -> None:
     assert not state.feed(still, 1.2)[1:]  # said once
 
 
+@pytest.mark.timing
 def test_the_console_over_uart2_in_tmux_leaves_the_stop_frame_last(tmp_path: Path) -> None:
     record = tmp_path / "board.transcript"
     with board_process("--pty", "--record", str(record), "--quiet", "--drive", "mecanum") as board:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import pytest
 from playwright.sync_api import Browser, CDPSession, Page
 
 from tests.support.processes import timed_sent
@@ -38,6 +39,7 @@ def touch(cdp: CDPSession, kind: str, fingers: dict[int, tuple[float, float]]) -
     cdp.send("Input.dispatchTouchEvent", {"type": kind, "touchPoints": points})
 
 
+@pytest.mark.timing
 def test_holding_a_cell_drives_and_lifting_the_finger_stops(
     browser: Browser, tmp_path: Path
 ) -> None:
