@@ -10,12 +10,17 @@ through the outbox. A view (the console) reads it all.
 
 from __future__ import annotations
 
+from collections import deque
+
 from appmode.host.control_query import ControlOutcome, ReadDone, ReadQuery
 from appmode.host.query import QueryFailed
 from appmode.host.state import LinkStats
 from appmode.protocol import app, control, control_decoders, params
 from appmode.protocol.params import DriveType
 
+OWED_FOR = 2.0
+"""Seconds a read sent is taken to be still owed a reply; after that it was lost (a
+board answers in milliseconds, a loaded host reads it within a second)."""
 TAKEOVER_BYTE = 10
 """The board follows the control port from this byte on (the sheet; §13's is the 11th)."""
 
@@ -46,6 +51,13 @@ class ControlState:
         self.query: ReadQuery | None = None
         self._outbox = bytearray()
         self._errors_at_start = 0
+        self._queries = 0  # queries started
+        self._owed: dict[int, deque[tuple[float, int]]] = {}
+        """Reads sent and not yet answered, by reply id: (when, the query's number). The
+        board answers them in order; a reply owed to an earlier query (a round of it
+        that ended at its time-out on a loaded host, its replies late) is not the
+        running one's: before, it answered the next query (`800` read after `defaults`
+        had made it 500)."""
 
     @property
     def app_mode(self) -> bool:
@@ -69,6 +81,9 @@ class ControlState:
         events = self.sent_decoder.feed(data)
         reread: list[Received] = []
         for event in events:
+            if isinstance(event, control.ReadFrame):
+                owed = self._owed.setdefault(event.read.reply_id, deque())
+                owed.append((now, self._queries))
             if isinstance(
                 event, (control.VelocityFrame, control.MotorFrame, control.PositionFrame)
             ):
@@ -111,11 +126,22 @@ class ControlState:
             self.stats.count_record(now)
             if isinstance(event, control.EncoderReport):
                 self.report, self.report_at = event, now
-            elif isinstance(event, control.Reply) and self.query is not None:
+            elif isinstance(event, control.Reply) and self._answers_this_query(event, now):
+                assert self.query is not None
                 outcome = self._step(*self.query.on_reply(event, now))
                 if outcome is not None:
                     out.append(outcome)
         return out
+
+    def _answers_this_query(self, reply: control.Reply, now: float) -> bool:
+        """Whether a reply answers a read of the running query (the oldest read of its
+        id still owed one; reads sent OWED_FOR ago were lost, and one lost costs the
+        next query at most a reply)."""
+        owed = self._owed.get(reply.id)
+        while owed and owed[0][0] < now - OWED_FOR:
+            owed.popleft()
+        answered = owed.popleft()[1] if owed else self._queries  # one not sent here
+        return self.query is not None and answered == self._queries
 
     # ------------------------------------------------------------ queries
 
@@ -123,6 +149,7 @@ class ControlState:
         """Begin a read or set; its bytes wait in the outbox."""
         self.query = query
         self._errors_at_start = self.stats.errors
+        self._queries += 1
         self._outbox += query.start(now)
 
     def tick(self, now: float) -> ControlOutcome | None:

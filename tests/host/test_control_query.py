@@ -7,7 +7,7 @@ import pytest
 from appmode.errors import AppmodeError
 from appmode.host.control_query import ReadDone, ReadQuery, rotation_done
 from appmode.host.control_state import ControlState
-from appmode.host.query import QueryFailed
+from appmode.host.query import AGREE, QueryFailed
 from appmode.protocol import control, control_decoders, settings
 
 
@@ -112,6 +112,39 @@ def test_the_state_follows_replies_reports_and_the_take_over() -> None:
     assert isinstance(state.in_force, control.VelocityFrame)
     state.sent(control.STOP, 0.03)
     assert state.in_force is None
+
+
+def test_a_late_reply_to_an_earlier_query_does_not_answer_the_next() -> None:
+    """A read's first round timed out on a loaded host and was sent again; the first
+    round's replies ended it, the second's came after: they are not the next read's
+    (which took them, and said 800 after `defaults` had made it 500). A reply lost to
+    noise costs the next read at most that reply."""
+    state = ControlState()
+    max_speed = settings.read_named("max_speed").reply_id
+
+    def replies(value: int) -> bytes:
+        return control.encode(control.Reply(max_speed, value)) * AGREE
+
+    state.start_query(ReadQuery(["max_speed"]), 0.0)
+    state.sent(state.take_outbox(), 0.0)
+    assert state.tick(0.15) is None  # no reply in time: the round again
+    state.sent(state.take_outbox(), 0.15)
+    assert ReadDone({"max_speed": 800}, "max_speed = 800") in state.feed(replies(800), 0.16)
+    state.start_query(ReadQuery(["max_speed"]), 0.2)  # the board was set to 500 meanwhile
+    state.sent(state.take_outbox(), 0.2)
+    assert not [e for e in state.feed(replies(800), 0.21) if isinstance(e, ReadDone)]
+    assert ReadDone({"max_speed": 500}, "max_speed = 500") in state.feed(replies(500), 0.22)
+    one = control.encode(control.Reply(max_speed, 500))
+    state.start_query(ReadQuery(["max_speed"]), 0.3)  # one of its replies is lost
+    state.sent(state.take_outbox(), 0.3)
+    assert not [e for e in state.feed(one, 0.31) if isinstance(e, ReadDone)]
+    assert state.tick(0.45) is None
+    state.sent(state.take_outbox(), 0.45)
+    assert ReadDone({"max_speed": 500}, "max_speed = 500") in state.feed(replies(500), 0.46)
+    state.start_query(ReadQuery(["max_speed"]), 0.5)  # the lost one costs it one reply
+    state.sent(state.take_outbox(), 0.5)
+    assert not [e for e in state.feed(replies(500), 0.51) if isinstance(e, ReadDone)]
+    assert ReadDone({"max_speed": 500}, "max_speed = 500") in state.feed(one, 0.52)
 
 
 def test_a_rotation_ends_at_zero_and_fails_past_its_timeout() -> None:
