@@ -95,8 +95,8 @@ def _running(pid: str, path: Path | None = None) -> bool:
 
 ALONE = RUNS / "alone"
 """Per run of the suite going beside another: `RUN.lock`, which its tests hold shared
-and a test marked `alone` of another run exclusively, and `RUN-PID.wants`, such a test
-(its worker's pid) running or waiting to."""
+and a test marked `alone` or `timing` of another run exclusively, and `RUN-PID.wants`,
+such a test (its worker's pid) running or waiting to."""
 ALONE_WAIT = 300.0
 """Seconds a test waits for the machine before it runs anyway."""
 
@@ -132,7 +132,7 @@ def _machine(alone: bool, others: list[str]) -> Iterator[None]:
                 held.callback(wants.unlink, missing_ok=True)
                 locks = [held.enter_context((ALONE / f"{o}.lock").open("a")) for o in others]
             else:
-                _wait(lambda: not _wanted(run))  # another run's test marked alone goes first
+                _wait(lambda: not _wanted(run))  # another run's such test goes first
                 locks = [held.enter_context((ALONE / f"{run}.lock").open("a"))]
         except OSError:  # another user's folder
             locks = []
@@ -144,7 +144,8 @@ def _machine(alone: bool, others: list[str]) -> Iterator[None]:
 
 
 def _wanted(run: str) -> bool:
-    """Whether a test marked alone of another run than `run` runs, or waits to."""
+    """Whether a test marked `alone` or `timing` of another run than `run` runs, or
+    waits to."""
     for path in ALONE.glob("*.wants"):
         other, _, pid = path.stem.partition("-")
         if other != run and _running(pid, path):

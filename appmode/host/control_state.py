@@ -83,6 +83,7 @@ class ControlState:
         for event in events:
             if isinstance(event, control.ReadFrame):
                 owed = self._owed.setdefault(event.read.reply_id, deque())
+                _expire(owed, now)  # a board that never answers: bounded all the same
                 owed.append((now, self._queries))
             if isinstance(
                 event, (control.VelocityFrame, control.MotorFrame, control.PositionFrame)
@@ -138,8 +139,8 @@ class ControlState:
         id still owed one; reads sent OWED_FOR ago were lost, and one lost costs the
         next query at most a reply)."""
         owed = self._owed.get(reply.id)
-        while owed and owed[0][0] < now - OWED_FOR:
-            owed.popleft()
+        if owed:
+            _expire(owed, now)
         answered = owed.popleft()[1] if owed else self._queries  # one not sent here
         return self.query is not None and answered == self._queries
 
@@ -180,3 +181,9 @@ class ControlState:
                 "the link is noisy)"
             )
         return outcome
+
+
+def _expire(owed: deque[tuple[float, int]], now: float) -> None:
+    """Forget the reads sent over OWED_FOR ago: their replies were lost."""
+    while owed and owed[0][0] < now - OWED_FOR:
+        owed.popleft()

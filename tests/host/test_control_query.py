@@ -6,7 +6,7 @@ import pytest
 
 from appmode.errors import AppmodeError
 from appmode.host.control_query import ReadDone, ReadQuery, rotation_done
-from appmode.host.control_state import ControlState
+from appmode.host.control_state import OWED_FOR, ControlState
 from appmode.host.query import AGREE, QueryFailed
 from appmode.protocol import control, control_decoders, settings
 
@@ -145,6 +145,17 @@ def test_a_late_reply_to_an_earlier_query_does_not_answer_the_next() -> None:
     state.sent(state.take_outbox(), 0.5)
     assert not [e for e in state.feed(replies(500), 0.51) if isinstance(e, ReadDone)]
     assert ReadDone({"max_speed": 500}, "max_speed = 500") in state.feed(one, 0.52)
+
+
+def test_reads_a_board_never_answers_are_not_kept_for_ever() -> None:
+    """The reference firmware answers no read (§13): what a host sent it over 2 s
+    (OWED_FOR) ago is forgotten, not kept for a whole session."""
+    state = ControlState()
+    read = control.encode(control.read("max_speed"))
+    for tick in range(1000):  # ten reads a second for 100 s, no reply
+        state.sent(read, tick / 10)
+    owed = state._owed[settings.read_named("max_speed").reply_id]
+    assert len(owed) <= OWED_FOR * 10 + 1, len(owed)
 
 
 def test_a_rotation_ends_at_zero_and_fails_past_its_timeout() -> None:
