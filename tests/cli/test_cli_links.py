@@ -17,8 +17,9 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+import serial
 
-from tests.support.processes import board_process, run, sent_lines
+from tests.support.processes import board_process, run, sent_lines, wait_for
 
 
 def test_done_when_params_set_save_survives_a_board_restart(tmp_path: Path) -> None:
@@ -207,8 +208,13 @@ def test_monitor_writes_nothing_to_the_port_unless_asked(
         extra = ["--stop-on-exit"] if stop_on_exit else []
         done = run("monitor", board.url, "--duration", "0.4", *extra)
         assert done.returncode == 0, done.stderr
+        # a read sent after it, once taken, is after whatever the monitor sent (a board
+        # stopped at once had not yet read the monitor's last stop on a busy machine)
+        with serial.serial_for_url(board.url, baudrate=9600) as port:
+            port.write(b"{Q:P}")
+            wait_for(lambda: sent_lines(record)[-1:] == ["{Q:P}"])
     assert " < {" in done.stdout
-    assert sent_lines(record) == (["Z"] if stop_on_exit else [])
+    assert sent_lines(record) == (["Z"] if stop_on_exit else []) + ["{Q:P}"]
 
 
 def test_monitor_count_counts_records_only() -> None:

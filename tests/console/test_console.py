@@ -5,16 +5,17 @@ from __future__ import annotations
 import io
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
+from unittest import mock
 
 import pytest
 from prompt_toolkit.input import create_pipe_input
 from prompt_toolkit.output import DummyOutput
 
 from appmode.console.driving import run_drive
-from appmode.console.terminal import REDRAW
+from appmode.console.terminal import REDRAW, Console
 from appmode.session.app_session import Session
 from appmode.session.hold import HoldToDrive
 
@@ -43,18 +44,35 @@ class CountedOutput(DummyOutput):  # type: ignore[misc]
         self.drawn.append(time.monotonic())
 
 
+Seen = Callable[[Console], bool]
+"""What a person waits to see after a key before the next (the menu open, say)."""
+
+
 def run_console(
     tmp_path: Path,
-    keys: list[tuple[str, float]],
+    keys: list[tuple[str, float]] | list[tuple[str, float, Seen | None]],
     url: str = "sim://",
     output: DummyOutput | None = None,
     **driving: Any,
 ) -> tuple[Session, Path, list[float]]:
-    """Run the console with `keys` typed (text, pause after); returns when it has quit."""
+    """Run the console with `keys` typed (text, pause after, and what to see before the
+    pause, if anything); returns when it has quit."""
     record = tmp_path / "app.transcript"
     session = Session(url, HoldToDrive(**driving), str(record))
     typed_at: list[float] = []
-    with create_pipe_input() as pipe:
+    consoles: list[Console] = []
+
+    class Watched(Console):
+        def __init__(self, *args: Any) -> None:
+            super().__init__(*args)
+            consoles.append(self)
+
+    def see(what: Seen | None) -> None:
+        ready = time.monotonic() + 10
+        while what is not None and not what(consoles[0]) and time.monotonic() < ready:
+            time.sleep(0.01)
+
+    with create_pipe_input() as pipe, mock.patch("appmode.console.driving.Console", Watched):
 
         def typist() -> None:
             # as a person does: types once the console has read the parameters (on a
@@ -63,9 +81,10 @@ def run_console(
             while "parameters read" not in session.messages and time.monotonic() < ready:
                 time.sleep(0.01)
             time.sleep(0.1)
-            for text, pause in keys:
+            for text, pause, *seen in keys:
                 typed_at.append(session.host.now())
                 pipe.send_text(text)
+                see(*seen or [None])
                 time.sleep(pause)
 
         thread = threading.Thread(target=typist, daemon=True)
@@ -210,8 +229,18 @@ TAB = "\t"
 def test_up_recalls_the_previous_command_not_a_completion(tmp_path: Path, typed: str) -> None:
     # typed a key at a time; then `:`, Tab (the menu of commands), ↑ and Enter: this used
     # to pick the menu's last entry, quit
-    keys = [(":", 0.1), *((c, 0.02) for c in typed), ("\r", 0.6), (":", 0.1), (TAB, 0.2)]
-    keys += [(UP, 0.2), ("\r", 0.6), (CTRL_C, 0.0)]
+    # (each key once its effect shows, as a person sees it: on a busy machine the menu
+    # came after ↑, the keys at fixed pauses)
+    def menu(console: Console) -> bool:
+        return console.command.complete_state is not None
+
+    def recalled(console: Console) -> bool:
+        return console.command.text == typed
+
+    keys: list[tuple[str, float, Seen | None]] = [(":", 0.1, None)]
+    keys += [(c, 0.02, None) for c in typed]
+    keys += [("\r", 0.6, None), (":", 0.1, None), (TAB, 0.2, menu), (UP, 0.2, recalled)]
+    keys += [("\r", 0.6, None), (CTRL_C, 0.0, None)]
     session, record, _ = run_console(tmp_path, keys)
     assert not session.host.connected
     lines = [p for _, p in sent(record)]
