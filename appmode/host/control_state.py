@@ -10,7 +10,7 @@ through the outbox. A view (the console) reads it all.
 
 from __future__ import annotations
 
-from collections import deque
+from collections import Counter, deque
 
 from appmode.host.control_query import ControlOutcome, ReadDone, ReadQuery
 from appmode.host.query import QueryFailed
@@ -52,12 +52,15 @@ class ControlState:
         self._outbox = bytearray()
         self._errors_at_start = 0
         self._queries = 0  # queries started
-        self._owed: dict[int, deque[tuple[float, int]]] = {}
-        """Reads sent and not yet answered, by reply id: (when, the query's number). The
-        board answers them in order; a reply owed to an earlier query (a round of it
-        that ended at its time-out on a loaded host, its replies late) is not the
-        running one's: before, it answered the next query (`800` read after `defaults`
-        had made it 500)."""
+        self._owed: deque[tuple[float, int, int]] = deque()
+        """Reads sent and not yet answered, in the order sent: (when, reply id, the
+        query's number). The board answers them in that order, so a reply answers the
+        oldest read of its id, and the reads sent before that one are lost (noise). A
+        reply owed to an earlier query (a round of it that ended at its time-out on a
+        loaded host, its replies late) is not the running one's: before, it answered
+        the next query (`800` read after `defaults` had made it 500)."""
+        self._owing: Counter[int] = Counter()
+        """How many reads in `_owed` each reply id has."""
 
     @property
     def app_mode(self) -> bool:
@@ -82,9 +85,9 @@ class ControlState:
         reread: list[Received] = []
         for event in events:
             if isinstance(event, control.ReadFrame):
-                owed = self._owed.setdefault(event.read.reply_id, deque())
-                _expire(owed, now)  # a board that never answers: bounded all the same
-                owed.append((now, self._queries))
+                self._expire(now)  # a board that never answers: bounded all the same
+                self._owed.append((now, event.read.reply_id, self._queries))
+                self._owing[event.read.reply_id] += 1
             if isinstance(
                 event, (control.VelocityFrame, control.MotorFrame, control.PositionFrame)
             ):
@@ -135,14 +138,27 @@ class ControlState:
         return out
 
     def _answers_this_query(self, reply: control.Reply, now: float) -> bool:
-        """Whether a reply answers a read of the running query (the oldest read of its
-        id still owed one; reads sent OWED_FOR ago were lost, and one lost costs the
-        next query at most a reply)."""
-        owed = self._owed.get(reply.id)
-        if owed:
-            _expire(owed, now)
-        answered = owed.popleft()[1] if owed else self._queries  # one not sent here
+        """Whether a reply answers a read of the running query: the oldest read of its
+        id still owed one (one not sent here is taken as the running query's). The
+        reads sent before that one were lost, whatever their id; reads sent OWED_FOR
+        ago too (a board that answers none). A reply lost to noise costs the next query
+        at most a reply, and only until a reply to a later read comes."""
+        self._expire(now)
+        answered = self._queries
+        if self._owing[reply.id]:
+            while True:
+                _, reply_id, query = self._owed.popleft()
+                self._owing[reply_id] -= 1
+                if reply_id == reply.id:
+                    answered = query
+                    break
         return self.query is not None and answered == self._queries
+
+    def _expire(self, now: float) -> None:
+        """Forget the reads sent over OWED_FOR ago: their replies were lost."""
+        while self._owed and self._owed[0][0] < now - OWED_FOR:
+            _, reply_id, _ = self._owed.popleft()
+            self._owing[reply_id] -= 1
 
     # ------------------------------------------------------------ queries
 
@@ -181,9 +197,3 @@ class ControlState:
                 "the link is noisy)"
             )
         return outcome
-
-
-def _expire(owed: deque[tuple[float, int]], now: float) -> None:
-    """Forget the reads sent over OWED_FOR ago: their replies were lost."""
-    while owed and owed[0][0] < now - OWED_FOR:
-        owed.popleft()
