@@ -320,7 +320,9 @@ def test_a_power_up_transcript_keeps_a_simulated_board_s_time_however_slow_the_h
 ) -> None:
     """`conform --board sim://` counted a power-up transcript's time from after the host's
     first steps, not from the board's boot: a host 0.3 s slow to start (a loaded machine)
-    saw the board's records 0.3 s early, and failed them."""
+    saw the board's records 0.3 s early, and failed them. (±50 ms, not the transcript's
+    ±10 ms, which a busy machine misses in real time: the battery reads from 1.9 s, and
+    0.3 s early is still its −740 % seen as 100.)"""
 
     class SlowHost(Host):
         def __enter__(self) -> SlowHost:
@@ -328,6 +330,7 @@ def test_a_power_up_transcript_keeps_a_simulated_board_s_time_however_slow_the_h
             return self
 
     monkeypatch.setattr(runner, "Host", SlowHost)
-    transcript = read_transcript(SUITE_DIR / "minibalance" / "s13_power_up.transcript")
+    text = (SUITE_DIR / "minibalance" / "s13_power_up.transcript").read_text()
+    transcript = parse_transcript(text.replace("@tolerance 0.01", "@tolerance 0.05"))
     result = run_live(transcript, "sim://?profile=minibalance")
     assert result.passed, result.failure
