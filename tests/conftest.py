@@ -94,49 +94,54 @@ def _running(pid: str, path: Path | None = None) -> bool:
 
 
 ALONE = RUNS / "alone"
-"""Per run of the suite going beside another: `RUN.lock`, which its tests hold shared
-and a test marked `alone` or `timing` of another run exclusively, and `RUN-PID.wants`,
-such a test (its worker's pid) running or waiting to."""
+"""Per run of the suite: `RUN.lock`, which its tests hold shared and a test that wants
+the machine exclusively, and `RUN-PID.wants` (beside other runs: a `timing` test) or
+`RUN-PID.alone` (an `alone` test), such a test (its worker's pid) running or waiting
+to."""
 ALONE_WAIT = 300.0
 """Seconds a test waits for the machine before it runs anyway."""
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
-    """A test marked `alone` or `timing` has the machine to itself across runs of this
-    suite side by side: it waits until the tests running in the others end, and theirs
-    wait until it has; its own run goes on beside it, the load its bounds were set for.
-    Beside another run, the suite in real time, its boards starved, applied commands
+    """A test marked `alone` (the suite in real time, run last) has the machine to
+    itself: it waits until the tests running in this run and in others beside it end,
+    and theirs wait until it has. One marked `timing` has it to itself across runs of
+    this suite side by side, its own run going on beside it (the load its bounds were
+    set for). In the real-time suite beside the run's last tests a board's encoder
+    report came 50 ms late (±25 ms); beside another run its boards applied commands
     later than its ±0.3 s, and a console let go of stopped the car 0.45 s after, not
-    within 0.35. In a run alone on the machine nothing waits."""
+    within 0.35."""
     others = _other_runs()
-    alone = any(item.get_closest_marker(name) for name in ("alone", "timing"))
-    with _machine(alone, others) if others else contextlib.nullcontext():
+    alone = item.get_closest_marker("alone") is not None
+    timing = item.get_closest_marker("timing") is not None and bool(others)
+    with _machine(alone, timing, others):
         yield
 
 
 @contextlib.contextmanager
-def _machine(alone: bool, others: list[str]) -> Iterator[None]:
+def _machine(alone: bool, timing: bool, others: list[str]) -> Iterator[None]:
     try:
         import fcntl
-    except ImportError:  # Windows: no runs side by side are told apart
+    except ImportError:  # Windows: tests are not kept apart
         yield
         return
     run = _run()
     with contextlib.ExitStack() as held:
         try:
             ALONE.mkdir(parents=True, exist_ok=True)
-            if alone:
-                wants = ALONE / f"{run}-{os.getpid()}.wants"
+            if alone or timing:
+                wants = ALONE / f"{run}-{os.getpid()}.{'alone' if alone else 'wants'}"
                 wants.touch()
                 held.callback(wants.unlink, missing_ok=True)
-                locks = [held.enter_context((ALONE / f"{o}.lock").open("a")) for o in others]
+                runs = [*others, run] if alone else others
+                locks = [held.enter_context((ALONE / f"{o}.lock").open("a")) for o in runs]
             else:
-                _wait(lambda: not _wanted(run))  # another run's such test goes first
+                _wait(lambda: not _wanted(run))  # such a test goes first
                 locks = [held.enter_context((ALONE / f"{run}.lock").open("a"))]
         except OSError:  # another user's folder
             locks = []
-        kind = fcntl.LOCK_EX if alone else fcntl.LOCK_SH
+        kind = fcntl.LOCK_EX if alone or timing else fcntl.LOCK_SH
         for lock in locks:
             _wait(lambda lock=lock: _locked(lock.fileno(), kind | fcntl.LOCK_NB))
         yield
@@ -144,11 +149,13 @@ def _machine(alone: bool, others: list[str]) -> Iterator[None]:
 
 
 def _wanted(run: str) -> bool:
-    """Whether a test marked `alone` or `timing` of another run than `run` runs, or
-    waits to."""
-    for path in ALONE.glob("*.wants"):
-        other, _, pid = path.stem.partition("-")
-        if other != run and _running(pid, path):
+    """Whether a test that wants the machine runs or waits to: an `alone` one of any
+    run, a `timing` one of another run than `run`."""
+    for path in ALONE.iterdir():
+        owner, _, pid = path.stem.partition("-")
+        mine = pid == str(os.getpid())
+        wants = path.suffix == ".alone" or (path.suffix == ".wants" and owner != run)
+        if wants and not mine and _running(pid, path):
             return True
     return False
 
@@ -191,12 +198,12 @@ def _other_runs() -> list[str]:
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """The page's tests in Chromium go first and tests marked `alone` last: pytest-xdist
-    hands the last out while the other workers are finishing, so a real-time run meets
-    no load of this run's own (a starved board applies commands late, and the suite in
-    real time holds it to ±0.3 s), and the browsers, whose heartbeats a burst of boards
-    starves past the page's 0.25-s lease (a held direction then stops, as it must), are
-    done before it (they came last by name, beside it). Within each, the long ones
-    (`slow`) first: a long test handed out last keeps the run going after the rest."""
+    hands the last out while the other workers are finishing, so the few tests that
+    wait while one runs (pytest_runtest_protocol) are the run's last, and the browsers,
+    whose heartbeats a burst of boards starves past the page's 0.25-s lease (a held
+    direction then stops, as it must), are done long before (they came last by name).
+    Within each, the long ones (`slow`) first: a long test handed out last keeps the
+    run going after the rest."""
     items.sort(
         key=lambda item: (
             item.get_closest_marker("alone") is not None,
