@@ -172,12 +172,13 @@ class BoardServer:
         with self.lock:
             one = self._served[index]
             old = one.wire
+            board = make(old.board, self.now())
             one.wire = Wire(
-                make(old.board, self.now()),
-                old.ports[APP].to_host.baud,
-                old.tap,
-                old.ports[UART2].to_host.baud,
+                board, old.ports[APP].to_host.baud, old.tap, old.ports[UART2].to_host.baud
             )
+            if self._recorder is not None:  # APP mode and the report are never saved
+                self._recorder.note(f"board {index} restarted (a power cycle)", self.now())
+                self._recorder.follow(int(board.params[SYSTEM_MODE]), self.now())
             one.changed()
             self._reschedule(index)
         self._wake()

@@ -14,6 +14,8 @@ from appmode.protocol.params import DriveType
 
 SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
 Event = app.Event | control.HostEvent | control.BoardEvent
+APP_EVENTS = app.Event
+"""The events of APP text: on UART2, what APP mode carries (§12)."""
 
 
 class PortsReader:

@@ -14,7 +14,7 @@ from typing import TextIO
 from appmode.errors import AppmodeError
 from appmode.files import is_fifo, open_fifo
 from appmode.protocol.escaping import escape
-from appmode.protocol.reader import Event, PortsReader
+from appmode.protocol.reader import APP_EVENTS, Event, PortsReader
 from appmode.protocol.transcript import (
     DIRECTIONS,
     HEADER,
@@ -108,7 +108,9 @@ class Recorder:
         self._origin = origin
         self._reader = PortsReader()
         self._held = {direction: _Held() for direction in DIRECTIONS}
-        self._queue: list[tuple[float, int, bytes, str]] = []  # lines not yet written
+        self._queue: list[tuple[float, int, bytes, str, bool]] = []
+        """Lines not yet written: time, order, bytes, direction, and whether a UART2 line
+        is APP text (§12) — as decoded, whatever the mode when it is written."""
         self._order = itertools.count()  # keeps lines of one time in the order they came
         self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
 
@@ -171,7 +173,7 @@ class Recorder:
     def note(self, text: str, time: float) -> None:
         """A comment line at `time`: what happened that no byte shows (the first comment
         of a transcript is its title)."""
-        self._queue.append((time, next(self._order), " ".join(text.split()).encode(), "#"))
+        self._queue.append((time, next(self._order), " ".join(text.split()).encode(), "#", False))
         self._release(time)
 
     def follow(self, system_mode: int, time: float) -> None:
@@ -183,7 +185,8 @@ class Recorder:
         for shown, event in events:
             when, raw = self._held[shown].take(len(event.raw))
             if raw:
-                self._queue.append((when, next(self._order), raw, shown))
+                text = isinstance(event, APP_EVENTS)
+                self._queue.append((when, next(self._order), raw, shown, text))
 
     def _release(self, now: float) -> None:
         """Write, in time order, the lines that no incomplete unit came before; a unit
@@ -194,23 +197,21 @@ class Recorder:
                 start = held.time_at(held.written)
                 if start <= now - HOLD:
                     when, raw = held.unshown()
-                    self._queue.append((when, next(self._order), raw, direction))
+                    text = self._reader.app_mode
+                    self._queue.append((when, next(self._order), raw, direction, text))
                 else:
                     first = min(first, start)
         self._queue.sort()
         ready = [line for line in self._queue if line[0] < first]
         del self._queue[: len(ready)]
-        for when, _, raw, direction in ready:
-            self._line(when, raw, direction)
+        for when, _, raw, direction, text in ready:
+            self._line(when, raw, direction, text)
 
-    def _line(self, time: float, raw: bytes, direction: str) -> None:
+    def _line(self, time: float, raw: bytes, direction: str, text: bool) -> None:
         if direction == "#":
             self._write(f"# {raw.decode()}\n")
             return
-        if direction in UART2_DIRECTIONS:
-            payload = uart2_payload(raw, self._reader.app_mode)
-        else:
-            payload = escape(raw)
+        payload = uart2_payload(raw, text) if direction in UART2_DIRECTIONS else escape(raw)
         self._write(f"{max(0.0, time - self._origin):.{TIME_DIGITS}f} {direction} {payload}\n")
 
     def _write(self, text: str) -> None:
