@@ -120,7 +120,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from appmode.console.driving import run_drive  # here: start-up stays short
     from appmode.console.script import command_lines
-    from appmode.session.base import MAX_COMMAND
+    from appmode.session.commands import MAX_COMMAND
     from appmode.session.hold import HoldToDrive
 
     interactive = sys.stdin.isatty() and sys.stdout.isatty()

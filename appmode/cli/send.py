@@ -134,7 +134,9 @@ def run_send(
         for note in host.notes:
             print(f"appmode: WARNING: {note}", file=sys.stderr)
         if stop is None:
-            print("appmode: the link is down: the final Z was not sent", file=sys.stderr)
+            from appmode.host.link import UNDELIVERED
+
+            print(f"appmode: {UNDELIVERED} (the link is down)", file=sys.stderr)
             return 1
         if not as_json:
             out.write(line(sent_at, ">", stop, stop_text) + "\n")

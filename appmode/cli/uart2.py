@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, TextIO
 from appmode.board.profiles import SHEET, Profile
 from appmode.cli.hostio import until_count, with_recording
 from appmode.host.control_client import ControlHost, Event
+from appmode.host.control_state import PortMode
 from appmode.host.control_tokens import Step, parse_setting, parse_token, perform
 from appmode.host.state import LinkStatus
 from appmode.host.tokens import Wait
@@ -54,11 +55,16 @@ def open_control_host(
 
 
 def show(
-    host: ControlHost, direction: str, event: reader.Event | LinkStatus, out: TextIO, as_json: bool
+    host: ControlHost,
+    direction: str,
+    event: reader.Event | LinkStatus | PortMode,
+    out: TextIO,
+    as_json: bool,
 ) -> None:
-    """One event: a line of text, or (what the board sent) a JSON line; link changes on
-    stderr. APP records show as such while APP mode (bit 7) moves them here (§12)."""
-    if isinstance(event, LinkStatus):
+    """One event: a line of text, or (what the board sent) a JSON line; link and mode
+    changes on stderr. APP records show as such while APP mode (bit 7) moves them here
+    (§12)."""
+    if isinstance(event, (LinkStatus, PortMode)):
         print(f"appmode: {event.text}", file=sys.stderr, flush=True)
         return
     if as_json and direction == host.sent:
@@ -153,7 +159,9 @@ def run_send(
             _drain(host.poll(0))
         _drain(host.events(listen))
         if host.close() is None:
-            print("appmode: the link is down: the final stop frame was not sent", file=sys.stderr)
+            from appmode.host.link import UNDELIVERED
+
+            print(f"appmode: {UNDELIVERED} (the link is down)", file=sys.stderr)
             return 1
     return 0
 

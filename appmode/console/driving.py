@@ -29,7 +29,8 @@ def run_drive(
     """Start the session, run the console (or script mode), and always close it: the
     stop last. Values set and not saved are named at the end. Script mode ends at the
     first error (every line with `keep_going`); its exit status is 1 if any line failed,
-    or (in either mode) if the recording stopped on its own."""
+    or (in either mode) if the recording stopped on its own or the final stop could not
+    be sent to a car last told to move."""
     try:
         session.start()
         if interactive:
@@ -56,5 +57,7 @@ def run_drive(
                     f"appmode: error: {session.recording_failure}; the recording stopped there",
                     file=sys.stderr,
                 )
+            if session.undelivered is not None:
+                print(f"appmode: {session.undelivered}", file=sys.stderr)
     failed = session.failures and not interactive
-    return 1 if failed or session.recording_failure is not None else 0
+    return 1 if failed or session.recording_failure is not None or session.left_moving else 0

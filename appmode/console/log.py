@@ -12,7 +12,7 @@ from prompt_toolkit.layout import Window
 from prompt_toolkit.layout.controls import BufferControl
 from prompt_toolkit.layout.dimension import Dimension
 
-from appmode.session.base import LOG
+from appmode.session.commands import LOG
 from appmode.session.status import WIDTH
 from appmode.text import wrapped
 

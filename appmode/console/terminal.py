@@ -39,7 +39,8 @@ from appmode.console.script import show
 from appmode.files import data_folder
 from appmode.host import signals
 from appmode.host.tokens import Wait
-from appmode.session.base import QUIT_WORDS, BaseSession, Quit, ShowHelp
+from appmode.session.base import BaseSession
+from appmode.session.commands import QUIT_WORDS, Quit, ShowHelp
 from appmode.session.status import WIDTH
 
 REFRESH = 0.02

@@ -24,24 +24,24 @@ from appmode.host.control_query import (
     ReadQuery,
     rotation_done,
 )
-from appmode.host.control_state import TAKEOVER_BYTE, ControlState
+from appmode.host.control_state import TAKEOVER_BYTE, ControlState, PortMode
 from appmode.host.link import Link, LinkLost, Opener
 from appmode.host.query import TRIES, QueryFailed
 from appmode.host.state import LinkStatus
 from appmode.line.wire import UART2_BAUD, Tap
 from appmode.ports.target import Target, as_target
 from appmode.ports.urls import open_link
-from appmode.protocol import control, params, reader, settings
+from appmode.protocol import app, control, params, reader, settings
 from appmode.protocol.params import DriveType
 
 READ_TIMEOUT = 0.1
 """Seconds to wait for a reply: the board answers in its next 10 ms tick (§11)."""
 
-Event = control.BoardEvent | ControlOutcome | LinkStatus
+Event = control.BoardEvent | ControlOutcome | PortMode | LinkStatus
 OPEN_UART2 = partial(open_link, baud=UART2_BAUD)
 
 
-class ControlHost(Link[control.BoardEvent | ControlOutcome]):
+class ControlHost(Link[control.BoardEvent | ControlOutcome | PortMode]):
     """A session with one board's control port."""
 
     sent = "2>"
@@ -71,7 +71,7 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
         self.state = ControlState(drive, takeover_byte)
         self._held: list[Event] = []
         self._put_back: control.SetSetting | None = None
-        self.watch: Callable[[str, reader.Event | LinkStatus], None] | None = None
+        self.watch: Callable[[str, reader.Event | LinkStatus | PortMode], None] | None = None
         """Called with each frame sent (`2>`) and each event received (`2<`) as it is
         decoded: a session printing as it goes."""
 
@@ -216,6 +216,19 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
         if op != "save":
             self.state.forget_drive()  # system_mode may have changed: read it when needed
 
+    def set_in_app_mode(self, name: str, value: int) -> None:
+        """Set system_mode while the port speaks APP text (§12): the APP frame `{8:…}`,
+        which a board in APP mode reads; AppmodeError for any other setting."""
+        if name != "system_mode":
+            raise AppmodeError(
+                "UART2 is in APP mode (system_mode bit 7): it takes APP letters and frames, "
+                "not settings frames; set system_mode without bit 7 first"
+            )
+        error = settings.value_error(settings.lookup(name), value)
+        if error is not None:
+            raise AppmodeError(error)
+        self.send(app.encode(app.SetParam(params.SYSTEM_MODE, value)))
+
     def set_mode_bit(self, name: str, on: bool) -> int:
         """Turn a system_mode bit (`encoder_report`, `app_mode`…) on or off, verified."""
         mode = self.read("system_mode")
@@ -279,12 +292,11 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
 
     @property
     def stop_bytes(self) -> bytes:
-        """What closing sends: the zero velocity frame, after zeros completing a frame
-        left open by raw bytes; in APP mode (§12) `Z`, after `{}` closing an open frame."""
-        sent = self.state.sent_decoder
-        if sent.app_mode:
-            return b"{}Z" if sent.buffered else b"Z"
-        return sent.rest() + control.STOP
+        """What stops the car whatever mode the port is in: zeros completing a frame left
+        open by raw bytes, then the zero velocity frame (in APP mode its last byte stops
+        the car too, §2.1); while APP mode may be on (§12), then `Z` (after `{}` closing
+        an APP frame left open)."""
+        return self._stop_with(control.STOP)
 
     def put_back_on_close(self, name: str, value: int) -> None:
         """Set `name` back to `value` when the session closes, just before its stop
@@ -294,5 +306,11 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome]):
     def _stop(self) -> bytes:
         if self._put_back is None or self.state.app_mode:
             return self.stop_bytes
+        return self._stop_with(control.encode(self._put_back) + control.STOP)
+
+    def _stop_with(self, frames: bytes) -> bytes:
         sent = self.state.sent_decoder
-        return sent.rest() + control.encode(self._put_back) + control.STOP
+        if not self.state.app_maybe:
+            return sent.rest() + frames
+        close = b"{}" if sent.app_mode and sent.buffered else b""
+        return sent.rest() + close + frames + app.encode(app.Stop())

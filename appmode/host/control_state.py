@@ -10,13 +10,16 @@ through the outbox. A view (the console) reads it all.
 
 from __future__ import annotations
 
+import re
 from collections import Counter, deque
+from dataclasses import dataclass
 
 from appmode.host.control_query import ControlOutcome, ReadDone, ReadQuery
 from appmode.host.query import QueryFailed
 from appmode.host.state import LinkStats
 from appmode.protocol import app, control, control_decoders, params
 from appmode.protocol.params import DriveType
+from appmode.protocol.session_end import SessionEnd
 
 OWED_FOR = 2.0
 """Seconds a read sent is taken to be still owed a reply; after that it was lost (a
@@ -24,8 +27,28 @@ board answers in milliseconds, a loaded host reads it within a second)."""
 TAKEOVER_BYTE = 10
 """The board follows the control port from this byte on (the sheet; §13's is the 11th)."""
 
+APP_QUIET = 1.0
+"""Seconds without an APP record on UART2, in APP mode, after which the board has left
+it (a reset, or system_mode set from the APP port: bit 7 is never saved, §12); the
+board streams one every 50–80 ms while it is on."""
+APP_RECORD = re.compile(rb"\{[ABC]-?\d+(?::-?\d+)*\}")
+"""An APP record whole in bytes that no binary reply or report holds: the board speaks
+APP text on UART2 (§12)."""
+APP_MODE_BIT = params.MODE_BIT["app_mode"]
+
 MOTION = (control.VelocityFrame, control.MotorFrame, control.PositionFrame)
-Received = control.BoardEvent | ControlOutcome
+
+
+@dataclass(frozen=True, slots=True)
+class PortMode:
+    """What the board's output showed of UART2's mode: APP text (`app`), or that it
+    stopped (the board left APP mode: read system_mode anew)."""
+
+    app: bool
+    text: str
+
+
+Received = control.BoardEvent | ControlOutcome | PortMode
 Sent = control.HostEvent | app.HostEvent
 
 
@@ -61,11 +84,25 @@ class ControlState:
         the next query (`800` read after `defaults` had made it 500)."""
         self._owing: Counter[int] = Counter()
         """How many reads in `_owed` each reply id has."""
+        self.app_end = SessionEnd()
+        """What was sent in APP mode (§12): the drive letter the board follows there."""
+        self.app_maybe = False
+        """APP mode may be on: this host set bit 7, or the board sent APP records here;
+        until a binary reply or report shows the port speaks frames. The stop then ends
+        with `Z` too (the zero frame alone stops an APP-mode port only outside a frame)."""
+        self._app_heard_at = 0.0
+        """When the last APP record came in APP mode (or APP mode began)."""
 
     @property
     def app_mode(self) -> bool:
-        """system_mode bit 7 as this host last set it: the port speaks the APP protocol."""
+        """system_mode bit 7 as this host last set it, or as the board's APP records on
+        UART2 show it: the port speaks the APP protocol (§12)."""
         return self.sent_decoder.app_mode
+
+    @property
+    def letter(self) -> str | None:
+        """The APP drive letter sent here in APP mode that the board still follows."""
+        return self.app_end.letter if self.app_end.moving else None
 
     # ------------------------------------------------------------ bytes
 
@@ -84,6 +121,10 @@ class ControlState:
         events = self.sent_decoder.feed(data)
         reread: list[Received] = []
         for event in events:
+            if isinstance(event, app.HostEvent):
+                self.app_end.sent(event.raw)
+            elif event.raw == control.STOP:  # its last byte stops an APP-mode port too
+                self.app_end.sent(app.encode(app.Stop()))
             if isinstance(event, control.ReadFrame):
                 self._expire(now)  # a board that never answers: bounded all the same
                 self._owed.append((now, event.read.reply_id, self._queries))
@@ -101,7 +142,12 @@ class ControlState:
         """A system_mode the host set: the drive type fixes frame lengths and the
         encoding of velocity, bit 7 moves the APP protocol onto this port (§12)."""
         self.learn_drive(mode)
-        on = bool(mode & params.MODE_BIT["app_mode"])
+        return self._switch(bool(mode & APP_MODE_BIT), now)
+
+    def _switch(self, on: bool, now: float) -> list[Received]:
+        """Decode both ways as APP text (`on`) or frames; what the board's decoder held."""
+        if on:
+            self.app_maybe, self._app_heard_at = True, now
         self.sent_decoder.set_app_mode(on)
         return self._apply(self.decoder.set_app_mode(on), now)
 
@@ -126,8 +172,17 @@ class ControlState:
             out.append(event)
             if isinstance(event, (*control.ERRORS, *app.ERRORS)):
                 self.stats.count_error(now, len(event.raw))
+                if not self.app_mode and APP_RECORD.search(event.raw):
+                    out += self._app_text_seen(now)
                 continue
             self.stats.count_record(now)
+            if isinstance(event, app.RECORDS):
+                self._app_heard_at = now
+                outcome = self._app_mode_set()
+                if outcome is not None:
+                    out.append(outcome)
+            elif isinstance(event, (control.Reply, control.EncoderReport)):
+                self.app_maybe = False  # the port speaks frames
             if isinstance(event, control.EncoderReport):
                 self.report, self.report_at = event, now
             elif isinstance(event, control.Reply) and self._answers_this_query(event, now):
@@ -136,6 +191,33 @@ class ControlState:
                 if outcome is not None:
                     out.append(outcome)
         return out
+
+    def _app_text_seen(self, now: float) -> list[Received]:
+        """The board sends APP records on UART2: APP mode is on (set from the APP port,
+        or before this session): decode both ways as APP text from now on."""
+        said = PortMode(
+            True,
+            "the board sends APP records on UART2: APP mode (system_mode bit 7) is on; "
+            "drive letters work here, frames do not",
+        )
+        return [said, *self._switch(True, now)]
+
+    def _app_mode_set(self) -> ControlOutcome | None:
+        """A set of system_mode that turns APP mode on is verified by the board's APP
+        records on UART2 (no binary read is answered in APP mode, §12)."""
+        query = self.query
+        frame = None if query is None else query.set_frame
+        if frame is None or control.system_mode_set(frame) is None:
+            return None
+        if not frame.value & APP_MODE_BIT:
+            return None
+        self.query = None
+        self.values["system_mode"] = frame.value
+        return ReadDone(
+            {"system_mode": frame.value},
+            f"set system_mode = {frame.value} (APP mode on: the board's APP records now "
+            "come on UART2; frames do not work until bit 7 is cleared with a {8:…} frame)",
+        )
 
     def _answers_this_query(self, reply: control.Reply, now: float) -> bool:
         """Whether a reply answers a read of the running query: the oldest read of its
@@ -169,8 +251,16 @@ class ControlState:
         self._queries += 1
         self._outbox += query.start(now)
 
-    def tick(self, now: float) -> ControlOutcome | None:
-        """Let time pass: a query may send its next round (into the outbox) or fail."""
+    def tick(self, now: float) -> ControlOutcome | PortMode | None:
+        """Let time pass: a query may send its next round (into the outbox) or fail; an
+        APP-mode port that fell silent has left APP mode."""
+        if self.app_mode and now - self._app_heard_at > APP_QUIET:
+            self._switch(False, now)
+            return PortMode(
+                False,
+                f"no APP record on UART2 for {APP_QUIET:g} s: the board left APP mode (a "
+                "reset, or system_mode set from the APP port); reading system_mode",
+            )
         if self.query is None:
             return None
         return self._step(*self.query.on_time(now))

@@ -36,6 +36,11 @@ R = TypeVar("R")
 L = TypeVar("L", bound="Link[Any]")
 
 
+UNDELIVERED = "the final stop was not delivered: the car may still be moving"
+"""Said when a session ends with its link down and the car last told to move: no host
+can stop it now (the firmware has no time-out)."""
+
+
 class LinkLost(AppmodeError):
     """The link is down; the host is trying to get it back."""
 

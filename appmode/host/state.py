@@ -136,7 +136,8 @@ class HostState:
         self.query: ParamQuery | None = None
         self._errors_at_start = 0
         self._outbox = bytearray()
-        self.end = session_end.SessionEnd()
+        self.end = session_end.SessionEnd(layout.profile.speed_keys, frames_stop)
+        """What the board was last sent: the letter it follows, the stop that ends it."""
         self.stopped_at: float | None = None
         """When the host last told the car to stop (Z or a page letter), while it has not
         told it to move since."""

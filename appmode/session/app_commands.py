@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from appmode.errors import AppmodeError
 from appmode.protocol import param_values, params
-from appmode.session.base import SPEED_COMPLETES, SPEED_STEP, CommandSpec
+from appmode.session.commands import SPEED_COMPLETES, SPEED_STEP, CommandSpec
 
 if TYPE_CHECKING:
     from appmode.session.app_session import Session

@@ -18,8 +18,6 @@ from appmode.host.state import BoardWarning, HostState, LinkStatus
 from appmode.host.tokens import Wait, parse_token
 from appmode.ports.target import Target
 from appmode.protocol import param_values, params
-from appmode.protocol.app import Move, Noise, Stop, SwitchPage
-from appmode.protocol.app_decoders import HostDecoder
 from appmode.protocol.directions import (
     PAGE_LETTERS,
     PAGE_NAMES,
@@ -31,13 +29,19 @@ from appmode.protocol.directions import (
 from appmode.protocol.layouts import VELOCITY, Layout, named
 from appmode.session import instruments
 from appmode.session.app_commands import COMMANDS
-from appmode.session.base import (
-    SPEED_KEYS,
-    BaseSession,
-)
+from appmode.session.base import BaseSession
+from appmode.session.commands import SPEED_KEYS
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments, Value
-from appmode.session.status import GLYPHS, Row, Span, hold_mode, link_rows, telemetry
+from appmode.session.status import (
+    GLYPHS,
+    Row,
+    Span,
+    hold_mode,
+    link_rows,
+    telemetry,
+    unsent_row,
+)
 
 KEYS_HELP = (
     "arrows, q w e / a s d / z x c drive · space stop · i j k page · l latch\n"
@@ -83,10 +87,6 @@ class Session(BaseSession):
             stop_again=stop_again or b"",
             frames_stop=frames_stop,
         )
-        self.page = Page.DIRECTION
-        self.page_letter = "J"
-        self.in_force = STOP_LETTER
-        self._sent = HostDecoder()
         self.baseline: tuple[int, ...] | None = None
         """The parameters as first read, or as last sent to flash: what a quit would keep."""
         self._open_recording(record)
@@ -105,7 +105,7 @@ class Session(BaseSession):
         the board's A records — and close everything."""
         self.guard.close()
         try:
-            self.host.close()
+            self._close_link(self.host)
         finally:
             self._drop_recorder()
             self.closing_notes += self.host.notes
@@ -121,8 +121,7 @@ class Session(BaseSession):
             if isinstance(event, LinkStatus):
                 self.say(event.text)
                 if not event.up:
-                    self.driving.stop()
-                    self.in_force = STOP_LETTER
+                    self.driving.stop()  # what the car was last told stays in force
             elif isinstance(event, BoardWarning):
                 self.say(f"WARNING: {event.text}")
             elif isinstance(event, QueryDone):
@@ -156,15 +155,27 @@ class Session(BaseSession):
         self._send_letter(STOP_LETTER)
 
     @property
+    def in_force(self) -> str:
+        """The drive letter the board was last sent and follows, or `Z`."""
+        return self.host.state.end.letter or STOP_LETTER
+
+    @property
+    def page_letter(self) -> str:
+        return self.host.state.end.page_letter
+
+    @property
+    def page(self) -> Page:
+        return PAGE_LETTERS[self.page_letter]
+
+    @property
     def moving(self) -> bool:
-        return self.in_force != STOP_LETTER
+        return self.host.state.end.moving
 
     def _guard_stop(self) -> None:
         self.host.send(self.host.state.end.stop)
 
     def _forget_motion(self) -> None:
         self.driving.stop()
-        self.in_force = STOP_LETTER
 
     def switch_page(self, letter: str) -> None:
         self.driving.stop()
@@ -175,24 +186,13 @@ class Session(BaseSession):
         self._send(self.host.state.end.stop if letter == STOP_LETTER else letter.encode())
 
     def _send(self, data: bytes) -> bool:
-        """Send, then follow what was sent: the page and the direction in force."""
+        """Send; the host follows what left (the page, the letter in force)."""
         try:
             self.host.send(data)
         except LinkLost as exc:
             self.say(str(exc))
             self.driving.stop()
             return False
-        for event in self._sent.feed(data):
-            if isinstance(event, Move):
-                self.in_force = event.letter
-            elif isinstance(event, SwitchPage):
-                self.page = PAGE_LETTERS[event.letter]
-                self.page_letter = event.letter
-                self.in_force = STOP_LETTER
-            elif isinstance(event, Stop) or (
-                isinstance(event, Noise) and event.raw.decode("latin-1") not in self._speed_keys
-            ):  # a firmware's own speed letter (`X`) changes the speed, not the motion
-                self.in_force = STOP_LETTER
         return True
 
     @property
@@ -228,6 +228,8 @@ class Session(BaseSession):
             ("", f"   {hold_mode(self.driving)}"),
         )
         rows.append(Row("page", page))
+        if moving and not host.connected:
+            rows.append(unsent_row())
         if state.letters_ignored:
             ignored: tuple[Span, ...] = (
                 ("warn", " the car does not follow the letters "),
@@ -267,6 +269,7 @@ class Session(BaseSession):
             telemetry=instruments.telemetry(state, now),
             in_force="stopped" if not self.moving else letter_name(self.page, self.in_force),
             moving=self.moving,
+            stop_unsent=self.moving and not host.connected,
             page=self.page_name,
             speed=self._speed_value(values),
             values=values,

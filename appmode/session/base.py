@@ -1,7 +1,7 @@
 """What every driving session shares, whatever port it drives: messages, recording,
-hold-to-drive, and the command line's common commands (help, latch, record, wait,
-status, quit). `session.Session` drives the APP port, `control_session.ControlSession`
-the control port.
+hold-to-drive, the stop authority and the command line (`commands`).
+`app_session.Session` drives the APP port, `control_session.ControlSession` the control
+port.
 """
 
 from __future__ import annotations
@@ -9,17 +9,23 @@ from __future__ import annotations
 import shlex
 from abc import ABC, abstractmethod
 from collections import deque
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from appmode.errors import AppmodeError
-from appmode.files import new_recording, recordings_folder
 from appmode.host import signals
-from appmode.host.tokens import Wait, parse_token
+from appmode.host.link import UNDELIVERED, Link
 from appmode.ports.target import Target, as_target
 from appmode.protocol.recorder import Recorder
 from appmode.session.authority import LAPSE, StopGuard
+from appmode.session.commands import (
+    COMMON,
+    COMMON_ALIASES,
+    LOG,
+    MAX_COMMAND,
+    CommandSpec,
+    Step,
+)
 from appmode.session.hold import HoldToDrive
 from appmode.text import wrapped
 from appmode.writer import CLOSE_WAIT
@@ -30,99 +36,6 @@ if TYPE_CHECKING:
     from appmode.host.state import HostState
     from appmode.session.instruments import Instruments
     from appmode.session.status import Row
-
-SPEED_STEP = 100
-SPEED_KEYS = {"+": f"speed +{SPEED_STEP}", "=": f"speed +{SPEED_STEP}", "-": f"speed -{SPEED_STEP}"}
-"""The keys that change the speed, as command lines."""
-SPEED_COMPLETES = {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None}
-LOG = 500
-"""Messages kept for scrolling back."""
-QUIT_WORDS = ("quit", "exit", "q")
-MAX_COMMAND = 1000
-"""Characters a command line may have (splitting one into words takes time that grows
-as the square of its length: a megabyte pasted or piped in would hang the session)."""
-ON_OFF = {"on": None, "off": None}
-
-
-class Quit(Exception):
-    """The user asked to leave."""
-
-
-class ShowStatus:
-    """`status` was asked for: the view prints the panel (script mode)."""
-
-
-SHOW_STATUS = ShowStatus()
-
-
-class ShowHelp:
-    """`help` was asked for: the view shows `help_lines()`."""
-
-
-SHOW_HELP = ShowHelp()
-
-Step = Wait | ShowStatus | ShowHelp | None
-S = TypeVar("S", bound="BaseSession")
-
-
-@dataclass(frozen=True, slots=True)
-class CommandSpec(Generic[S]):
-    """A command of the command line: its name, its arguments and help as `help` lists
-    them, what runs it, and what completes after its name."""
-
-    name: str
-    args: str
-    help: str
-    run: Callable[[S, list[str]], Step]
-    """Runs it on a session with its arguments; AppmodeError or ValueError for a mistake."""
-    completes: Mapping[str, object] | None = None
-
-
-def _latch(session: BaseSession, args: list[str]) -> None:
-    if args not in (["on"], ["off"]):
-        raise AppmodeError("usage: latch on|off")
-    session.driving.latched = args[0] == "on"
-    session.say(f"latched driving {args[0]}")
-
-
-def _record(session: BaseSession, args: list[str]) -> None:
-    if args == ["stop"]:
-        session.stop_recording()
-    elif session.names_files:
-        if len(args) != 1:
-            raise AppmodeError("usage: record FILE, or record stop")
-        session.start_recording(args[0])
-    elif args in ([], ["start"]):
-        session.start_recording(str(new_recording()))
-    else:
-        raise AppmodeError(
-            f"the page names no file: 'record' starts a recording in {recordings_folder()} "
-            "under a new name, 'record stop' ends it"
-        )
-
-
-def _wait(session: BaseSession, args: list[str]) -> Wait:
-    step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
-    assert isinstance(step, Wait)
-    return step
-
-
-def _quit(session: BaseSession, args: list[str]) -> None:
-    raise Quit
-
-
-COMMON: tuple[CommandSpec[BaseSession], ...] = (
-    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop", _latch, ON_OFF),
-    CommandSpec(
-        "record", "FILE|stop", "start or stop recording a transcript", _record, {"stop": None}
-    ),
-    CommandSpec("wait", "SECONDS", "script mode: let time pass", _wait),
-    CommandSpec("status", "", "print the status panel (script mode)", lambda s, a: SHOW_STATUS),
-    CommandSpec("help", "", "list the commands and keys", lambda s, a: SHOW_HELP),
-    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)", _quit),
-)
-"""The commands every session takes, listed after its own."""
-COMMON_ALIASES = {"?": "help", **{word: "quit" for word in QUIT_WORDS}}
 
 
 class BaseSession(ABC):
@@ -168,12 +81,17 @@ class BaseSession(ABC):
         """Every command's name, and what the command line completes after it."""
         self.closing_notes: list[str] = []
         """What closing had to do beyond its stop, for people (shown after the console)."""
+        self.undelivered: str | None = None
+        """Set when the session ended with its link down, so that its stop was never sent:
+        what to tell people (the view prints it and exits non-zero when `left_moving`)."""
+        self.left_moving = False
+        """The car was last told to move when the final stop could not be delivered."""
         self.lease: float | None = None
         """Seconds any motion lasts without `keepalive` (a page's heartbeats); None: the
         view's own ticks prove it alive (the console, a script)."""
         self._alive_at = 0.0
         self._quiet_said = False
-        self.guard = StopGuard(lambda: self.moving, self._guard_stop, self._lapsed)
+        self.guard = StopGuard(self._stoppable, self._guard_stop, self._lapsed)
         """The stop authority's thread: stops the car when the ticks stall."""
 
     # ------------------------------------------------------------ what a session is
@@ -228,7 +146,26 @@ class BaseSession(ABC):
     def _forget_motion(self) -> None:
         """The car was stopped another way: nothing is in force any more."""
 
+    def _close_link(self, link: Link[Any]) -> None:
+        """Close the driving link (its stop last); note a stop that could not be sent."""
+        moving = self.moving
+        if link.close() is not None or not link.stop_on_close:
+            return
+        self.left_moving = moving
+        self.undelivered = (
+            f"{UNDELIVERED} (the link to {self.url} is down and the firmware has no "
+            "time-out: stop it by hand, or reconnect and stop it)"
+            if moving
+            else f"the final stop was not delivered (the link to {self.url} is down); the "
+            "last command the car got was a stop"
+        )
+
     # ------------------------------------------------------------ the stop authority
+
+    def _stoppable(self) -> bool:
+        """Motion is in force and a stop can go out now (a link that is down sends its
+        stop first when it is back: `Link._stop_after_outage`)."""
+        return self.moving and self.host.connected
 
     def keepalive(self) -> None:
         """The motion's source proves it is alive (a page's heartbeat)."""
@@ -241,11 +178,11 @@ class BaseSession(ABC):
         session could not tick); whether the car was stopped."""
         if self.guard.beat():
             self._forget_motion()
-            if self.guard.why:
+            if self.guard.why and not self.moving:
                 self.say(f"stopped: {self.guard.why}")
             return True
-        if self.lease is None or not self.moving:
-            return False
+        if self.lease is None or not self.moving or not self.host.connected:
+            return False  # a link that is down sends its stop first when it is back
         quiet = self.now() - self._alive_at
         if quiet <= self.lease:
             return False

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from appmode.errors import AppmodeError
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import MOTIONS
-from appmode.session.base import SPEED_COMPLETES, SPEED_STEP, CommandSpec
+from appmode.session.commands import SPEED_COMPLETES, SPEED_STEP, CommandSpec
 
 if TYPE_CHECKING:
     from appmode.session.control_session import ControlSession

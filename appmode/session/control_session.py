@@ -16,7 +16,7 @@ from appmode.errors import AppmodeError
 from appmode.host.client import Host
 from appmode.host.control_client import ControlHost
 from appmode.host.control_query import ROTATE_POLL, ReadDone, rotation_done
-from appmode.host.control_state import TAKEOVER_BYTE
+from appmode.host.control_state import TAKEOVER_BYTE, PortMode
 from appmode.host.control_tokens import parse_token, perform
 from appmode.host.link import LinkLost
 from appmode.host.query import QueryFailed
@@ -27,7 +27,8 @@ from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
-from appmode.session.base import SPEED_KEYS, BaseSession
+from appmode.session.base import BaseSession
+from appmode.session.commands import SPEED_KEYS
 from appmode.session.control_commands import COMMANDS, SETTING_NAMES
 from appmode.session.control_status import (
     STOP,
@@ -153,7 +154,7 @@ class ControlSession(BaseSession):
                 self.app.close()
         finally:
             try:
-                self.host.close()
+                self._close_link(self.host)
             finally:
                 self._drop_recorder()
 
@@ -166,7 +167,12 @@ class ControlSession(BaseSession):
             if isinstance(event, LinkStatus):
                 self.say(f"UART2: {event.text}")
                 if not event.up:
-                    self._forget_motion()
+                    self.driving.stop()  # what the car was last told stays in force
+            elif isinstance(event, PortMode):
+                self.say(f"UART2: {event.text}")
+                if not event.app:  # a reset, or cleared from the APP port
+                    self.baseline = None  # the encoder report is off again: turn it on
+                    self.query(SETTING_NAMES, quiet=True)
             elif isinstance(event, ReadDone):
                 self._done(event)
             elif isinstance(event, QueryFailed):
@@ -289,13 +295,15 @@ class ControlSession(BaseSession):
     def stop(self) -> None:
         """The zero velocity frame (it also drops a pending turn)."""
         self.driving.stop()
-        self._send(lambda: self.host.stop())
-        self._forget_motion()
+        if self._send(lambda: self.host.stop()):
+            self._forget_motion()
 
     @property
     def moving(self) -> bool:
-        frame = self.host.state.in_force
-        return self.in_force != STOP or self.rotation is not None or frame is not None
+        """A key's motion, a turn, a frame or (APP mode, §12) a letter is in force."""
+        state = self.host.state
+        frame, letter = state.in_force, state.letter
+        return self.in_force != STOP or self.rotation is not None or (frame or letter) is not None
 
     def _guard_stop(self) -> None:
         self.host.stop()
@@ -318,12 +326,12 @@ class ControlSession(BaseSession):
             self.say(f"rotating {degrees:g}°")
 
     def _send(self, send: Callable[[], object]) -> bool:
-        """Run a send; a lost link or a value out of range becomes a message."""
+        """Run a send; a lost link becomes a message (what was in force stays)."""
         try:
             send()
         except LinkLost as exc:
             self.say(str(exc))
-            self._forget_motion()
+            self.driving.stop()
             return False
         return True
 
@@ -343,7 +351,14 @@ class ControlSession(BaseSession):
         self.host.start_query(self.host.new_query(names, change))
 
     def set_setting(self, name: str, value: int) -> None:
-        self.query(change=(name, value))
+        """A verified set; in APP mode (§12) only system_mode, as the APP frame `{8:…}`,
+        verified by reading it back once bit 7 is off."""
+        if not self.host.state.app_mode:
+            self.query(change=(name, value))
+        elif self._send(lambda: self.host.set_in_app_mode(name, value)):
+            self.say(f"sent {{8:{value}}} (APP mode: the port reads APP frames)")
+            if not self.host.state.app_mode:
+                self.query(["system_mode"])
 
     def store(self, op: str) -> None:
         if not self._send(lambda: self.host.store(op)):

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from appmode.protocol import settings
 from appmode.protocol.control_view import describe
+from appmode.protocol.directions import PAGE_LETTERS, letter_name
 from appmode.session import instruments
 from appmode.session.instruments import Instruments, Value, Wheel
 from appmode.session.status import (
@@ -19,6 +20,7 @@ from appmode.session.status import (
     link_rows,
     reading,
     telemetry,
+    unsent_row,
 )
 
 if TYPE_CHECKING:
@@ -82,6 +84,9 @@ def in_force_text(session: ControlSession) -> str:
         return session.in_force
     if state.in_force is not None:
         return describe(state.in_force)
+    if state.letter is not None:
+        page = PAGE_LETTERS[state.app_end.page_letter]
+        return f"{state.letter} {letter_name(page, state.letter)} (APP letter)"
     return "stopped"
 
 
@@ -90,6 +95,8 @@ def _in_force(session: ControlSession) -> list[Row]:
     not fit)."""
     text = in_force_text(session)
     what: Span = ("", " stopped") if text == "stopped" else ("on", f" {text} ")
+    if session.moving and not session.host.connected:
+        return [Row("in force", (("alert", f" {text} "),)), unsent_row()]
     keys = f"speed {session.speed} · r/R {session.angle:g}° · {hold_mode(session.driving)}"
     room = WIDTH - len(" in force ") - len(what[1]) - 3
     if len(keys) <= room:
@@ -114,6 +121,7 @@ def control_instruments(session: ControlSession) -> Instruments:
         telemetry=None if app is None else instruments.telemetry(app.state, app.now()),
         in_force=in_force_text(session),
         moving=session.moving,
+        stop_unsent=session.moving and not host.connected,
         page=None,
         speed=Value("speed", session.speed, 0, session.top_speed()),
         values=values,

@@ -143,8 +143,10 @@ class Instruments:
     telemetry: Telemetry | None
     """The APP port's records (None: the session has no APP port)."""
     in_force: str
-    """What drives the car, in words ("stopped" when nothing does)."""
+    """What drives the car, in words ("stopped" when nothing does): what it was last sent."""
     moving: bool
+    stop_unsent: bool
+    """The car was last sent motion and the link is down: no stop can reach it."""
     page: str | None
     """The app page the board is on (joystick, gravity, button), or None (UART2)."""
     speed: Value | None

@@ -80,6 +80,16 @@ def link_spans(
     return first, ("", rate)
 
 
+UNSENT = " NOT STOPPED: the link is down and the car may still be moving (no stop can reach it) "
+"""What a view shows while motion is in force and the link is down: it never shows a stop
+that was not sent."""
+
+
+def unsent_row() -> Row:
+    """The row that says the car's last command was motion and no stop can be sent."""
+    return Row("", (("alert", UNSENT),))
+
+
 def link_rows(
     connected: bool,
     stats: LinkStats,

@@ -18,7 +18,8 @@ from typing import Any
 from appmode.errors import AppmodeError
 from appmode.host.state import TRACE_SECONDS, HostState
 from appmode.protocol import app
-from appmode.session.base import BaseSession, Quit, ShowHelp, ShowStatus
+from appmode.session.base import BaseSession
+from appmode.session.commands import Quit, ShowHelp, ShowStatus
 from appmode.session.hold import HoldToDrive
 
 HEARTBEAT = 0.25

@@ -333,7 +333,8 @@ def serve_web(
     fingerprint: str | None = None,
 ) -> int:
     """Start the session, serve the page until ended, and always close the session: its
-    stop is the last thing sent (exit status 1 if the recording stopped on its own).
+    stop is the last thing sent (exit status 1 if the recording stopped on its own, or
+    the stop could not be sent to a car last told to move).
     `names` are other addresses the page is reached at; a self-signed certificate's
     `fingerprint` is printed for the owner to check."""
     for name in ("aiohttp", "asyncio"):
@@ -380,4 +381,6 @@ def serve_web(
             print(f"appmode: WARNING: {note}", file=sys.stderr)
         if session.recording_failure is not None:
             print(f"appmode: error: {session.recording_failure}", file=sys.stderr)
-    return 0 if session.recording_failure is None else 1
+        if session.undelivered is not None:
+            print(f"appmode: {session.undelivered}", file=sys.stderr)
+    return 1 if session.recording_failure is not None or session.left_moving else 0

@@ -233,3 +233,51 @@ def test_ctrl_c_ends_a_scan_cleanly(appmode_ble_board: ServedBoard) -> None:
     _, err = proc.communicate(timeout=10)
     assert proc.returncode == 130
     assert "Traceback" not in err
+
+
+def kill_bus(bus: str) -> None:
+    """Kill the stand-in's dbus-daemon: the module is gone for good (its link never
+    comes back)."""
+    folder = bus.split("path=", 1)[1].split(",", 1)[0].rsplit("/", 1)[0]
+    wanted = f"--config-file={folder}/bus.conf".encode()
+    for entry in Path("/proc").iterdir():
+        try:
+            words = (entry / "cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if wanted in words:
+            os.kill(int(entry.name), signal.SIGKILL)
+            return
+    raise AssertionError(f"no dbus-daemon serves {bus}")
+
+
+def test_a_link_lost_for_good_is_never_shown_as_a_stop(appmode_ble_board: ServedBoard) -> None:
+    """Issue 64.2: the module gone for good, the car still moving on its last letter:
+    the panel says it may be moving, and `drive` ends non-zero saying the final stop was
+    not delivered."""
+    board = appmode_ble_board
+    assert board.bus is not None and board.ble is not None
+    proc = subprocess.Popen(
+        appmode_cmd("drive", board.ble),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None
+    proc.stdin.write("drive A\nwait 4\nstatus\nquit\n")
+    proc.stdin.flush()
+    try:
+        board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
+        kill_bus(board.bus)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 1, (out, err)
+    assert "appmode: the final stop was not delivered: the car may still be moving" in err, err
+    assert "Traceback" not in err
+    assert "NOT STOPPED" in out and "Z stop" not in out, out
+    assert board.state.moving and sent(board).endswith(b"A"), "the board's own record"

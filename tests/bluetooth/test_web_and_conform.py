@@ -5,14 +5,16 @@ from __future__ import annotations
 
 import asyncio
 from pathlib import Path
+from typing import Any
 
 import aiohttp
 import pytest
 
 from appmode.testing.served import ServedBoard
+from tests.bluetooth.test_standin import kill_bus
 from tests.support.processes import run
 from tests.support.web import WebProcess, wait_sent, web_process
-from tests.web.test_server import beat_until_sent, page, ready
+from tests.web.test_server import beat_until_sent, page, ready, status
 
 SUITE = Path(__file__).resolve().parents[2] / "transcripts" / "suite"
 SOME = ("s2_2_read_params", "s2_2_q_separator", "s5_save")
@@ -51,3 +53,34 @@ def test_conform_passes_over_the_module(appmode_ble_board: ServedBoard, which: s
     assert f"{len(SOME)} passed, 0 failed" in done.stdout
     sent = [e.data for e in appmode_ble_board.recording().entries if e.direction == ">"]
     assert sent[-1] == b"Z", sent[-5:]
+
+
+def test_a_module_gone_for_good_the_page_and_the_exit_say_the_car_may_be_moving(
+    tmp_path: Path,
+) -> None:
+    """Issue 64.2: no stop can reach the car; the page never shows one, and the server
+    ends non-zero saying so."""
+
+    async def scenario(web: WebProcess) -> dict[str, Any]:
+        async with aiohttp.ClientSession() as session:
+            socket = await page(session, web)
+            await ready(socket)
+            await socket.send_json({"t": "press", "key": "forward"})
+            await beat_until_sent(socket, web, "A")
+            kill_bus(web.board.details["bus"])
+            deadline = asyncio.get_running_loop().time() + 15
+            while True:
+                await socket.send_json({"t": "hold", "key": "forward"})
+                shown = await status(socket)
+                if shown["instruments"]["stop_unsent"]:
+                    return shown
+                assert asyncio.get_running_loop().time() < deadline, shown["messages"]
+
+    with web_process(tmp_path, bluetooth="ble") as web:
+        shown = asyncio.run(scenario(web))
+        code, err = web.stop()
+    assert shown["instruments"]["moving"] and shown["instruments"]["in_force"] != "stopped"
+    assert any("NOT STOPPED" in span[1] for row in shown["rows"] for span in row["spans"])
+    assert code == 1, err
+    assert "the final stop was not delivered: the car may still be moving" in err, err
+    assert web.sent()[-1] == "A", "the board's own recording: nothing stopped it"

@@ -15,7 +15,7 @@ import pytest
 from appmode.console.script import command_lines
 from appmode.protocol.recorder import Recorder
 from appmode.session.app_session import Session
-from appmode.session.base import MAX_COMMAND
+from appmode.session.commands import MAX_COMMAND
 from appmode.session.hold import HoldToDrive
 from tests.support.processes import BoardProcess, appmode_cmd, run, sent_lines
 

@@ -338,3 +338,33 @@ def test_a_network_that_drops_while_holding_stops_the_car(browser: Browser, tmp_
         page.context.set_offline(True)
         wait_sent(web, "Z", timeout=3)
         page.context.close()
+
+
+def test_a_server_killed_while_holding_is_not_said_to_have_stopped_the_car(
+    browser: Browser, tmp_path: Path
+) -> None:
+    """Issue 64.3: the page says what it knows — the server is gone, the car may still
+    be moving — and never that the car was stopped; so does the page kept for when the
+    server does not answer."""
+    with web_process(tmp_path) as web:
+        page = phone(browser, web)
+        page.wait_for_function("navigator.serviceWorker.controller !== null", timeout=10_000)
+        x, y = centre(page, "forward")
+        page.mouse.move(x, y)
+        page.mouse.down()
+        wait_sent(web, "A")
+        web.proc.kill()  # SIGKILL: nothing on this machine stops the car now
+        banner = page.locator("#connection")
+        banner.filter(has_text="may still be moving").wait_for(timeout=5_000)
+        said = banner.inner_text()
+        assert "stops the car;" not in said and "was stopped" not in said, said
+        banner.filter(has_text="NOT ANSWERING").wait_for(timeout=10_000)
+        page.screenshot(path=str(tmp_path / "gone.png"))
+        assert "may still be moving" in page.locator("#in-force").inner_text()
+        assert page.locator("#pad button.lit").count() == 0
+        page.mouse.up()
+        page.reload()
+        offline = page.locator("main").inner_text()
+        assert "may still be moving" in offline and "was stopped" not in offline, offline
+        page.context.close()
+        assert web.sent()[-1] == "A", "the board's recording: nobody stopped it"

@@ -6,6 +6,7 @@
 
 const HEARTBEAT_MS = 100;
 const RECONNECT_MS = 1000;
+const GONE_AFTER = 2; // failed reconnections after which the server is called gone
 const DEAD_ZONE = 10; // degrees of tilt in which the car stops
 const STICK_DEAD = 0.35; // a gamepad stick's dead zone
 const KEYS = {
@@ -395,8 +396,11 @@ function showInstruments(ins) {
   const noun = analog() ? "messages" : "records";
   $("link").textContent = linkText(ins.link, noun);
   $("link").className = `chip ${ins.link.state}`;
-  $("in-force").textContent = ins.in_force;
+  $("in-force").textContent = ins.stop_unsent
+    ? `${ins.in_force} — NOT STOPPED: the link to the car is down, it may still be moving`
+    : ins.in_force;
   $("force-tile").classList.toggle("moving", ins.moving);
+  $("force-tile").classList.toggle("unsent", ins.stop_unsent);
   $("page-name").textContent = ins.page ? `${ins.page} page` : "";
   $("tilt-page").textContent = ins.page || "";
   $("tilt-page-line").hidden = !ins.page;
@@ -714,14 +718,41 @@ function connect() {
     if (message.t === "status") showStatus(message);
     else if (message.t === "error") notice(message.text);
   });
+  socket.addEventListener("open", () => { failures = 0; });
   socket.addEventListener("close", () => {
+    if (failures === 0) { // what the car was last told, as this page knows it
+      wasMoving = current !== null || (status !== null && status.instruments.moving);
+    }
     held.clear();
     current = null;
     clearInterval(beat);
-    $("connection").hidden = false;
-    $("connection").textContent = "LINK TO APPMODE LOST — the server stops the car; reconnecting…";
+    failures += 1;
+    lostConnection();
     setTimeout(connect, RECONNECT_MS);
   });
+}
+
+// What the page says when it loses appmode web: only what it knows. A server that runs
+// stops the car when its page goes quiet; a server that was killed, or whose machine
+// is down, stops nothing, and the car keeps its last command (no time-out).
+let failures = 0; // connections in a row that closed (or never opened)
+let wasMoving = false; // the car was last told to move when the connection was lost
+function lostConnection() {
+  $("connection").hidden = false;
+  const gone = failures > GONE_AFTER;
+  const car = wasMoving
+    ? "The car was last told to move: it may still be moving."
+    : "The car was last told to stop.";
+  $("connection").textContent = gone
+    ? `APPMODE WEB IS NOT ANSWERING. ${car} If the server ended or its machine is down, `
+      + "nothing stops the car: stop it by hand, then start appmode web again. Trying again…"
+    : `CONNECTION TO APPMODE WEB LOST. ${car} A server that still runs stops it within a `
+      + "quarter of a second; a server that ended cannot. Reconnecting…";
+  $("in-force").textContent = wasMoving ? "unknown: no connection (it may still be moving)"
+    : "unknown: no connection";
+  $("link").textContent = "no connection to appmode";
+  $("link").className = "chip lost";
+  document.querySelectorAll("#pad button").forEach((b) => b.classList.remove("lit"));
 }
 
 connect();

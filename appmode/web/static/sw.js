@@ -2,7 +2,7 @@
 // reachable, and a page that says so. It never keeps the page itself ("/": its
 // cookie holds the token), the websocket or anything live.
 "use strict";
-const CACHE = "appmode-v1";
+const CACHE = "appmode-v2";
 const OWN = ["/static/app.css", "/static/icon.svg", "/static/offline.html"];
 
 self.addEventListener("install", (event) => {
