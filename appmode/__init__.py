@@ -8,7 +8,8 @@ The public API (docs/api.md):
 - `open_link`: open a board by URL or `Target` (importing appmode registers `sim://`,
   `ble://` and `bt://` with pyserial, so `serial.serial_for_url("sim://")` opens the
   simulated board in any program); `parse_target`: a URL parsed once into a `Target`;
-- `read_transcript`, `parse_transcript` and `Recorder`: the transcript reader and writer;
+- `read_transcript`, `parse_transcript`, `Recorder` and `open_recorder`: the transcript
+  reader and writer (to a stream, or to a file it opens);
 - `AppmodeError` (what went wrong, where, how to fix it) and its `TranscriptError`.
 
 Each name is imported when first used, so `import appmode` (and the pytest plugin that
@@ -30,32 +31,31 @@ import serial
 
 from appmode.errors import AppmodeError
 
-for _package in ("appmode.ports", "appmode.bluetooth"):  # sim://; ble:// and bt://
+for _package in ("appmode.ports", "appmode.bluetooth.links"):  # sim://; ble:// and bt://
     if _package not in serial.protocol_handler_packages:
         serial.protocol_handler_packages.append(_package)
 
 if TYPE_CHECKING:
     from appmode.board.firmware import Board
-    from appmode.host.client import Host
-    from appmode.host.control_client import ControlHost
+    from appmode.host.app.client import Host
+    from appmode.host.control.client import ControlHost
+    from appmode.ports.recording import open_recorder
     from appmode.ports.target import Target, parse_target
     from appmode.ports.urls import open_link
     from appmode.protocol.app import encode
     from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
     from appmode.protocol.recorder import Recorder
-    from appmode.protocol.transcript import (
-        TranscriptError,
-        parse_transcript,
-        read_transcript,
-    )
+    from appmode.protocol.transcript import TranscriptError, parse_transcript
+    from appmode.transcript.reading import read_transcript
 
 __version__ = "0.1.0"
 
 _WHERE = {
     "Board": "appmode.board.firmware",
-    "Host": "appmode.host.client",
-    "ControlHost": "appmode.host.control_client",
+    "Host": "appmode.host.app.client",
+    "ControlHost": "appmode.host.control.client",
     "open_link": "appmode.ports.urls",
+    "open_recorder": "appmode.ports.recording",
     "Target": "appmode.ports.target",
     "parse_target": "appmode.ports.target",
     "BoardDecoder": "appmode.protocol.app_decoders",
@@ -64,7 +64,7 @@ _WHERE = {
     "Recorder": "appmode.protocol.recorder",
     "TranscriptError": "appmode.protocol.transcript",
     "parse_transcript": "appmode.protocol.transcript",
-    "read_transcript": "appmode.protocol.transcript",
+    "read_transcript": "appmode.transcript.reading",
 }
 
 
@@ -89,6 +89,7 @@ __all__ = [
     "__version__",
     "encode",
     "open_link",
+    "open_recorder",
     "parse_target",
     "parse_transcript",
     "read_transcript",

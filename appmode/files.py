@@ -199,3 +199,15 @@ def say_if_fifo(path: str | os.PathLike[str]) -> None:
             file=sys.stderr,
             flush=True,
         )
+
+
+def read_limited(path: str, limit: int, hint: str) -> str:
+    """A small text file a user names, read whole (UTF-8): OSError if it is not a regular
+    file (a FIFO would wait for a writer, a device forever) or is over `limit` bytes
+    (`hint` says why that is too much); UnicodeDecodeError if it is not text."""
+    if not os.path.isfile(path):
+        raise OSError(0, "not a regular file" if os.path.exists(path) else "no such file")
+    if os.path.getsize(path) > limit:
+        raise OSError(0, f"over {limit // 1000} kB: {hint}")
+    with open(path, encoding="utf-8") as file:
+        return file.read(limit + 1)

@@ -1,8 +1,27 @@
-"""Words for people: a count with its noun."""
+"""Words for people: a count with its noun, text wrapped to a width, and text from
+outside (a device's name, a profile's labels, a board's bytes) made safe to show."""
 
 from __future__ import annotations
 
+import re
 import textwrap
+
+_UNSAFE = re.compile(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
+"""What a terminal or a page would act on rather than show: C0 and C1 controls (ESC
+starts a terminal's commands: colours, the clipboard, the title, erasing a line), DEL,
+the line and paragraph separators, and the bidirectional marks and overrides that
+reorder what follows."""
+
+
+def escaped(text: str) -> str:
+    """`text` with every control character written as an escape (`\\x1b`, `\\u202e`): what
+    came from outside is shown as what it is, never acted on."""
+    return _UNSAFE.sub(_escape, text)
+
+
+def _escape(found: re.Match[str]) -> str:
+    code = ord(found[0])
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
 
 
 def counted(count: int, noun: str, plural: str | None = None) -> str:

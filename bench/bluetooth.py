@@ -30,9 +30,9 @@ import serial
 from common import Row, percentile, started
 
 import appmode  # noqa: F401 - registers ble://
-from appmode.bluetooth.ble_port import AHEAD, BleSerial
-from appmode.bluetooth.endpoint import BluetoothEndpoint
+from appmode.bluetooth.links.ble_port import AHEAD, BleSerial
 from appmode.bluetooth.module import CONNECTION_INTERVAL, PAYLOAD, UART_BYTES_PER_S
+from appmode.bluetooth.standin.endpoint import BluetoothEndpoint
 
 ANSWER = b"{C500:10000:20:0:10:10:10:0:0}$"
 SENT = 1920

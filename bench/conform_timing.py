@@ -16,7 +16,7 @@ from pathlib import Path
 
 from common import board, summary_ms
 
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 
 SPACING = 0.017
 SENT = {bytes([c]) for c in b"ABCDEFGHJ"}

@@ -14,7 +14,7 @@ import time
 
 from common import Row, board, percentile
 
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.ports.urls import open_link
 from appmode.protocol.app import ParamsRecord
 from appmode.protocol.app_decoders import BoardDecoder

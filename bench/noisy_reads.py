@@ -15,7 +15,7 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 
 from appmode.errors import AppmodeError
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.ports.sim import SimSerial
 
 HEAVY = "drop:0.005,corrupt:0.01,dup:0.005,chatter:0.002,split:0.5,delay:0.01"

@@ -52,7 +52,7 @@ from common import (
 )
 
 from appmode.board.firmware import TICK, Board
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 from appmode.transcript.runner import SUITE, collect, run_virtual
 
 TICKS = os.sysconf("SC_CLK_TCK")
@@ -293,12 +293,14 @@ def bench_key_latency(keys: int) -> list[Row]:
     from prompt_toolkit.output import DummyOutput
 
     from appmode.console.driving import run_drive
-    from appmode.session.app_session import Session
+    from appmode.ports.choice import choose
+    from appmode.ports.target import parse_target
+    from appmode.session.app.session import AppSession
     from appmode.session.hold import HoldToDrive
 
     sent: list[float] = []
     typed: list[float] = []
-    session = Session("sim://?pace=0", HoldToDrive(latched=True))
+    session = AppSession(choose(parse_target("sim://?pace=0")), HoldToDrive(latched=True))
     real_send = session.host.send
 
     def send(data: bytes) -> None:

@@ -1,10 +1,11 @@
-"""The architecture as the code has it (issue 25): layers whose imports point only down,
-small modules and functions, and no two modules of one name."""
+"""The architecture as the code has it (issues 25, 65): layers whose imports point only
+down, folders within a layer for its sides (the APP port and the control port, the
+host's Bluetooth links and the stand-in), small modules and functions, and no two
+modules of one name but in sibling folders (`host/app/client.py`, `host/control/client.py`)."""
 
 from __future__ import annotations
 
 import ast
-from collections import Counter
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent / "appmode"
@@ -57,8 +58,15 @@ def name_of(path: Path) -> str:
 
 
 def test_every_subpackage_is_a_layer() -> None:
-    packages = {p.parent.name for p in modules() if p.parent != PACKAGE}
+    packages = {p.relative_to(PACKAGE).parts[0] for p in modules() if p.parent != PACKAGE}
     assert packages == set(LAYERS)
+
+
+def test_every_folder_is_a_package_that_says_what_it_holds() -> None:
+    for folder in {p.parent for p in modules()}:
+        init = folder / "__init__.py"
+        assert init.exists(), f"{folder} has no __init__.py"
+        assert ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))), f"{init}: say"
 
 
 def test_imports_point_down_the_layers() -> None:
@@ -89,6 +97,16 @@ def test_modules_and_functions_are_small() -> None:
     assert not long, "\n".join(long)
 
 
-def test_outside_cli_no_two_modules_share_a_name() -> None:
-    names = Counter(p.stem for p in modules() if p.parent.name != "cli" and p.stem != "__init__")
-    assert [name for name, count in names.items() if count > 1] == []
+def test_outside_cli_two_modules_share_a_name_only_in_sibling_folders() -> None:
+    """The two ports' modules match by name (`app/state.py`, `control/state.py`): a
+    reader finds one port's part by the other's; any other repeated name is a clash."""
+    places: dict[str, list[Path]] = {}
+    for path in modules():
+        if path.parent.name != "cli" and path.stem != "__init__":
+            places.setdefault(path.stem, []).append(path.parent)
+    clashes = [
+        f"{name}: {', '.join(str(f.relative_to(PACKAGE)) for f in folders)}"
+        for name, folders in places.items()
+        if len(folders) > 1 and len({f.parent for f in folders}) > 1
+    ]
+    assert clashes == [], "\n".join(clashes)

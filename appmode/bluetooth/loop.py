@@ -1,16 +1,32 @@
 """An asyncio event loop in a thread of its own, for the Bluetooth links: bleak and
-dbus-fast are asynchronous, a pyserial port is not."""
+dbus-fast are asynchronous, a pyserial port is not; and a socket read as it comes."""
 
 from __future__ import annotations
 
 import asyncio
 import concurrent.futures
 import contextlib
+import socket
 import threading
-from collections.abc import Coroutine
+from collections.abc import AsyncIterator, Coroutine
 from typing import TypeVar
 
 T = TypeVar("T")
+READ = 4096
+"""Bytes a socket read takes at most."""
+
+
+async def chunks(link: socket.socket) -> AsyncIterator[bytes]:
+    """What a socket brings, as it comes, until its end (or its error)."""
+    loop = asyncio.get_running_loop()
+    while True:
+        try:
+            data = await loop.sock_recv(link, READ)
+        except OSError:
+            return
+        if not data:
+            return
+        yield data
 
 
 class LoopThread:

@@ -6,15 +6,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from appmode.ports.radio import full
+
 SPP = "00001101-0000-1000-8000-00805f9b34fb"
 """The Serial Port profile (HC-05, HC-06, JDY-31 and the classic side of a JDY-33)."""
 CCCD = "00002902-0000-1000-8000-00805f9b34fb"
 """The client characteristic configuration descriptor (notifications on/off)."""
-
-
-def full(short: str) -> str:
-    """A 16-bit UUID (`ffe0`) as the 128-bit one BlueZ and bleak name it."""
-    return f"0000{short.lower()}-0000-1000-8000-00805f9b34fb" if len(short) == 4 else short.lower()
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,6 +15,7 @@ from types import MappingProxyType
 
 from appmode.board.names import PROFILE_NAMES
 from appmode.errors import AppmodeError
+from appmode.files import read_limited
 from appmode.protocol import layouts, params, profile_file
 from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
 from appmode.protocol.layouts import SCALED, VELOCITY, Layout
@@ -302,6 +303,23 @@ def profile_named(name: str) -> Profile:
     if name in PROFILES:
         return PROFILES[name]
     try:
-        return from_file(profile_file.load(name))
+        return from_file(load(name))
     except ProfileError as exc:
         raise AppmodeError(str(exc).replace("\n", "; ")) from None
+
+
+@cache
+def load(source: str) -> ProfileFile:
+    """A shipped profile file by name, or a user's file by path; ProfileError says what
+    is wrong, a line a mistake."""
+    if source in profile_file.SHIPPED:
+        return profile_file.shipped(source)
+    try:
+        text = read_limited(source, profile_file.MAX_SIZE, "a profile is a few kB")
+    except (OSError, UnicodeDecodeError) as exc:
+        known = ", ".join(profile_file.SHIPPED)
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise ProfileError(
+            source, [f"cannot read it ({why}): give a file or one of {known}"]
+        ) from None
+    return profile_file.parse(text, source)

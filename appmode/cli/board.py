@@ -193,7 +193,7 @@ def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
 
 
 def _advertised_name(text: str) -> str:
-    from appmode.bluetooth.addresses import name_problem
+    from appmode.bluetooth.advertise.module_name import name_problem
 
     if (why := name_problem(text)) is not None:
         raise argparse.ArgumentTypeError(why)
@@ -201,13 +201,13 @@ def _advertised_name(text: str) -> str:
 
 
 def _bluetooth(option: str) -> ModuleType:
-    """appmode.bluetooth.endpoint, or one line on what to install and what it runs on."""
+    """The stand-in's endpoint module, or one line on what to install and what it runs on."""
     from appmode.bluetooth.availability import unsupported
 
     if (why := unsupported()) is not None:
         raise AppmodeError(f"{option}: {why}")
     try:
-        from appmode.bluetooth import endpoint
+        from appmode.bluetooth.standin import endpoint
     except ImportError:
         raise AppmodeError(
             f"{option} needs the bluetooth extra: pip install 'appmode[bluetooth]'"

@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, add_profile, file_name, profile_for, target
+from appmode.cli.options import Subparsers, add_profile, file_name, target
 from appmode.errors import AppmodeError
 
 
@@ -64,19 +64,24 @@ WARNING = (
 
 
 def run(args: argparse.Namespace) -> int:
+    from appmode.board.profiles import profile_named
+    from appmode.ports.choice import choose
     from appmode.transcript.runner import run_conform
 
+    if args.board2 and not args.board:
+        raise AppmodeError("--board2 names the control port of the --board: give --board too")
+    board = board2 = None
+    profile = profile_named(args.profile or "sheet").name
     if args.board:
-        args.board = args.board.with_sim(profile=args.profile)
-    profile = profile_for(args.board, args.profile).name
-    if args.board and not args.board.simulated and not args.yes:
-        warning = WARNING.format(url=args.board)
+        choice = choose(args.board, args.board2, profile=args.profile)
+        board, board2 = (choice.app, choice.target) if choice.app else (choice.target, None)
+        profile = choice.profile.name
+    if board and not board.simulated and not args.yes:
+        warning = WARNING.format(url=board)
         if not sys.stdin.isatty():
             raise AppmodeError(f"{warning} Add --yes to run it without asking.")
         print(f"{warning}\nGo on? [y/N] ", end="", file=sys.stderr, flush=True)
         if sys.stdin.readline().strip().lower() not in ("y", "yes"):
             print("not run", file=sys.stderr)
             return 1
-    if args.board2 and not args.board:
-        raise AppmodeError("--board2 names the control port of the --board: give --board too")
-    return run_conform(args.paths, args.board, args.junit, sys.stdout, profile, board2=args.board2)
+    return run_conform(args.paths, board, args.junit, sys.stdout, profile, board2=board2)

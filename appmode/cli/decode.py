@@ -8,7 +8,7 @@ from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, BinaryIO, TextIO
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, add_profile, layout_for
+from appmode.cli.options import Subparsers, add_profile
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:  # the codec is imported when the command runs: start-up stays short
@@ -93,7 +93,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    layout = layout_for(None, args.profile) if args.profile else None  # None: the sheet's
+    from appmode.board.profiles import profile_named
+
+    layout = profile_named(args.profile).a_layout if args.profile else None  # None: the sheet's
     if args.file in (None, "-"):
         run_decode(sys.stdin.buffer, sys.stdout, args.source, layout=layout)
         return 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import shutil
 import sys
 import threading
@@ -11,13 +12,15 @@ import time
 from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers
-from appmode.text import counted, wrapped
+from appmode.cli.options import Subparsers, target
+from appmode.text import counted, escaped, wrapped
 
 if TYPE_CHECKING:  # imported by `run`: `appmode --help` does not load the host
     from concurrent.futures import Future
 
-    from appmode.host import probe
+    from appmode.host import identify, probe
+    from appmode.host.heard import Heard
+    from appmode.ports.target import Target
 
 WORKERS = 8
 """Ports listened to at once."""
@@ -44,6 +47,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     doctor.add_argument(
         "urls",
         nargs="*",
+        type=target,
         metavar="URL",
         help="the ports to check (default: every serial port, as appmode ports lists them, "
         "and the Bluetooth modules appmode scan finds)",
@@ -58,13 +62,16 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    urls: list[str] = list(dict.fromkeys(args.urls))
+    from appmode.ports.target import parse_target
+
+    urls = {t.url: t for t in args.urls}
     if not urls:
         from appmode.ports.listing import serial_ports
 
-        urls = [port.device for port in serial_ports()]
+        found = [port.device for port in serial_ports()]
         if not args.no_bluetooth:
-            urls += _bluetooth()
+            found += _bluetooth()
+        urls = {url: parse_target(url) for url in found}
     if not urls:
         print(
             wrapped(
@@ -76,10 +83,10 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    findings = _check(urls)
+    findings = _check(list(urls.values()))
     for finding in findings:
         if args.json:
-            sys.stdout.write(json.dumps(finding.to_json()) + "\n")
+            sys.stdout.write(json.dumps(to_json(finding)) + "\n")
         else:
             sys.stdout.write(_text(finding) + "\n")
     return 0 if any(f.is_car for f in findings) else 1
@@ -92,7 +99,7 @@ def _bluetooth() -> list[str]:
 
     try:
         from appmode.bluetooth.availability import explain
-        from appmode.bluetooth.scan import scan
+        from appmode.bluetooth.links.scan import scan
     except ImportError:
         print("doctor: Bluetooth not looked for: pip install 'appmode[bluetooth]'", file=sys.stderr)
         return []
@@ -114,20 +121,161 @@ def _text(finding: probe.Finding) -> str:
     mark = "ok" if finding.is_car else "--"
     return "\n".join(
         (
-            wrapped(f"{mark} {finding.url}: {finding.verdict}", indent="   "),
-            wrapped(f"   {finding.fix}", indent="   "),
+            wrapped(f"{mark} {escaped(finding.url)}: {verdict(finding)}", indent="   "),
+            wrapped(f"   {fix(finding)}", indent="   "),
         )
     )
 
 
-def _check(urls: list[str]) -> list[probe.Finding]:
+def verdict(finding: probe.Finding) -> str:
+    """What the port is, in a line."""
+    rate = "" if finding.fixed or finding.baud is None else f" at {finding.baud} bps"
+    shown = finding.shown
+    if finding.kind == "app":
+        return _car_verdict(finding, rate)
+    if finding.kind == "uart2":
+        what = (
+            "encoder reports"
+            if shown and shown.reports
+            else "the reference firmware's status bursts (§13.1)"
+        )
+        return f"this is a car's control port (UART2){rate}: it sends {what}"
+    if finding.kind == "silent":
+        spent = sum(h.seconds for h in finding.heard)
+        return f"silent: nothing came in {spent:.1f} s{_tried(finding)}"
+    if finding.kind == "text":
+        sample = bytes(shown.sample if shown else b"").decode("ascii", "replace").split()
+        return f"not a board: it sends text{rate} ({' '.join(sample)[:40]!r}…), no records"
+    if finding.kind == "noise":
+        return f"bytes but no records{_tried(finding)}"
+    if finding.kind == "unopened":
+        return f"cannot be opened: {finding.failure.partition(': ')[0]}"
+    return f"it opened, then failed while listening ({finding.failure})"
+
+
+def _car_verdict(finding: probe.Finding, rate: str) -> str:
+    period = f"a record every {5 * round((finding.period_ms or 0) / 5)} ms"  # a rhythm
+    what = f"{finding.profile or 'unknown'} firmware ({period})"
+    if finding.values is None:
+        return f"a car's APP port{rate}, {what}; its parameters did not come"
+    from appmode.protocol import param_values
+
+    pairs = zip(finding.specs, finding.values, strict=False)
+    shown = ", ".join(f"{s.name}={param_values.to_user(s, v)}" for s, v in pairs)
+    off = finding.baud not in (None, 9600) and not finding.fixed
+    note = f" (its Bluetooth module or UART runs at {finding.baud}, not 9600)" if off else ""
+    return f"this is a car: APP port{rate}{note}, {what}, parameters {shown}"
+
+
+def _tried(finding: probe.Finding) -> str:
+    tried = " or ".join(f"{h.baud}" for h in finding.heard)
+    return "" if finding.fixed else f" at {tried} bps"
+
+
+def fix(finding: probe.Finding) -> str:
+    """What to do next: the command that drives the car, or what to fix."""
+    url = shlex.quote(finding.url)
+    if finding.kind == "app":
+        drive = _drive_it(finding)
+        return f"{finding.failure}; {drive}" if finding.values is None else drive
+    if finding.kind == "uart2":
+        return (
+            f"drive it with: appmode drive {_at_rate(finding, 115200)} --uart2 (it takes "
+            "the motion over from the APP port)"
+        )
+    if finding.kind == "silent":
+        return (
+            "check that the car is on and wired TX to RX (or paired, for Bluetooth); a "
+            "control port (UART2) with its encoder report off is silent until spoken to: "
+            f"appmode params {url} --uart2 reads it (and takes the motion over)"
+        )
+    if finding.kind == "text":
+        return (
+            "name the car's port instead (appmode ports lists them); a pty path may now "
+            "be another program's: restart the board, or use board --link"
+        )
+    if finding.kind == "noise":
+        return (
+            "not a board, or at a rate appmode does not try: check the wiring (TX to RX, a "
+            "common ground) and the module's rate"
+        )
+    if finding.kind == "unopened":
+        what, _, then = finding.failure.partition(": ")
+        return then or what
+    return (
+        "the device went away: check the cable or adapter (or the program that served "
+        "this pty), then run appmode doctor again"
+    )
+
+
+def _at_rate(finding: probe.Finding, usual: int) -> str:
+    """The port's URL at the rate it showed (`?baud=` when not the port's usual one)."""
+    bare = finding.target.url if finding.fixed else finding.target.path
+    rate = finding.baud
+    return shlex.quote(bare if finding.fixed or rate in (None, usual) else f"{bare}?baud={rate}")
+
+
+def _drive_it(finding: probe.Finding) -> str:
+    """The command that drives a car, or how to write a profile for a firmware that fits
+    none."""
+    where = _at_rate(finding, 9600)
+    nearest: identify.Judgement | None = finding.nearest
+    if finding.profile is None and nearest is not None:
+        name = nearest.profile.name
+        return (
+            f"its records fit no shipped profile (nearest: {name}, but "
+            f"{'; '.join(nearest.against[:2])}): write one for it, starting from "
+            f"appmode profile show {name} --toml > mycar.toml, then "
+            f"appmode drive {where} --profile mycar.toml"
+        )
+    flag = ""  # a sim:// URL names its own profile
+    if finding.profile not in (None, "sheet") and not finding.target.simulated:
+        flag = f" --profile {finding.profile}"
+    return f"drive it with: appmode drive {where}{flag}"
+
+
+def to_json(finding: probe.Finding) -> dict[str, object]:
+    """A finding as `doctor --json` prints it."""
+    from appmode.protocol import param_values
+
+    values = finding.values
+    return {
+        "port": finding.url,
+        "kind": finding.kind,
+        "car": finding.is_car,
+        "verdict": verdict(finding),
+        "fix": fix(finding),
+        "baud": finding.baud,
+        "profile": finding.profile,
+        "record_period_ms": None if finding.period_ms is None else round(finding.period_ms, 1),
+        "params": None
+        if values is None
+        else {
+            s.name: param_values.user_number(s, v)
+            for s, v in zip(finding.specs, values, strict=False)
+        },
+        "heard": [_heard(h) for h in finding.heard],
+    }
+
+
+def _heard(heard: Heard) -> dict[str, object]:
+    return {
+        "baud": heard.baud,
+        "seconds": round(heard.seconds, 2),
+        "bytes": heard.size,
+        "records": heard.records,
+        "uart2_bursts": heard.uart2_bursts,
+    }
+
+
+def _check(targets: list[Target]) -> list[probe.Finding]:
     """Probe every port at once, showing progress on a terminal."""
     from concurrent.futures import ThreadPoolExecutor
 
     from appmode.host import probe
 
     stop = threading.Event()
-    doing = dict.fromkeys(urls, "waiting")
+    doing = {t.url: "waiting" for t in targets}
 
     def mark(url: str) -> probe.Progress:
         def say(text: str) -> None:
@@ -135,9 +283,9 @@ def _check(urls: list[str]) -> list[probe.Finding]:
 
         return say
 
-    pool = ThreadPoolExecutor(max_workers=min(WORKERS, len(urls)))
+    pool = ThreadPoolExecutor(max_workers=min(WORKERS, len(targets)))
     futures: dict[str, Future[probe.Finding]] = {
-        url: pool.submit(probe.probe, url, stop, mark(url)) for url in urls
+        t.url: pool.submit(probe.probe, t, stop, mark(t.url)) for t in targets
     }
     show = sys.stderr.isatty()
     try:
@@ -151,7 +299,7 @@ def _check(urls: list[str]) -> list[probe.Finding]:
         if show:
             sys.stderr.write("\r\x1b[K")
             sys.stderr.flush()
-    return [futures[url].result() for url in urls]
+    return [futures[t.url].result() for t in targets]
 
 
 def _progress(futures: dict[str, Future[probe.Finding]], doing: dict[str, str]) -> None:

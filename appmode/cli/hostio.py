@@ -9,16 +9,16 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import ExitStack, closing
 from typing import TYPE_CHECKING, TextIO, TypeVar
 
-from appmode.host.client import Event, Host
-from appmode.host.control_client import ControlHost
-from appmode.host.query import QueryDone, QueryFailed
-from appmode.host.state import BoardWarning, LinkStatus
-from appmode.protocol.layouts import VELOCITY, Layout
-from appmode.protocol.recorder import Recorder
+from appmode.host.app.client import Event, Host
+from appmode.host.app.query import QueryDone
+from appmode.host.control.client import ControlHost
+from appmode.host.events import BoardWarning, LinkStatus
+from appmode.host.outcomes import QueryFailed
+from appmode.ports.recording import open_recorder
 from appmode.protocol.render import describe, line, to_json
 
 if TYPE_CHECKING:
-    from appmode.ports.target import Target
+    from appmode.ports.choice import BoardChoice
 
 H = TypeVar("H", Host, ControlHost)
 E = TypeVar("E")
@@ -26,22 +26,18 @@ E = TypeVar("E")
 
 def open_host(
     stack: ExitStack,
-    url: Target,
+    choice: BoardChoice,
     record: str | None,
     stop_on_close: bool = True,
-    layout: Layout = VELOCITY,
-    stop_again: bytes | None = None,
-    frames_stop: bool = False,
+    confirm_stop: bool = False,
 ) -> Host:
-    """The APP host, then its recording (`with_recording`). With `stop_again` it confirms
-    its stop on the board's A records, sending those bytes while the car still moves."""
+    """The APP host of the board chosen, then its recording (`with_recording`); with
+    `confirm_stop` it checks its stop on the board's A records."""
     host = Host(
-        url,
+        choice.target,
         stop_on_close=stop_on_close,
-        layout=layout,
-        confirm_stop=stop_again is not None,
-        stop_again=stop_again or b"",
-        frames_stop=frames_stop,
+        profile=choice.profile,
+        confirm_stop=confirm_stop,
     )
     return with_recording(stack, host, record)
 
@@ -50,7 +46,7 @@ def with_recording(stack: ExitStack, host: H, record: str | None) -> H:
     """An opened host, then its recording: a URL that does not open leaves the file
     untouched. The recording is closed after the host, so it holds the final stop."""
     try:
-        recorder = Recorder.create(record, 0.0, host.target.directives) if record else None
+        recorder = open_recorder(record, 0.0, host.target.directives) if record else None
     except BaseException:
         host.close()
         raise

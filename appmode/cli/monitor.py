@@ -16,18 +16,16 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
-    layout_for,
+    board_choice,
     number_type,
-    profile_for,
 )
 from appmode.errors import AppmodeError
 from appmode.protocol import app
-from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.text import counted
 
 if TYPE_CHECKING:
-    from appmode.host.client import Event
-    from appmode.ports.target import Target
+    from appmode.host.app.client import Event
+    from appmode.ports.choice import BoardChoice
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -75,16 +73,14 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    args.url = args.url.with_sim(profile=args.profile)
-    if args.uart2:
+    choice = board_choice(args)
+    if choice.control:
         from appmode.cli import uart2  # here: start-up stays short
 
-        profile_for(args.url, args.profile).check_uart2()
         if args.filter is not None:
             raise AppmodeError("--filter picks APP records: not with --uart2")
         return uart2.run_monitor(
-            args.url,
-            profile=profile_for(args.url, args.profile),
+            choice,
             as_json=args.json,
             duration=args.duration,
             count=args.count,
@@ -93,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
             stop_on_exit=args.stop_on_exit,
         )
     return run_monitor(
-        args.url,
+        choice,
         as_json=args.json,
         duration=args.duration,
         count=args.count,
@@ -101,12 +97,11 @@ def run(args: argparse.Namespace) -> int:
         stop_on_exit=args.stop_on_exit,
         kinds=args.filter,
         out=sys.stdout,
-        layout=layout_for(args.url, args.profile),
     )
 
 
 def run_monitor(
-    url: Target,
+    choice: BoardChoice,
     *,
     as_json: bool,
     duration: float | None,
@@ -116,7 +111,6 @@ def run_monitor(
     stop_on_exit: bool = False,
     kinds: frozenset[str] | None = None,
     name: str = "monitor",
-    layout: Layout = VELOCITY,
 ) -> int:
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none
@@ -124,7 +118,8 @@ def run_monitor(
     from appmode.cli.hostio import open_host, show, until_count
 
     with ExitStack() as stack:
-        host = open_host(stack, url, record, stop_on_close=stop_on_exit, layout=layout)
+        host = open_host(stack, choice, record, stop_on_close=stop_on_exit)
+        url = choice.target
         doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"
         sys.stderr.write(f"{doing} (Ctrl-C to stop)\n")  # one write: the FIFO's note is another
         sys.stderr.flush()

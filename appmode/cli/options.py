@@ -11,9 +11,8 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
     from _typeshed import SupportsWrite
 
-    from appmode.board.profiles import Profile
+    from appmode.ports.choice import BoardChoice
     from appmode.ports.target import Target
-    from appmode.protocol.layouts import Layout
 
 URL_FORMS = (
     "the board: /dev/ttyUSB0, /dev/rfcomm0, COM3 (?baud=N), socket://HOST:PORT, "
@@ -71,7 +70,7 @@ HOLDS = (
 )
 A_RECORD = f"the board's profile, {HOLDS}"
 ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {HOLDS}"
-"""--profile of a command that opens a board (`Target.with_sim`)."""
+"""--profile of a command that opens a board (`board_choice`)."""
 FROM_URL = "a sim:// URL's profile, else sheet"
 
 
@@ -96,7 +95,8 @@ def profile_name(text: str) -> str:
     """A shipped profile's name, or a profile file that reads (one line when not)."""
     if text in SHIPPED_PROFILES:
         return text
-    from appmode.protocol.profile_file import ProfileError, load
+    from appmode.board.profiles import load
+    from appmode.protocol.profile_file import ProfileError
 
     try:
         load(text)
@@ -105,25 +105,23 @@ def profile_name(text: str) -> str:
     return text
 
 
-def profile_for(target: Target | None, name: str | None) -> Profile:
-    """The profile `--profile NAME` names, else a sim:// target's, else the sheet."""
-    from appmode.board.profiles import profile_named
+def board_choice(args: argparse.Namespace) -> BoardChoice:
+    """The board a command's arguments name, decided once (`ports.choice.choose`): its
+    URL; the same board's control port (a second URL, `--uart2-url`, or `--uart2` for
+    the URL's own); `--profile`; `--drive`."""
+    from appmode.errors import AppmodeError
+    from appmode.ports.choice import choose
 
-    if name is None and target is not None:
-        name = target.profile
-    return profile_named(name or "sheet")
-
-
-def stop_again_for(target: Target | None, name: str | None) -> bytes:
-    """What a host sends when its stop did not take, on `profile_for(target, name)`."""
-    from appmode.protocol.session_end import stop_again
-
-    return stop_again(frames_take_letters=not profile_for(target, name).steer_in_frames)
-
-
-def layout_for(target: Target | None, name: str | None) -> Layout:
-    """The A record layout of `profile_for(target, name)`."""
-    return profile_for(target, name).a_layout
+    url2, uart2_url = getattr(args, "url2", None), getattr(args, "uart2_url", None)
+    if url2 is not None and uart2_url is not None:
+        raise AppmodeError("give the control port once: a second URL or --uart2-url")
+    return choose(
+        args.url,
+        url2 or uart2_url,
+        uart2=getattr(args, "uart2", False),
+        profile=getattr(args, "profile", None),
+        drive=getattr(args, "drive_type", None),
+    )
 
 
 class Parser(argparse.ArgumentParser):

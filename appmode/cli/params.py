@@ -15,15 +15,14 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
-    profile_for,
+    board_choice,
 )
 from appmode.errors import AppmodeError
 from appmode.protocol import param_values, params
 from appmode.protocol.param_values import Specs
 
 if TYPE_CHECKING:  # imported when the command runs: start-up stays short
-    from appmode.board.profiles import Profile
-    from appmode.ports.target import Target
+    from appmode.ports.choice import BoardChoice
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -84,9 +83,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    args.url = args.url.with_sim(profile=args.profile)
-    if args.uart2:
-        profile_for(args.url, args.profile).check_uart2()
+    choice = board_choice(args)
+    if choice.control:
         if args.verify_saved:
             raise AppmodeError(
                 "--verify-saved is for the APP port: over --uart2, restart the board and "
@@ -96,19 +94,18 @@ def run(args: argparse.Namespace) -> int:
 
         store = next((op for op in ("load", "defaults", "save") if getattr(args, op)), None)
         return uart2.run_params(
-            args.url, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
+            choice, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
         )
     if args.load or args.defaults:
         raise AppmodeError("--load and --defaults are frames of the control port: add --uart2")
     return run_params(
-        args.url,
+        choice,
         args.set,
         save=args.save,
         verify=args.verify_saved,
         as_json=args.json,
         record=args.record,
         out=sys.stdout,
-        profile=profile_for(args.url, args.profile),
     )
 
 
@@ -129,7 +126,7 @@ def parse_assignment(text: str, specs: Specs = param_values.SHEET) -> tuple[int,
 
 
 def run_params(
-    url: Target,
+    choice: BoardChoice,
     assignments: list[str],
     *,
     save: bool,
@@ -137,7 +134,6 @@ def run_params(
     record: str | None,
     out: TextIO,
     verify: bool = False,
-    profile: Profile,
 ) -> int:
     """Read the parameters; set each (verified by reading back), save, and print them;
     or check them against what was saved (`verify`)."""
@@ -147,6 +143,7 @@ def run_params(
     from appmode.host import saves
     from appmode.protocol.render import params_table
 
+    url, profile = choice.target, choice.profile
     specs = profile.a_layout.params
     changes = [parse_assignment(text, specs) for text in assignments]  # all checked first
     saved = saves.recall(url.url) if verify else None
@@ -156,7 +153,7 @@ def run_params(
             f"'appmode params {url} --save' (in {saves.path()})"
         )
     with ExitStack() as stack:
-        host = open_host(stack, url, record, layout=profile.a_layout)
+        host = open_host(stack, choice, record)
         values = host.read_params()
         for index, value in changes:
             values = host.set_param(index, value)

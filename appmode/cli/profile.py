@@ -6,10 +6,11 @@ from __future__ import annotations
 import argparse
 import sys
 
+from appmode.board.profiles import load
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers
 from appmode.protocol import param_values
-from appmode.protocol.profile_file import SHIPPED, Field, ProfileError, ProfileFile, load
+from appmode.protocol.profile_file import SHIPPED, Field, ProfileError, ProfileFile
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -53,8 +54,7 @@ def run(args: argparse.Namespace) -> int:
         print(exc, file=sys.stderr)
         return 1
     if args.toml:
-        with open(profile.path, encoding="utf-8") as file:
-            sys.stdout.write(file.read())
+        sys.stdout.write(profile.text)
         return 0
     sys.stdout.write(shown(profile))
     return 0

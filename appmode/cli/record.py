@@ -6,7 +6,7 @@ import argparse
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.monitor import add_limits, run_monitor
-from appmode.cli.options import Subparsers, add_url, file_name
+from appmode.cli.options import Subparsers, add_url, board_choice, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -26,7 +26,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     return run_monitor(
-        args.url,
+        board_choice(args),
         as_json=False,
         duration=args.duration,
         count=args.count,

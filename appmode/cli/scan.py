@@ -47,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     from appmode.bluetooth.availability import NO_BLEAK, explain
 
     try:
-        from appmode.bluetooth.scan import Found, scan
+        from appmode.bluetooth.links.scan import Found, scan
     except ImportError:
         raise AppmodeError(NO_BLEAK) from None
     shown = sys.stderr.isatty()
@@ -108,6 +108,7 @@ def _probe(urls: list[str], shown: bool) -> dict[str, str | None]:
     import threading
 
     from appmode.host.probe import probe
+    from appmode.ports.target import parse_target
 
     stop = threading.Event()
     answers: dict[str, str | None] = {}
@@ -118,7 +119,7 @@ def _probe(urls: list[str], shown: bool) -> dict[str, str | None]:
                 sys.stderr.write(f"\r\033[Kprobing {url}: {text}")
                 sys.stderr.flush()
 
-        finding = probe(url, stop, say)
+        finding = probe(parse_target(url), stop, say)
         answers[url] = (finding.profile or "unknown") if finding.is_car else None
     if shown:
         sys.stderr.write("\r\033[K")

@@ -16,16 +16,13 @@ from appmode.cli.options import (
     add_record,
     add_uart2,
     add_url,
-    layout_for,
+    board_choice,
     number_type,
-    profile_for,
-    stop_again_for,
 )
 from appmode.host.token_help import APP_TOKENS, CONTROL_TOKENS
 
 if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
-    from appmode.ports.target import Target
-    from appmode.protocol.layouts import Layout
+    from appmode.ports.choice import BoardChoice
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -60,15 +57,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    args.url = args.url.with_sim(profile=args.profile)
-    if args.uart2:
+    choice = board_choice(args)
+    if choice.control:
         from appmode.cli import uart2  # here: start-up stays short
 
-        profile_for(args.url, args.profile).check_uart2()
         return uart2.run_send(
-            args.url,
+            choice,
             args.tokens,
-            profile=profile_for(args.url, args.profile),
             listen=args.listen,
             report=not args.no_report,
             as_json=args.json,
@@ -76,21 +71,18 @@ def run(args: argparse.Namespace) -> int:
             out=sys.stdout,
         )
     return run_send(
-        args.url,
+        choice,
         args.tokens,
         listen=args.listen,
         raw=args.raw,
         as_json=args.json,
         record=args.record,
         out=sys.stdout,
-        layout=layout_for(args.url, args.profile),
-        stop_again=stop_again_for(args.url, args.profile),
-        frames_stop=profile_for(args.url, args.profile).steer_in_frames,
     )
 
 
 def run_send(
-    url: Target,
+    choice: BoardChoice,
     tokens: list[str],
     *,
     listen: float,
@@ -98,23 +90,18 @@ def run_send(
     as_json: bool,
     record: str | None,
     out: TextIO,
-    layout: Layout,
-    stop_again: bytes | None = None,
-    frames_stop: bool = False,
 ) -> int:
-    """Send the tokens in order, printing what comes back; `Z` is always sent last (and
-    with `stop_again`, confirmed on the board's A records). `frames_stop`: every frame
-    stops this board's car (§13)."""
+    """Send the tokens in order, printing what comes back; `Z` is always sent last,
+    confirmed on the board's A records (the board's profile says what else stops it)."""
     from appmode.cli.hostio import open_host, show
-    from appmode.host.tokens import Wait, parse_token
+    from appmode.host.app.tokens import parse_token
+    from appmode.host.waits import Wait
     from appmode.protocol.app_decoders import HostDecoder
     from appmode.protocol.render import describe, line
 
     steps = [parse_token(token, raw) for token in tokens]  # all checked before sending
     with ExitStack() as stack:
-        host = open_host(
-            stack, url, record, layout=layout, stop_again=stop_again, frames_stop=frames_stop
-        )
+        host = open_host(stack, choice, record, confirm_stop=True)
         for step in steps:
             if isinstance(step, Wait):
                 for event in host.events(step.seconds):

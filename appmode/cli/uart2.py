@@ -9,20 +9,19 @@ from collections.abc import Iterable
 from contextlib import ExitStack
 from typing import TYPE_CHECKING, TextIO
 
-from appmode.board.profiles import SHEET, Profile
 from appmode.cli.hostio import until_count, with_recording
-from appmode.host.control_client import ControlHost, Event
-from appmode.host.control_state import PortMode
-from appmode.host.control_tokens import Step, parse_setting, parse_token, perform
-from appmode.host.state import LinkStatus
-from appmode.host.tokens import Wait
+from appmode.host.control.client import ControlHost, Event
+from appmode.host.control.state import PortMode
+from appmode.host.control.tokens import Step, parse_setting, parse_token, perform
+from appmode.host.events import LinkStatus
+from appmode.host.waits import Wait
 from appmode.protocol import control, params, reader, settings
 from appmode.protocol.control_view import settings_table, view
 from appmode.protocol.render import line
 from appmode.text import counted, wrapped
 
 if TYPE_CHECKING:
-    from appmode.ports.target import Target
+    from appmode.ports.choice import BoardChoice
 
 QUIET_UART2 = (
     "a board sends replies only to reads, and encoder reports only while system_mode "
@@ -37,19 +36,12 @@ TAKEOVER = (
 
 
 def open_control_host(
-    stack: ExitStack,
-    url: Target,
-    record: str | None,
-    stop_on_close: bool = True,
-    profile: Profile = SHEET,
+    stack: ExitStack, choice: BoardChoice, record: str | None, stop_on_close: bool = True
 ) -> ControlHost:
-    """The control-port host, then its recording (hostio.with_recording). A profile
-    without drive types drives an omni car: nothing to read first."""
+    """The control-port host of the board chosen, then its recording
+    (hostio.with_recording)."""
     host = ControlHost(
-        url,
-        stop_on_close=stop_on_close,
-        drive=profile.fixed_drive,
-        takeover_byte=profile.takeover_byte,
+        choice.target, stop_on_close=stop_on_close, profile=choice.profile, drive=choice.drive
     )
     return with_recording(stack, host, record)
 
@@ -81,7 +73,7 @@ def show(
 
 
 def run_params(
-    url: Target,
+    choice: BoardChoice,
     assignments: list[str],
     *,
     store: str | None,
@@ -94,7 +86,7 @@ def run_params(
     changes = [parse_setting(text, f"--set {text!r}") for text in assignments]  # checked first
     print(f"appmode: {TAKEOVER}", file=sys.stderr)
     with ExitStack() as stack:
-        host = open_control_host(stack, url, record)
+        host = open_control_host(stack, choice, record)
         if store in ("load", "defaults"):
             host.store(store)
             print(f"{settings.STORE_BY_NAME[store].meaning} (sent)", file=sys.stderr)
@@ -107,7 +99,7 @@ def run_params(
         if store == "save":
             print(
                 "save requested (FF FE 80 80 00 80 00 00 03 00); the board does not confirm "
-                f"a save: restart it, then run appmode params {url} --uart2",
+                f"a save: restart it, then run appmode params {choice.target} --uart2",
                 file=sys.stderr,
             )
     if as_json:
@@ -121,7 +113,7 @@ def run_params(
 
 
 def run_send(
-    url: Target,
+    choice: BoardChoice,
     tokens: list[str],
     *,
     listen: float,
@@ -129,18 +121,18 @@ def run_send(
     as_json: bool,
     record: str | None,
     out: TextIO,
-    profile: Profile = SHEET,
 ) -> int:
     """Send the tokens in order, printing what comes back; the zero velocity frame is
     always sent last. `report` turns the encoder report on for the session (on a board
     that has one: a profile without settings frames has no reads and no report)."""
     steps = [parse_token(token) for token in tokens]  # all checked before sending
+    profile = choice.profile
     if profile.firmware_uart2 and any(
         isinstance(step, Step) and step.kind == "velocity" for step in steps
     ):
         print(f"appmode: note: {UNLIMITED}", file=sys.stderr)
     with ExitStack() as stack:
-        host = open_control_host(stack, url, record, profile=profile)
+        host = open_control_host(stack, choice, record)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         report_bit = params.MODE_BIT["encoder_report"]
         report = report and profile.answers_reads
@@ -176,7 +168,7 @@ def _drain(events: Iterable[Event]) -> None:
 
 
 def run_monitor(
-    url: Target,
+    choice: BoardChoice,
     *,
     as_json: bool,
     duration: float | None,
@@ -184,12 +176,11 @@ def run_monitor(
     record: str | None,
     out: TextIO,
     stop_on_exit: bool = False,
-    profile: Profile = SHEET,
 ) -> int:
     """Print replies and encoder reports as they arrive; passive unless `stop_on_exit`."""
     seen = errors = bursts = 0
     with ExitStack() as stack:
-        host = open_control_host(stack, url, record, stop_on_exit, profile)
+        host = open_control_host(stack, choice, record, stop_on_exit)
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         try:

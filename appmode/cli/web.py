@@ -42,8 +42,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from appmode.cli.drive import make_session
+    from appmode.cli.options import board_choice
     from appmode.ports.endpoints import parse_listen
+    from appmode.session.opener import open_session
     from appmode.web.access import is_loopback
     from appmode.web.bridge import driving
 
@@ -66,5 +67,5 @@ def run(args: argparse.Namespace) -> int:
     elif not is_loopback(host):
         cert, key = certificate.own_certificate(certificate.machine_names(host))
         tls, fingerprint = certificate.server_context(cert, key), certificate.fingerprint(cert)
-    session = make_session(args, driving(), None)
+    session = open_session(board_choice(args), driving(), record=args.record)
     return serve_web(session, host, port, tls, tuple(addresses), fingerprint)

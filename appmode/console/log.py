@@ -12,8 +12,8 @@ from prompt_toolkit.layout import Window
 from prompt_toolkit.layout.controls import BufferControl
 from prompt_toolkit.layout.dimension import Dimension
 
-from appmode.session.commands import LOG
-from appmode.session.status import WIDTH
+from appmode.session.command_line import LOG
+from appmode.session.rows import WIDTH
 from appmode.text import wrapped
 
 MESSAGES = 8

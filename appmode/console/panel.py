@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from appmode.console.panel_parts import Fragments, header, key_grid, keys_help, rows
 from appmode.console.waves import waveform_lines
-from appmode.host.state import TRACE_SECONDS
+from appmode.host.app.state import TRACE_SECONDS
 from appmode.session.base import BaseSession
-from appmode.session.status import WIDTH
+from appmode.session.rows import WIDTH
 
 
 def status_fragments(session: BaseSession, waveforms: bool = False) -> Fragments:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from prompt_toolkit.formatted_text import StyleAndTextTuples
 
 from appmode.session.base import BaseSession
-from appmode.session.status import WIDTH, Row, Tone
+from appmode.session.rows import WIDTH, Row, Tone
 
 Fragments = StyleAndTextTuples
 

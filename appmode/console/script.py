@@ -9,9 +9,9 @@ from collections.abc import Iterable, Iterator
 from typing import TextIO
 
 from appmode.console.panel import status_text
-from appmode.host.tokens import Wait
+from appmode.host.waits import Wait
 from appmode.session.base import BaseSession
-from appmode.session.commands import Quit, ShowHelp, ShowStatus, Step
+from appmode.session.command_line import Quit, ShowHelp, ShowStatus, Step
 
 REFRESH = 0.02
 """Seconds between reads of the link while time passes."""

@@ -38,10 +38,10 @@ from appmode.console.panel_parts import ARROWS, KEY_GRID, Fragments
 from appmode.console.script import show
 from appmode.files import data_folder
 from appmode.host import signals
-from appmode.host.tokens import Wait
+from appmode.host.waits import Wait
 from appmode.session.base import BaseSession
-from appmode.session.commands import QUIT_WORDS, Quit, ShowHelp
-from appmode.session.status import WIDTH
+from appmode.session.command_line import QUIT_WORDS, Quit, ShowHelp
+from appmode.session.rows import WIDTH
 
 REFRESH = 0.02
 """Seconds between reads of the link (and checks of the hold-to-drive timers)."""

@@ -3,7 +3,7 @@ line of block characters, scaled to its own range."""
 
 from __future__ import annotations
 
-from appmode.host.state import TRACE_SECONDS, HostState, Trace
+from appmode.host.app.state import TRACE_SECONDS, HostState, Trace
 from appmode.protocol import app
 
 LEVELS = "▁▂▃▄▅▆▇█"

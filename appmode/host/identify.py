@@ -51,7 +51,7 @@ class Judgement(NamedTuple):
 
 def judge(sent: Sent, profiles: Sequence[ProfileFile] | None = None) -> list[Judgement]:
     """Each profile's fit, the best first (those that fit before those that do not)."""
-    profiles = profiles or [profile_file.load(name) for name in profile_file.SHIPPED]
+    profiles = profiles or [profile_file.shipped(name) for name in profile_file.SHIPPED]
     found = [_judge(profile, sent) for profile in profiles]
     order = {id(j): i for i, j in enumerate(found)}
     return sorted(found, key=lambda j: (bool(j.against), len(j.against), -j.score, order[id(j)]))

@@ -18,7 +18,7 @@ import serial
 
 from appmode.errors import AppmodeError
 from appmode.host import signals
-from appmode.host.state import LinkStatus
+from appmode.host.events import LinkStatus
 from appmode.line.pacing import Ahead
 from appmode.line.wire import Tap
 from appmode.ports.target import Target, as_target

@@ -28,6 +28,7 @@ from appmode.errors import AppmodeError
 from appmode.line.faults import Faults, FaultSpec
 from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
 from appmode.ports.endpoints import Endpoint, Log, MakeEndpoint
+from appmode.ports.recording import open_recorder
 from appmode.ports.schedule import INPUT_BACKLOG, Served
 from appmode.ports.urls import BAUD
 from appmode.ports.wakeups import exact_wakeups, select_exactly
@@ -104,7 +105,7 @@ class BoardServer:
                 self._endpoints.append(pair[UART2])
             pairs.append(pair)
         self._recorder = (
-            Recorder.create(record, 0.0, directives, background=False) if record else None
+            open_recorder(record, 0.0, directives, background=False) if record else None
         )
         for pair, board in zip(pairs, boards, strict=True):
             if self._recorder is not None:

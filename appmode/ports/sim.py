@@ -20,7 +20,6 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import parse_qs, urlsplit
 
 import serial
 from serial import SerialBase, SerialException
@@ -31,24 +30,20 @@ from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec, FaultyLine
 from appmode.line.pacing import Line
-from appmode.line.wire import APP, PORTS, UART2, UART2_BAUD, Wire
+from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
+from appmode.ports.target import SIM_USAGE, Target
+from appmode.ports.urls import port_target
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
 from appmode.protocol.transcript import TIME_DIGITS
 
-OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults", "port", "share")
 BOARD_OPTIONS = ("profile", "drive", "flash", "pace")
 """The options that make the board: ports that share one must agree on them."""
 WRITE_BUFFER = 4096
+"""Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
 MIN_BAUD, MAX_BAUD = 300, 4_000_000
 """Paced rates a simulated line takes: below 300 bps closing (which waits for what is
 queued to go out) could take minutes."""
-"""Bytes a write may queue ahead of the line, like an OS serial buffer; then it blocks."""
-USAGE = (
-    "sim://[?profile=sheet|minibalance][&drive=omni|mecanum|diff|diff-gyro][&flash=FILE]"
-    "[&pace=1|0][&baud=9600]"
-    "[&faults=drop:0.01,corrupt:0.01,…][&port=app|uart2][&share=NAME]"
-)
 
 
 def _on_grid(seconds: float) -> float:
@@ -70,19 +65,6 @@ class Shared:
 
 _SHARED: dict[str, Shared] = {}
 _SHARED_LOCK = threading.Lock()
-
-
-def parse_sim_url(url: str) -> dict[str, str]:
-    """The options of a sim:// URL; SerialException says what is wrong."""
-    parts = urlsplit(url)
-    if parts.scheme != "sim" or parts.netloc or parts.path not in ("", "/"):
-        raise SerialException(f"expected {USAGE}, not {url!r}")
-    options: dict[str, str] = {}
-    for name, values in parse_qs(parts.query, keep_blank_values=True).items():
-        if name not in OPTIONS:
-            raise SerialException(f"unknown sim:// option {name!r}: use {', '.join(OPTIONS)}")
-        options[name] = values[-1]
-    return options
 
 
 def _flag(name: str, text: str) -> bool:
@@ -115,6 +97,8 @@ class SimSerial(SerialBase):  # type: ignore[misc]
         self.read_runs: list[tuple[float, int]] = []
         """The bytes the last read returned, as runs of (board time they arrived, count)."""
         self.board: Board | None = None
+        self.target: Target | None = None
+        """The board to open, parsed once (`ports.urls.port_target`)."""
         super().__init__(*args, **kwargs)
 
     def open(self) -> None:
@@ -122,10 +106,10 @@ class SimSerial(SerialBase):  # type: ignore[misc]
             raise SerialException("port is already open")
         if self._port is None:
             raise SerialException("port must be configured before it can be used")
-        options = parse_sim_url(self._port)
-        side = options.get("port", APP).lower()
-        if side not in PORTS:
-            raise SerialException(f"sim:// option port={side!r}: use {' or '.join(PORTS)}")
+        target = port_target(self)
+        if not target.simulated:
+            raise SerialException(f"expected {SIM_USAGE}, not {target.url!r}")
+        options, side = target.sim, target.sim_port
         try:
             drive = DriveType.from_cli_name(options["drive"]) if "drive" in options else None
         except ValueError as exc:

@@ -1,17 +1,21 @@
-"""A board's URL, parsed once into the `Target` every layer reads: what kind of link it
-is, a simulated board's options, a device's path and rate (docs/design.md, "Contracts").
-What a `ble://` or `bt://` address says is read by its port when it opens."""
+"""A board's URL, parsed once into the `Target` every layer reads (docs/design.md,
+"Contracts"): what kind of link it is, a simulated board's options, a device's path and
+rate, a Bluetooth module's address. A Target is a value: its `url` is made from its
+fields, and another board choice (`with_sim`, `for_uart2`) is a new Target, never text
+parsed again."""
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
-from urllib.parse import urlsplit
-
-from serial import SerialException
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import TypeAlias
+from urllib.parse import parse_qsl, unquote, urlsplit
 
 from appmode.errors import AppmodeError
-from appmode.line.wire import APP, UART2
+from appmode.line.wire import APP, PORTS, UART2
+from appmode.ports.radio import BadAddress, BleTarget, BtTarget, parse_ble, parse_bt
 from appmode.protocol import params
 
 SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt")
@@ -23,22 +27,41 @@ URL_HELP = (
     "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
     "rfc2217://HOST:PORT, ble://ADDRESS, bt://ADDRESS, loop:// or sim://"
 )
+SIM_OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults", "port", "share")
+"""What a sim:// URL may set (ports/sim.py says what each does)."""
+SIM_USAGE = (
+    "sim://[?profile=sheet|minibalance][&drive=omni|mecanum|diff|diff-gyro][&flash=FILE]"
+    "[&pace=1|0][&baud=9600]"
+    "[&faults=drop:0.01,corrupt:0.01,…][&port=app|uart2][&share=NAME]"
+)
+
+NO_OPTIONS: Mapping[str, str] = MappingProxyType({})
 
 
 @dataclass(frozen=True, slots=True)
 class Target:
-    """Where a board is, as `parse_target` read it from a URL."""
+    """Where a board is: `parse_target` reads one from a URL, once."""
 
-    url: str
-    """The URL as opened (and as messages show it)."""
     scheme: str
     """`sim`, `socket`, `rfc2217`, `loop`, `ble`, `bt`; "" for a device path."""
-    sim: dict[str, str] = field(default_factory=dict)
-    """A sim:// URL's options."""
+    address: str = ""
+    """What follows `scheme://` up to the options: HOST:PORT, a module's address or name."""
+    options: Mapping[str, str] = field(default_factory=lambda: NO_OPTIONS)
+    """The URL's options, in their order: a sim:// board's, a module's, pyserial's own."""
     path: str = ""
     """A device's path (without `?baud=`)."""
     baud: int | None = None
     """A device's `?baud=N`."""
+    radio: BleTarget | BtTarget | None = None
+    """What a `ble://` or `bt://` URL names."""
+
+    @property
+    def url(self) -> str:
+        """The URL as it opens (and as messages show it)."""
+        if not self.scheme:
+            return self.path if self.baud is None else f"{self.path}?baud={self.baud}"
+        query = "&".join(f"{k}={v}" if v else k for k, v in self.options.items())
+        return f"{self.scheme}://{self.address}{'?' if query else ''}{query}"
 
     def __str__(self) -> str:
         return self.url
@@ -53,15 +76,15 @@ class Target:
         return self.scheme in NETWORK_SCHEMES
 
     @property
-    def radio(self) -> bool:
-        """A Bluetooth module reached directly (ble://, bt://)."""
-        return self.scheme in RADIO_SCHEMES
-
-    @property
     def numbered_pty(self) -> bool:
         """A pseudo-terminal named by its number (/dev/pts/N, /dev/ttysN): once it is gone
         it never comes back, and the number may soon name another program's terminal."""
         return NUMBERED_PTY.fullmatch(self.path) is not None
+
+    @property
+    def sim(self) -> Mapping[str, str]:
+        """A sim:// URL's options (none for any other URL)."""
+        return self.options if self.simulated else NO_OPTIONS
 
     @property
     def sim_port(self) -> str:
@@ -87,47 +110,83 @@ class Target:
         targets as they are."""
         if not self.simulated:
             return self
-        url = self.url
+        added: dict[str, str] = {}
         for name, value in options.items():
             if not value:
                 continue
             if name not in self.sim:
-                url += f"{'&' if '?' in url else '?'}{name}={value}"
+                added[name] = value
             elif self.sim[name] != value:
                 raise AppmodeError(
                     f"{self.url} sets {name}={self.sim[name]}, and --{name} {value} another: "
                     f"give the {name} once"
                 )
-        return parse_target(url) if url != self.url else self
+        return replace(self, options=_frozen({**self.options, **added})) if added else self
 
     def for_uart2(self) -> Target:
         """The control port of this target: a sim:// URL without `port=` opens the
         simulated board's UART2; anything else is the port it names."""
-        return self.with_sim(port=UART2) if self.simulated and "port" not in self.sim else self
+        return self.on_port(UART2) if self.simulated and "port" not in self.sim else self
+
+    def on_port(self, port: str) -> Target:
+        """The same simulated board's `port` (`app` or `uart2`)."""
+        return replace(self, options=_frozen({**self.options, "port": port}))
+
+
+AnyTarget: TypeAlias = "Target | str"
+"""What the public API takes for a board (`appmode.Host`, `ControlHost`, `open_link`): a
+Target, or a URL it parses once."""
 
 
 def parse_target(url: str) -> Target:
     """`url` as a Target; AppmodeError says what is wrong and how to write it."""
     if "://" not in url:
         path, baud = parse_device(url)
-        return Target(url, "", path=path, baud=baud)
+        return Target("", path=path, baud=baud)
     scheme = url.split("://", 1)[0].lower()
     if scheme not in SCHEMES:
         raise AppmodeError(f"unknown URL scheme {scheme + '://'!r} in {url!r}: {URL_HELP}")
     if scheme in NETWORK_SCHEMES:
         _check_address(url, scheme)
+    try:
+        parts = urlsplit(url)
+    except ValueError as exc:  # an unclosed [ in a module's address
+        raise AppmodeError(f"{url!r} is not a URL ({exc}): {URL_HELP}") from None
+    options = _frozen(dict(parse_qsl(parts.query, keep_blank_values=True)))
     if scheme == "sim":
-        from appmode.ports.sim import parse_sim_url
-
+        _check_sim(url, parts.netloc, parts.path, options)
+    address = unquote(parts.netloc) + (parts.path if scheme in NETWORK_SCHEMES else "")
+    radio: BleTarget | BtTarget | None = None
+    if scheme in RADIO_SCHEMES:
+        if parts.path not in ("", "/"):
+            address = ""  # a path is no part of a module's address: the usage says so
         try:
-            return Target(url, scheme, sim=parse_sim_url(url))
-        except SerialException as exc:
+            parse = parse_ble if scheme == "ble" else parse_bt
+            radio = parse(address, options, url)
+        except BadAddress as exc:
             raise AppmodeError(str(exc)) from None
-    return Target(url, scheme)
+    return Target(scheme, address, options, radio=radio)
 
 
-def as_target(url: Target | str) -> Target:
+def as_target(url: AnyTarget) -> Target:
+    """A Target as it is; a URL (the public API's) parsed once."""
     return url if isinstance(url, Target) else parse_target(url)
+
+
+def _frozen(options: dict[str, str]) -> Mapping[str, str]:
+    return MappingProxyType(options)
+
+
+def _check_sim(url: str, netloc: str, path: str, options: Mapping[str, str]) -> None:
+    """A sim:// URL names only its options; a port= is one of the board's two."""
+    if netloc or path not in ("", "/"):
+        raise AppmodeError(f"expected {SIM_USAGE}, not {url!r}")
+    for name in options:
+        if name not in SIM_OPTIONS:
+            raise AppmodeError(f"unknown sim:// option {name!r}: use {', '.join(SIM_OPTIONS)}")
+    side = options.get("port", APP).lower()
+    if side not in PORTS:
+        raise AppmodeError(f"sim:// option port={side!r}: use {' or '.join(PORTS)}")
 
 
 def _check_address(url: str, scheme: str) -> None:
@@ -149,12 +208,10 @@ def parse_device(url: str, baud: int | None = None) -> tuple[str, int | None]:
     path, _, query = url.partition("?")
     if not path:
         raise AppmodeError(f"empty port name in {url!r}: {URL_HELP}")
-    from urllib.parse import parse_qs
-
-    for name, values in parse_qs(query, keep_blank_values=True).items():
+    for name, value in parse_qsl(query, keep_blank_values=True):
         if name != "baud":
             raise AppmodeError(f"unknown option {name!r} in {url!r}: only ?baud=N is known")
-        if not params.whole(values[-1]):
-            raise AppmodeError(f"bad baud rate {values[-1]!r} in {url!r}: use e.g. ?baud=9600")
-        baud = int(values[-1].strip())
+        if not params.whole(value):
+            raise AppmodeError(f"bad baud rate {value!r} in {url!r}: use e.g. ?baud=9600")
+        baud = int(value.strip())
     return path, baud

@@ -14,6 +14,7 @@ Every failure to open becomes one AppmodeError that says what to do.
 from __future__ import annotations
 
 import errno
+import importlib
 import os
 from typing import TYPE_CHECKING
 
@@ -21,20 +22,25 @@ import serial
 
 from appmode.errors import AppmodeError
 from appmode.ports.holders import holders
-from appmode.ports.target import Target, as_target
+from appmode.ports.target import AnyTarget, Target, as_target, parse_target
 
 if TYPE_CHECKING:
     from appmode.ports.newpty import PtyPort
 
 NO_PTY = "this system has no pseudo-terminals (Windows)"
 
-for _package in ("appmode.ports", "appmode.bluetooth"):  # sim://; ble:// and bt://
+for _package in ("appmode.ports", "appmode.bluetooth.links"):  # sim://; ble:// and bt://
     if _package not in serial.protocol_handler_packages:
         serial.protocol_handler_packages.append(_package)
 
 BAUD = 9600
-OWN_WORDS = ("sim", "ble", "bt")
-"""Schemes whose ports say themselves what went wrong and what to do."""
+OWN_PORTS = {
+    "sim": "appmode.ports.protocol_sim",
+    "ble": "appmode.bluetooth.links.protocol_ble",
+    "bt": "appmode.bluetooth.links.protocol_bt",
+}
+"""appmode's own port classes (pyserial's handlers for these schemes): they take the
+Target itself, and say themselves what went wrong and what to do."""
 
 
 class LinkLeft(ConnectionError):
@@ -42,25 +48,43 @@ class LinkLeft(ConnectionError):
     appmode serves): the end of a session, not a fault."""
 
 
-def open_link(
-    url: Target | str, timeout: float | None = 0.05, baud: int = BAUD
-) -> serial.SerialBase:
+def open_link(url: AnyTarget, timeout: float | None = 0.05, baud: int = BAUD) -> serial.SerialBase:
     """An open pyserial port for `url`, at `baud` (9600) 8N1 unless the URL says otherwise."""
     target = as_target(url)
-    if target.scheme:
-        try:
-            return serial.serial_for_url(target.url, baudrate=baud, timeout=timeout)
-        except (serial.SerialException, ValueError, OSError) as exc:
-            raise AppmodeError(explain_open_error(target.url, exc, target.scheme)) from None
     try:
+        if target.scheme in OWN_PORTS:
+            return _own_port(target, baud, timeout)
+        if target.scheme:
+            return serial.serial_for_url(target.url, baudrate=baud, timeout=timeout)
         return serial.Serial(
-            target.path,
-            baudrate=target.baud or baud,
-            timeout=timeout,
-            exclusive=os.name == "posix",
+            target.path, baudrate=target.baud or baud, timeout=timeout, exclusive=os.name == "posix"
         )
     except (serial.SerialException, ValueError, OSError) as exc:
-        raise AppmodeError(explain_open_error(target.path, exc)) from None
+        where = target.url if target.scheme else target.path
+        raise AppmodeError(explain_open_error(where, exc, target.scheme)) from None
+
+
+def _own_port(target: Target, baud: int, timeout: float | None) -> serial.SerialBase:
+    """One of appmode's own ports, given the Target (nothing parses its URL again)."""
+    port: serial.SerialBase = importlib.import_module(OWN_PORTS[target.scheme]).Serial(
+        None, baudrate=baud, timeout=timeout
+    )
+    port.target = target
+    port.port = target.url
+    port.open()
+    return port
+
+
+def port_target(port: serial.SerialBase) -> Target:
+    """The Target an own port opens: the one `open_link` gave it, else its name parsed (a
+    program that opens `serial.serial_for_url("sim://…")`); SerialException if bad."""
+    given = getattr(port, "target", None)
+    if isinstance(given, Target):
+        return given
+    try:
+        return parse_target(port.portstr)
+    except AppmodeError as exc:
+        raise serial.SerialException(str(exc)) from None
 
 
 LIST_PORTS = "list ports with: appmode ports"
@@ -83,7 +107,7 @@ def is_rfcomm(where: str) -> bool:
 def explain_open_error(where: str, exc: Exception, scheme: str = "") -> str:
     code = getattr(exc, "errno", None)
     text = str(exc)
-    if scheme in OWN_WORDS:  # the port's own message: what, then the fix
+    if scheme in OWN_PORTS:  # the port's own message: what, then the fix
         return text
     if code == errno.ENOENT or "No such file" in text:
         if is_rfcomm(where):

@@ -24,7 +24,7 @@ class Page(Enum):
 
 
 PAGE_LETTERS: dict[str, Page] = {"I": Page.DIRECTION, "J": Page.DIRECTION, "K": Page.BUTTON}
-PAGE_NAMES: dict[str, str] = dict(profile_file.load("sheet").pages)
+PAGE_NAMES: dict[str, str] = dict(profile_file.shipped("sheet").pages)
 """The app's page each letter switches to, as the sheet's profile file names them."""
 STOP_LETTER = "Z"
 

@@ -6,8 +6,6 @@ picks a layout (`--profile`); every layout comes from a profile's file."""
 
 from __future__ import annotations
 
-from functools import cache
-
 from appmode.protocol import profile_file
 from appmode.protocol.app_decoders import BoardDecoder
 from appmode.protocol.profile_file import Field, ParamSpec, ProfileFile
@@ -95,7 +93,7 @@ class Layout(Frozen):
                 i for i, field in enumerate(a) if field.unit and i not in motion and i != battery
             ),
             "speed_index": None if speed is None else param_names.index(speed),
-            "sheet_b": b_names == tuple(f.name for f in profile_file.load("sheet").b),
+            "sheet_b": b_names == tuple(f.name for f in profile_file.shipped("sheet").b),
         }
         for key, value in derived.items():
             object.__setattr__(self, key, value)
@@ -109,16 +107,6 @@ class Layout(Frozen):
         return BoardDecoder(len(self.b_fields), len(self.params))
 
 
-VELOCITY = Layout("velocity", profile_file.load("sheet"))
-SCALED = Layout("scaled", profile_file.load("minibalance"))
+VELOCITY = Layout("velocity", profile_file.shipped("sheet"))
+SCALED = Layout("scaled", profile_file.shipped("minibalance"))
 A_LAYOUTS: dict[str, Layout] = {layout.name: layout for layout in (VELOCITY, SCALED)}
-
-
-@cache
-def named(profile: str) -> Layout:
-    """The layout of a profile by name or file (ProfileError when it does not read)."""
-    shipped = {"sheet": VELOCITY, "minibalance": SCALED}
-    if profile in shipped:
-        return shipped[profile]
-    loaded = profile_file.load(profile)
-    return Layout(loaded.name, loaded)

@@ -34,7 +34,7 @@ class Param(NamedTuple):
         return f"{self.minimum}–{self.maximum}"
 
 
-SPECS: tuple[profile_file.ParamSpec, ...] = profile_file.load("sheet").params
+SPECS: tuple[profile_file.ParamSpec, ...] = profile_file.shipped("sheet").params
 """The sheet's nine as its file declares them (`param_values` reads any profile's)."""
 PARAMS: tuple[Param, ...] = tuple(
     Param(i, p.name, p.label, p.maximum, p.default, p.minimum) for i, p in enumerate(SPECS)

@@ -9,10 +9,10 @@ shipped `sheet` and `minibalance` files: one source of truth.
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Callable, Mapping
 from functools import cache
+from importlib import resources
 from typing import Any, NamedTuple
 
 if sys.version_info >= (3, 11):
@@ -28,7 +28,6 @@ NAME_CHARACTERS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
 a command word)."""
 MAX_SIZE = 256_000
 """The largest profile file read, in bytes."""
-FOLDER = os.path.join(os.path.dirname(__file__), "profiles")
 A_FIELDS = 4
 """Fields of an A record: `{A f0:f1:f2:f3}$` for every firmware of the family."""
 MAX_FIELDS = 9
@@ -99,31 +98,18 @@ class ProfileFile(NamedTuple):
     boot: str
     """Text its start-up output holds (the sensor's messages), or ""."""
     path: str
-    """Where it was read from."""
-
-
-def shipped_path(name: str) -> str:
-    return os.path.join(FOLDER, f"{name}.toml")
+    """Where it was read from (a file's path, or a shipped profile's name)."""
+    text: str
+    """The file as it was read (`profile show --toml` prints it)."""
 
 
 @cache
-def load(source: str) -> ProfileFile:
-    """A shipped profile by name, or a file by path; ProfileError says what is wrong."""
-    path = shipped_path(source) if source in SHIPPED else source
-    try:
-        if not os.path.isfile(path):  # a FIFO would wait for a writer, a device forever
-            raise OSError(0, "not a regular file" if os.path.exists(path) else "no such file")
-        if os.path.getsize(path) > MAX_SIZE:
-            raise OSError(0, f"over {MAX_SIZE // 1000} kB: a profile is a few kB")
-        with open(path, encoding="utf-8") as file:
-            text = file.read(MAX_SIZE + 1)
-    except (OSError, UnicodeDecodeError) as exc:
-        known = ", ".join(SHIPPED)
-        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise ProfileError(
-            source, [f"cannot read it ({why}): give a file or one of {known}"]
-        ) from None
-    return parse(text, path)
+def shipped(name: str) -> ProfileFile:
+    """A profile appmode ships, from the package's own data (`profiles/NAME.toml`)."""
+    if name not in SHIPPED:
+        raise ProfileError(name, [f"no shipped profile: choose one of {', '.join(SHIPPED)}"])
+    text = resources.files(__package__).joinpath("profiles", f"{name}.toml").read_text("utf-8")
+    return parse(text, f"{name} (shipped)")
 
 
 def parse(text: str, where: str) -> ProfileFile:
@@ -138,11 +124,11 @@ def parse(text: str, where: str) -> ProfileFile:
         if like not in SHIPPED or like == data.get("name"):
             problems.append(f"like = {like!r}: name a shipped profile ({', '.join(SHIPPED)})")
         else:
-            base = load(like)
+            base = shipped(like)
     profile = _build(data, base, where, problems.append)
     if problems or profile is None:
         raise ProfileError(where, problems)
-    return profile
+    return profile._replace(text=text)
 
 
 TOP = {
@@ -222,6 +208,7 @@ def _build(
         speed_param,
         boot,
         where,
+        "",
     )
 
 

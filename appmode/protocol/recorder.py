@@ -3,16 +3,12 @@ happens: `Recorder`, a tap on both ports that writes one protocol unit a line.""
 
 from __future__ import annotations
 
-import contextlib
 import itertools
 import math
-import os
 from collections import deque
-from functools import partial
 from typing import TextIO
 
 from appmode.errors import AppmodeError
-from appmode.files import is_fifo, open_fifo
 from appmode.protocol.escaping import escape
 from appmode.protocol.reader import APP_EVENTS, Event, PortsReader
 from appmode.protocol.transcript import (
@@ -24,14 +20,6 @@ from appmode.protocol.transcript import (
 )
 from appmode.writer import CLOSE_WAIT, BoundedWriter, reason
 
-_CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
-HEADER_WAIT = 0.1
-"""Seconds `Recorder.create` waits to see a file take its header once its writer's
-thread has run (a file or device takes it at once; a full one fails then, and the
-caller is told)."""
-THREAD_WAIT = 5.0
-"""Seconds `Recorder.create` waits for that thread to run at all: on a busy machine one
-not scheduled for 0.1 s had its empty file refused as if full."""
 HOLD = 0.5
 """Seconds a recorder waits for a unit to end before writing it as far as it goes (the
 lines after it wait too: the file stays in time order)."""
@@ -97,14 +85,15 @@ class Recorder:
         origin: float = 0.0,
         directives: tuple[str, ...] = (),
         name: str | None = None,
+        closes: bool = False,
     ) -> None:
+        """`out`: a stream (written at once, and left open unless `closes`), or a bounded
+        writer (written off the caller's thread, closed with the recorder)."""
         self._out = out
-        """A stream given by the caller (written at once, and left open), or the bounded
-        writer of a file `create` opened (written off the caller's thread)."""
         self.name = name or str(getattr(out, "name", "the transcript"))
         self._failed = False
         self._closed = False
-        self._closes = False  # a file `create` opened, written on the caller's thread
+        self._closes = closes
         self._origin = origin
         self._reader = PortsReader()
         self._held = {direction: _Held() for direction in DIRECTIONS}
@@ -113,57 +102,6 @@ class Recorder:
         is APP text (§12) — as decoded, whatever the mode when it is written."""
         self._order = itertools.count()  # keeps lines of one time in the order they came
         self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
-
-    @classmethod
-    def create(
-        cls,
-        path: str | os.PathLike[str],
-        origin: float = 0.0,
-        directives: tuple[str, ...] = (),
-        background: bool = True,
-    ) -> Recorder:
-        """A recorder of the file `path`, written by a `BoundedWriter`: a full disk, a
-        FIFO nobody reads or a stalled reader never holds up the caller (the recording
-        stops, and the next call or `close` says why). With `background` False it is
-        written on the caller's thread, which its reader may slow down (a simulated
-        board's own recording: nothing waits for it, and a flood is recorded whole)."""
-        shown = os.fspath(path)
-        if is_fifo(path) and background:  # its open waits for a reader: in the writer
-            opener = partial(open_fifo, path, "transcript", "the session goes on meanwhile")
-            return cls(BoundedWriter(opener, shown), origin, directives)
-        new = not os.path.lexists(path)
-        try:
-            if is_fifo(path):
-                fd = open_fifo(path, "transcript")
-            else:
-                fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | _CLOEXEC, 0o666)
-        except OSError as exc:
-            raise AppmodeError(f"cannot write transcript {shown}: {exc.strerror}") from None
-        try:
-            if not background:
-                out = os.fdopen(fd, "w", encoding="utf-8")
-                try:
-                    recorder = cls(out, origin, directives, shown)
-                except AppmodeError:  # not even the header fits
-                    with contextlib.suppress(OSError):
-                        out.close()
-                    raise
-                recorder._closes = True
-                return recorder
-            recorder = cls(BoundedWriter(lambda: fd, shown), origin, directives)
-            writer = recorder._out
-            assert isinstance(writer, BoundedWriter)
-            writer.ran(THREAD_WAIT)
-            if not writer.drained(HEADER_WAIT):  # not even the header fits (a full disk)
-                why = writer.failure or f"its first line unwritten after {HEADER_WAIT:g} s"
-                writer.close(0.0)
-                raise AppmodeError(f"cannot write transcript {shown}: {why}")
-        except AppmodeError:
-            if new:  # leave nothing
-                with contextlib.suppress(OSError):
-                    os.unlink(path)
-            raise
-        return recorder
 
     def __call__(self, direction: str, time: float, data: bytes) -> None:
         self._held[direction].add(data, time)

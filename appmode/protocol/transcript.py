@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import codecs
 import itertools
-import os
 import re
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -113,44 +112,12 @@ def parse_transcript(text: str, path: str = "<transcript>") -> Transcript:
     lines = text.removeprefix("\ufeff").split("\n")  # a BOM some editors write
     last = len(lines)
     numbered = ((n, line.encode(), n < last) for n, line in enumerate(lines, start=1))
-    return _parse(numbered, path)
+    return parse_lines(numbered, path)
 
 
-def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
-    """Read a transcript file; TranscriptError (file:line, with `name` in place of the
-    path if given) or AppmodeError if unreadable. Read a line at a time, each at most
-    MAX_LINE bytes: a file that is no transcript (/dev/zero, a binary) fails at once. A
-    last line cut short (a recording stopped by a full disk) is left out, with a warning
-    in `warnings`."""
-    name = name or os.fspath(path)
-    try:
-        with open(path, "rb") as handle:
-            return _parse(_file_lines(handle, name), name)
-    except OSError as exc:
-        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
-
-
-def iter_transcript(
-    path: str | os.PathLike[str], warn: Callable[[str], None], directives_only: bool = False
-) -> Iterator[Entry | Directive]:
-    """The lines of a transcript file one at a time, in constant memory, as
-    `read_transcript` reads them; `warn` hears of a last line cut short. With
-    `directives_only`, only the `@` lines are read (a quick first pass)."""
-    name = os.fspath(path)
-    try:
-        with open(path, "rb") as handle:
-            lines = _file_lines(handle, name)
-            if directives_only:
-                lines = (line for line in lines if line[1].lstrip().startswith(b"@"))
-            for item in _items(lines, name, warn):
-                if not isinstance(item, str):
-                    yield item
-    except OSError as exc:
-        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
-
-
-def _file_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, bytes, bool]]:
-    """(line number, bytes, whether a newline ended it)."""
+def stream_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, bytes, bool]]:
+    """A transcript's lines from an open stream, a line at a time, each at most
+    MAX_LINE bytes: (line number, bytes, whether a newline ended it)."""
     for lineno in itertools.count(1):
         raw = handle.readline(MAX_LINE + 1)
         if not raw:
@@ -164,11 +131,12 @@ def _file_lines(handle: BinaryIO, name: str) -> Iterator[tuple[int, bytes, bool]
         yield lineno, raw.removesuffix(b"\n"), raw.endswith(b"\n")
 
 
-def _parse(lines: Iterable[tuple[int, bytes, bool]], path: str) -> Transcript:
+def parse_lines(lines: Iterable[tuple[int, bytes, bool]], path: str) -> Transcript:
+    """A Transcript of numbered lines (`stream_lines`); TranscriptError if one is bad."""
     items: list[Entry | Directive] = []
     warnings: list[str] = []
     title = ""
-    for item in _items(lines, path, warnings.append):
+    for item in line_items(lines, path, warnings.append):
         if isinstance(item, str):
             title = title or item
         else:
@@ -176,7 +144,7 @@ def _parse(lines: Iterable[tuple[int, bytes, bool]], path: str) -> Transcript:
     return Transcript(path, tuple(items), title, tuple(warnings))
 
 
-def _items(
+def line_items(
     lines: Iterable[tuple[int, bytes, bool]], path: str, warn: Callable[[str], None]
 ) -> Iterator[Entry | Directive | str]:
     """Each line's item; a comment as its text (the first one is the title)."""

@@ -15,10 +15,11 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from appmode.errors import AppmodeError
 from appmode.host import signals
 from appmode.host.link import UNDELIVERED, Link
-from appmode.ports.target import Target, as_target
+from appmode.ports.recording import open_recorder
+from appmode.ports.target import Target
 from appmode.protocol.recorder import Recorder
 from appmode.session.authority import LAPSE, StopGuard
-from appmode.session.commands import (
+from appmode.session.command_line import (
     COMMON,
     COMMON_ALIASES,
     LOG,
@@ -31,11 +32,11 @@ from appmode.text import wrapped
 from appmode.writer import CLOSE_WAIT
 
 if TYPE_CHECKING:
-    from appmode.host.client import Host
-    from appmode.host.control_client import ControlHost
-    from appmode.host.state import HostState
+    from appmode.host.app.client import Host
+    from appmode.host.app.state import HostState
+    from appmode.host.control.client import ControlHost
     from appmode.session.instruments import Instruments
-    from appmode.session.status import Row
+    from appmode.session.rows import Row
 
 
 class BaseSession(ABC):
@@ -56,11 +57,11 @@ class BaseSession(ABC):
 
     def __init__(
         self,
-        url: Target | str,
+        target: Target,
         driving: HoldToDrive | None,
         on_message: Callable[[str], None] | None,
     ) -> None:
-        self.target = as_target(url)
+        self.target = target
         self.url = self.target.url
         self.simulated = self.target.simulated
         self.driving = driving or HoldToDrive()
@@ -320,7 +321,7 @@ class BaseSession(ABC):
         """Record from now on, times counted from `origin` (default: now)."""
         try:
             start = self.now() if origin is None else origin
-            recorder = Recorder.create(path, start, self.target.directives)
+            recorder = open_recorder(path, start, self.target.directives)
         except AppmodeError as exc:
             if self.recorder is None:
                 raise

@@ -9,7 +9,8 @@ from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from appmode.host.state import HostState, LinkStats
+from appmode.host.app.state import HostState
+from appmode.host.stats import LinkStats
 from appmode.protocol import app
 
 LinkState = Literal["up", "late", "degraded", "lost", "opening", "silent"]

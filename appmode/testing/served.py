@@ -31,8 +31,9 @@ from appmode.ports.endpoints import MakeEndpoint, PtyEndpoint, TcpEndpoint
 from appmode.ports.serve import BoardServer
 from appmode.protocol import params
 from appmode.protocol.params import DriveType
-from appmode.protocol.transcript import Transcript, read_transcript
+from appmode.protocol.transcript import Transcript
 from appmode.transcript.matcher import Check
+from appmode.transcript.reading import read_transcript
 from appmode.transcript.recorded import check_recorded
 
 LOG_LINES = 1000
@@ -249,7 +250,7 @@ class ServedBoard:
 def _bluetooth() -> MakeEndpoint:
     """The BlueZ stand-in on a private bus (Linux; needs dbus-daemon and dbus-fast)."""
     try:
-        from appmode.bluetooth.endpoint import BluetoothEndpoint
+        from appmode.bluetooth.standin.endpoint import BluetoothEndpoint
     except ImportError:
         raise AppmodeError(
             "appmode_ble_board needs the bluetooth extra: pip install 'appmode[bluetooth]'"

@@ -21,14 +21,7 @@ from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT2, PortsReader
 from appmode.protocol.render import json_keys, line, record_names
-from appmode.protocol.transcript import (
-    DIRECTIONS,
-    Directive,
-    Entry,
-    Transcript,
-    iter_transcript,
-    read_transcript,
-)
+from appmode.protocol.transcript import DIRECTIONS, Directive, Entry, Transcript
 from appmode.transcript.matcher import (
     BoardNeeds,
     BytesPattern,
@@ -37,6 +30,7 @@ from appmode.transcript.matcher import (
     board_needs,
     parse_pattern,
 )
+from appmode.transcript.reading import iter_transcript, read_transcript
 
 Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent
 

@@ -23,12 +23,12 @@ from typing import TYPE_CHECKING
 import serial
 
 from appmode.errors import AppmodeError
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.ports.urls import new_pty, open_link
 from appmode.ports.wakeups import exact_wakeups
 from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
 from appmode.protocol.render import describe, line
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 
 if TYPE_CHECKING:
     from appmode.ports.newpty import PtyPort

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import itertools
 import sys
 import time
 import xml.etree.ElementTree as ET
@@ -20,18 +19,19 @@ from appmode.board.profiles import Profile, profile_named
 from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.host.link import LinkLost
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
-from appmode.ports.target import Target, as_target
+from appmode.ports.choice import both_ports
+from appmode.ports.target import Target
 from appmode.ports.urls import open_link
 from appmode.protocol import app, app_decoders, param_values, params
-from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
-from appmode.protocol.transcript import SUFFIX, Transcript, read_transcript
+from appmode.protocol.transcript import SUFFIX, Transcript
 from appmode.text import wrapped
 from appmode.transcript.matcher import Check
+from appmode.transcript.reading import read_transcript
 
 Progress = Callable[[str], None]
 
@@ -104,33 +104,23 @@ def _result(transcript: Transcript, check: Check, now: float, wall: float) -> Re
     return Result(transcript.path, transcript.title, failure is None, now, wall, failure)
 
 
-def _shared(target: Target) -> tuple[Target, Target]:
-    """Both ports of one new sim:// board."""
-    base = target.with_sim(share=f"conform-{next(_SHARES)}")
-    return base, base.for_uart2()
-
-
-_SHARES = itertools.count(1)
-
-
 def run_live(
     transcript: Transcript,
-    url: Target | str,
+    url: Target,
     progress: Progress | None = None,
-    url2: Target | str | None = None,
+    url2: Target | None = None,
 ) -> Result:
     """Run in real time against any board URL (and its control port at `url2`)."""
-    url = as_target(url)
     started = time.perf_counter()
     check = Check(transcript)
     link2 = None
     if check.uses_uart2:
         if url2 is None and url.simulated:
-            url, url2 = _shared(url)
+            url, url2 = both_ports(url)
         if url2 is None:
             why = "has UART2 lines: give the board's control port with --board2 URL"
             return Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
-    with Host(url, layout=check.needs.profile.a_layout) as host, contextlib.ExitStack() as stack:
+    with Host(url, profile=check.needs.profile) as host, contextlib.ExitStack() as stack:
         if url2 is not None and check.uses_uart2:
             link2 = open_link(url2, timeout=0, baud=UART2_BAUD)
             stack.callback(link2.close)
@@ -253,11 +243,11 @@ def write_junit(path: str, results: list[Result]) -> None:
 
 def run_conform(
     paths: list[str],
-    board: Target | str | None,
+    board: Target | None,
     junit: str | None,
     out: TextIO,
     profile: str = "sheet",
-    board2: Target | str | None = None,
+    board2: Target | None = None,
 ) -> int:
     """Run every transcript for `profile`; one line each; exit status 1 on any failure."""
     if junit:
@@ -276,7 +266,6 @@ def run_conform(
         if not transcript.entries:
             raise AppmodeError(f"{transcript.path} has no '>' or '<' lines: nothing to check")
     chosen = profile_named(profile)
-    layout = chosen.a_layout
     transcripts = _for_profile(transcripts, chosen, out)
     interactive = sys.stderr.isatty()
 
@@ -284,19 +273,18 @@ def run_conform(
         if interactive:
             print(f"\r\033[K{text}", end="", file=sys.stderr, flush=True)
 
-    board, board2 = (as_target(b) if b is not None else None for b in (board, board2))
     live = board is not None and not board.simulated  # sim:// is a new board each time
-    found = _read_params(board, layout) if live and board is not None else None
+    found = _read_params(board, chosen) if live and board is not None else None
     results: list[Result] = []
     between = None
     if board is not None and found is not None:
         url, values = board, found
-        between = lambda: put_back(url, values, layout)  # noqa: E731 - the run's own undo
+        between = lambda: put_back(url, values, chosen)  # noqa: E731 - the run's own undo
     try:
         _run_all(transcripts, board, progress, interactive, results, out, board2, between)
     finally:
         if board is not None and found is not None:
-            out.write(restore_params(board, found, layout) + "\n")
+            out.write(restore_params(board, found, chosen) + "\n")
     if board2 is not None and not board2.simulated and _sent_on_uart2(transcripts, results):
         out.write(wrapped(f"note: {TAKEN_OVER}") + "\n")
     failed = sum(not r.passed for r in results)
@@ -381,8 +369,8 @@ def _for_profile(transcripts: list[Transcript], profile: Profile, out: TextIO) -
     return chosen
 
 
-def _read_params(url: Target, layout: Layout) -> tuple[int, ...]:
-    with Host(url, layout=layout) as host:
+def _read_params(url: Target, profile: Profile) -> tuple[int, ...]:
+    with Host(url, profile=profile) as host:
         try:
             return host.read_params()
         except AppmodeError as exc:
@@ -398,26 +386,26 @@ def _set_back(host: Host, values: tuple[int, ...]) -> list[int]:
     return changed
 
 
-def put_back(url: Target | str, values: tuple[int, ...], layout: Layout = VELOCITY) -> str | None:
+def put_back(url: Target, values: tuple[int, ...], profile: Profile) -> str | None:
     """Between two transcripts on a real board: its parameters back to `values`
     (verified, not saved); what went wrong, in a line, or None."""
     try:
-        with Host(url, layout=layout) as host:
+        with Host(url, profile=profile) as host:
             _set_back(host, values)
     except AppmodeError as exc:
         return f"could not put the parameters back before the next transcript: {exc}"
     return None
 
 
-def restore_params(url: Target | str, values: tuple[int, ...], layout: Layout = VELOCITY) -> str:
+def restore_params(url: Target, values: tuple[int, ...], profile: Profile) -> str:
     """Set the board's parameters back to `values` (verified) and send `{Q:W}`: what a
     run against a real board changed is undone. Returns what was done, in a line."""
     try:
-        with Host(url, layout=layout) as host:
+        with Host(url, profile=profile) as host:
             changed = _set_back(host, values)
             host.save()
     except AppmodeError as exc:
-        pairs = zip(layout.params, values, strict=True)
+        pairs = zip(profile.a_layout.params, values, strict=True)
         shown = ", ".join(f"{p.name}={param_values.to_user(p, v)}" for p, v in pairs)
         return f"could not restore the parameters found at the start ({shown}): {exc}"
     return (

@@ -19,6 +19,7 @@ import serial
 
 from appmode.errors import AppmodeError
 from appmode.line.pacing import Ahead
+from appmode.ports.recording import open_recorder
 from appmode.ports.urls import LinkLeft, new_pty, open_link
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.session_end import SessionEnd
@@ -62,14 +63,14 @@ def _app_side(app_url: str, nus: bool, quiet: bool) -> Stream:
     if word != ADVERTISE:
         link: Stream = open_link(app_url, timeout=READ_TIMEOUT)
         return link
-    from appmode.bluetooth.addresses import name_problem
+    from appmode.bluetooth.advertise.module_name import name_problem
     from appmode.bluetooth.availability import unsupported
 
     name = name or ADVERTISED_NAME
     if (why := name_problem(name) or unsupported()) is not None:
         raise AppmodeError(f"tap {app_url}: {why}")
     try:
-        from appmode.bluetooth.advertised_port import AdvertisedPort
+        from appmode.bluetooth.advertise.port import AdvertisedPort
         from appmode.bluetooth.uuids import UART_SERVICES
     except ImportError:
         raise AppmodeError(
@@ -96,7 +97,7 @@ def run_tap(app_url: str, board_url: str, record: str, quiet: bool, nus: bool = 
         app.close()
         raise
     try:
-        recorder = Recorder.create(record)
+        recorder = open_recorder(record)
     except BaseException:
         board.close()
         app.close()

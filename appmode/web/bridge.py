@@ -16,10 +16,10 @@ import time
 from typing import Any
 
 from appmode.errors import AppmodeError
-from appmode.host.state import TRACE_SECONDS, HostState
+from appmode.host.app.state import TRACE_SECONDS, HostState
 from appmode.protocol import app
 from appmode.session.base import BaseSession
-from appmode.session.commands import Quit, ShowHelp, ShowStatus
+from appmode.session.command_line import Quit, ShowHelp, ShowStatus
 from appmode.session.hold import HoldToDrive
 
 HEARTBEAT = 0.25

@@ -6,43 +6,52 @@ import threading
 
 import pytest
 
-from appmode.bluetooth.addresses import BadAddress, parse_ble, parse_bt
-from appmode.bluetooth.ble_port import BleSerial
 from appmode.bluetooth.inbox import RECEIVE_BUFFER, Inbox
+from appmode.bluetooth.links.ble_port import BleSerial
 from appmode.bluetooth.module import INPUT_BUFFER, PAYLOAD, UART_BYTES_PER_S, ModuleModel
 from appmode.bluetooth.uuids import UART_SERVICES, full, uart_service
+from appmode.errors import AppmodeError
+from appmode.ports.radio import BleTarget, BtTarget
+from appmode.ports.target import parse_target
+
+
+def ble(url: str) -> BleTarget:
+    radio = parse_target(url).radio
+    assert isinstance(radio, BleTarget)
+    return radio
+
+
+def bt(url: str) -> BtTarget:
+    radio = parse_target(url).radio
+    assert isinstance(radio, BtTarget)
+    return radio
 
 
 def test_ble_urls_name_an_address_a_macos_uuid_or_a_name() -> None:
-    assert parse_ble("ble://aa:bb:cc:dd:ee:ff").address == "AA:BB:CC:DD:EE:FF"
+    assert ble("ble://aa:bb:cc:dd:ee:ff").address == "AA:BB:CC:DD:EE:FF"
     mac_uuid = "ble://0c4a7e2b-9f3d-4f7a-8b1e-2d6c5a4b3c21"
-    assert parse_ble(mac_uuid).address == "0C4A7E2B-9F3D-4F7A-8B1E-2D6C5A4B3C21"
-    named = parse_ble("ble://My%20Car")
+    assert ble(mac_uuid).address == "0C4A7E2B-9F3D-4F7A-8B1E-2D6C5A4B3C21"
+    named = ble("ble://My%20Car")
     assert (named.address, named.name, named.service) == (None, "My Car", None)
 
 
 def test_a_named_service_needs_all_three_uuids() -> None:
-    target = parse_ble("ble://HC-08?service=fff0&write=fff2&notify=fff1")
-    assert target.service is not None
-    assert (target.service.service, target.service.write, target.service.notify) == (
-        full("fff0"),
-        full("fff2"),
-        full("fff1"),
-    )
-    with pytest.raises(BadAddress, match="give write, notify too"):
-        parse_ble("ble://HC-08?service=fff0")
-    with pytest.raises(BadAddress, match="not a UUID"):
-        parse_ble("ble://HC-08?service=zz&write=fff2&notify=fff1")
-    with pytest.raises(BadAddress, match="unknown option 'baud'"):
-        parse_ble("ble://HC-08?baud=9600")
+    target = ble("ble://HC-08?service=fff0&write=fff2&notify=fff1")
+    assert target.service == (full("fff0"), full("fff2"), full("fff1"))
+    with pytest.raises(AppmodeError, match="give write, notify too"):
+        ble("ble://HC-08?service=fff0")
+    with pytest.raises(AppmodeError, match="not a UUID"):
+        ble("ble://HC-08?service=zz&write=fff2&notify=fff1")
+    with pytest.raises(AppmodeError, match="unknown option 'baud'"):
+        ble("ble://HC-08?baud=9600")
 
 
 def test_bt_urls_take_an_address_and_a_channel() -> None:
-    assert parse_bt("bt://02:ca:40:00:00:05").channel == 1
-    assert parse_bt("bt://02:CA:40:00:00:05?channel=3").channel == 3
+    assert bt("bt://02:ca:40:00:00:05").channel == 1
+    assert bt("bt://02:CA:40:00:00:05?channel=3").channel == 3
     for bad in ("bt://HC-05", "bt://02:CA:40:00:00:05?channel=31", "bt://"):
-        with pytest.raises(BadAddress):
-            parse_bt(bad)
+        with pytest.raises(AppmodeError):
+            bt(bad)
 
 
 def test_known_uart_services_are_recognised_among_others() -> None:

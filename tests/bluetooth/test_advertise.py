@@ -21,9 +21,9 @@ from pathlib import Path
 import pytest
 
 from appmode.bluetooth.availability import unsupported
-from appmode.bluetooth.bus import PrivateBus
-from appmode.protocol.transcript import read_transcript
+from appmode.bluetooth.standin.bus import PrivateBus
 from appmode.testing.served import ServedBoard
+from appmode.transcript.reading import read_transcript
 from tests.support.processes import appmode_cmd, board_process, run, sent_lines, wait_for
 
 NAME = "appmode-car"

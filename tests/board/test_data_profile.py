@@ -9,12 +9,11 @@ from pathlib import Path
 import pytest
 
 from appmode.board.firmware import Board
-from appmode.board.profiles import profile_named
+from appmode.board.profiles import load, profile_named
 from appmode.errors import AppmodeError
 from appmode.protocol import app_decoders, param_values
 from appmode.protocol.app import OtherRecord, ParamsRecord, Velocity
-from appmode.protocol.profile_file import load
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 from tests.support.processes import ROOT, run
 
 BALANCE = ROOT / "appmode" / "protocol" / "profiles" / "balance.toml"

@@ -138,7 +138,7 @@ def test_the_errors_the_docs_name_are_importable_from_appmode() -> None:
 def test_the_command_line_loads_a_commands_machinery_only_to_run_it() -> None:
     """Issue 28.2: `appmode --help` imported every command's host, board and probe."""
     heavy = (
-        "appmode.host.client",
+        "appmode.host.app.client",
         "appmode.host.probe",
         "appmode.cli.hostio",
         "appmode.cli.uart2",

@@ -21,8 +21,10 @@ import serial
 
 from appmode.board.profiles import MINIBALANCE, SHEET
 from appmode.cli import main as cli_main
-from appmode.host import probe
-from appmode.protocol import app, app_decoders, params
+from appmode.cli.doctor import fix, verdict
+from appmode.host import heard, probe
+from appmode.ports.target import parse_target
+from appmode.protocol import app, app_decoders, control_decoders, params
 from tests.support.processes import ROOT, appmode_cmd, board_process, run
 
 
@@ -222,15 +224,15 @@ def test_no_ports_at_all_says_how_to_connect_one(
     assert capsys.readouterr().err.startswith("no serial ports found")
 
 
-def timed_records(period_ms: float, records: list[bytes]) -> probe.Heard:
-    heard = probe.Heard(9600)
+def timed_records(period_ms: float, records: list[bytes]) -> heard.Heard:
+    one = heard.Heard(9600)
     decoders = (
         app_decoders.BoardDecoder(b_fields=None),
-        probe.control_decoders.ReplyDecoder(wheels=None),
+        control_decoders.ReplyDecoder(wheels=None),
     )
     for i, record in enumerate(records):
-        heard.feed(record, i * period_ms / 1000, *decoders)
-    return heard
+        one.feed(record, i * period_ms / 1000, *decoders)
+    return one
 
 
 def test_the_firmware_is_told_by_what_it_sends() -> None:
@@ -239,18 +241,18 @@ def test_the_firmware_is_told_by_what_it_sends() -> None:
     sheet_a, sheet_b = b"{A0:0:0:0}$", b"{B0:0:0:100}$"
     mini_a = b"{A0:0:100:0}$"  # |0.7x|, |0.7y|, battery: the B record's battery too
     balance_a, balance_b = b"{A0:0:95:2}$", b"{B2:0:0}$"  # B: angle, left, right
-    assert probe.firmware(timed_records(50, [sheet_a, sheet_b] * 8).sent)[0] is SHEET
-    assert probe.firmware(timed_records(60, [mini_a, sheet_b] * 8).sent)[0] is MINIBALANCE
+    assert heard.firmware(timed_records(50, [sheet_a, sheet_b] * 8).sent)[0] is SHEET
+    assert heard.firmware(timed_records(60, [mini_a, sheet_b] * 8).sent)[0] is MINIBALANCE
     # the values decide even when a loaded host's period misleads (60 ms for the sheet)
-    assert probe.firmware(timed_records(60, [sheet_a, sheet_b] * 8).sent)[0] is SHEET
-    found, _ = probe.firmware(timed_records(50, [balance_a, balance_b] * 8).sent)
+    assert heard.firmware(timed_records(60, [sheet_a, sheet_b] * 8).sent)[0] is SHEET
+    found, _ = heard.firmware(timed_records(50, [balance_a, balance_b] * 8).sent)
     assert found is not None and found.name == "balance"
     # B records of two fields: no shipped profile; the nearest says why
-    found, nearest = probe.firmware(timed_records(50, [balance_a, b"{B0:0}$"] * 8).sent)
+    found, nearest = heard.firmware(timed_records(50, [balance_a, b"{B0:0}$"] * 8).sent)
     assert found is None and nearest.profile.name == "balance"
     assert nearest.against == ("B records of 2 fields (3 here)",)
     # far off every period (400 ms) and records of no shipped shape
-    found, _ = probe.firmware(timed_records(400, [b"{A-5:0:0:0}$", b"{B0:0}$"] * 8).sent)
+    found, _ = heard.firmware(timed_records(400, [b"{A-5:0:0:0}$", b"{B0:0}$"] * 8).sent)
     assert found is None
     # held up and delivered in a burst (a loaded host): the period says nothing, the
     # values still do (a battery of -740 %: the minibalance's before its motors are on)
@@ -258,34 +260,36 @@ def test_the_firmware_is_told_by_what_it_sends() -> None:
     burst = timed_records(60, dead)
     burst.record_times[:8] = [burst.record_times[7]] * 8
     assert not burst.steady and timed_records(60, dead).steady
-    assert probe.firmware(burst.sent)[0] is MINIBALANCE
+    assert heard.firmware(burst.sent)[0] is MINIBALANCE
     # the last record held up 0.7 s (the host not scheduled): 160 ms on average, far
     # from the minibalance's 60–90; the period says nothing then either
     held = timed_records(60, dead[:8])
     held.record_times[-1] += 0.7
     assert not held.steady and round(held.period_ms or 0) == 160
-    assert probe.firmware(held.sent)[0] is MINIBALANCE
+    assert heard.firmware(held.sent)[0] is MINIBALANCE
     # its motors come on while it is heard: the battery changes between an A and a B
     waking = dead[:5] + [mini_a, b"{B0:0:0:100}$"] * 6
-    assert probe.firmware(timed_records(60, waking).sent)[0] is MINIBALANCE
+    assert heard.firmware(timed_records(60, waking).sent)[0] is MINIBALANCE
     c = app.encode(app.ParamsRecord(params.DEFAULTS))
     # a long record keeps the reference loop waiting longer (§13): still that firmware
     mixed = timed_records(MINIBALANCE.record_period_ms(len(c)), [c] * 6)
-    assert probe.firmware(mixed.sent)[0] is MINIBALANCE
+    assert heard.firmware(mixed.sent)[0] is MINIBALANCE
 
 
 def test_a_file_or_a_folder_is_not_a_serial_port(tmp_path: Any) -> None:
     plain = tmp_path / "notes.txt"
     plain.write_text("hello\n")
-    status, (file, folder, sim), _ = doctor(str(plain), str(tmp_path), "sim://?bogus=1")
+    status, (file, folder), _ = doctor(str(plain), str(tmp_path))
     assert status == 1
     assert (
         file["verdict"] == f"cannot be opened: {plain} is not a serial port (not a terminal device)"
     )
     assert folder["verdict"] == f"cannot be opened: {tmp_path} is not a serial port (a folder)"
     assert file["fix"] == "name the car's port; list ports with: appmode ports"
-    assert sim["verdict"] == "cannot be opened: unknown sim:// option 'bogus'"
     assert plain.read_text() == "hello\n"  # opened, never written
+    bad = run("doctor", "sim://?bogus=1")  # a URL is read once, with the command line
+    assert bad.returncode == 2 and "unknown sim:// option 'bogus'" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1, bad.stderr
 
 
 def test_a_port_that_goes_away_while_listened_to_is_said_so() -> None:
@@ -294,13 +298,13 @@ def test_a_port_that_goes_away_while_listened_to_is_said_so() -> None:
     closing = threading.Timer(0.3, os.close, (master,))
     closing.start()
     try:
-        found = probe.probe(path, threading.Event(), lambda text: None)
+        found = probe.probe(parse_target(path), threading.Event(), lambda text: None)
     finally:
         closing.join()
         os.close(slave)
     assert found.kind == "lost" and not found.is_car
-    assert found.verdict.startswith("it opened, then failed while listening")
-    assert "the device went away" in found.fix
+    assert verdict(found).startswith("it opened, then failed while listening")
+    assert "the device went away" in fix(found)
 
 
 @contextmanager
@@ -380,12 +384,13 @@ def test_bursts_heard_at_every_rate_are_the_control_port_s_at_its_own(
     bursts = {probe.APP_BAUD: 16, probe.UART2_BAUD: 2, 38400: 0}
 
     def listen(
-        url: str, baud: int, seconds: float, stop: threading.Event
-    ) -> tuple[probe.Heard, serial.SerialBase]:
+        url: object, baud: int, seconds: float, stop: threading.Event
+    ) -> tuple[heard.Heard, serial.SerialBase]:
         count = bursts.get(baud, 0)
-        heard = probe.Heard(baud, seconds, 3 * count, uart2_bytes=3 * count, uart2_bursts=count)
-        return heard, serial.serial_for_url("loop://")
+        one = heard.Heard(baud, seconds, 3 * count, uart2_bytes=3 * count, uart2_bursts=count)
+        return one, serial.serial_for_url("loop://")
 
     monkeypatch.setattr(probe, "listen", listen)
-    finding = probe.probe("/dev/ttyUSB7", threading.Event(), lambda text: None)
+    target = parse_target("/dev/ttyUSB7")
+    finding = probe.probe(target, threading.Event(), lambda text: None)
     assert finding.kind == "uart2" and finding.baud == probe.UART2_BAUD, finding

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from appmode.protocol.transcript import read_transcript
+from appmode.ports.target import parse_target
+from appmode.transcript.reading import read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, BoardProcess, board_process, run
 
@@ -39,7 +40,7 @@ def test_s13_suite_passes_on_virtual_time(path: Path) -> None:
 )
 def test_s13_suite_passes_in_real_time_over_a_pty(board: BoardProcess, name: str) -> None:
     path = ROOT / "transcripts" / "suite" / "minibalance" / f"{name}.transcript"
-    result = run_live(read_transcript(path), board.url)
+    result = run_live(read_transcript(path), parse_target(board.url))
     assert result.passed, result.failure
 
 

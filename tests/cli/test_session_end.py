@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 import serial
 
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.ports.sim import SimSerial
 from appmode.protocol import params
 from tests.support.processes import (

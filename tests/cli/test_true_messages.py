@@ -7,7 +7,7 @@ from pathlib import Path
 
 from appmode.board.firmware import Board
 from appmode.protocol import params
-from appmode.session.app_session import COMMANDS
+from appmode.session.app.session import COMMANDS
 from appmode.text import counted, wrapped
 from tests.support.processes import run
 

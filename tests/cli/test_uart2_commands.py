@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 from appmode.protocol import app, app_decoders, control
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 from tests.support.processes import appmode_cmd, board_process, run
 
 STOP = control.STOP.hex(" ").upper()

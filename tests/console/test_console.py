@@ -16,8 +16,9 @@ from prompt_toolkit.output import DummyOutput
 
 from appmode.console.driving import run_drive
 from appmode.console.terminal import REDRAW, Console
-from appmode.session.app_session import Session
+from appmode.session.app.session import AppSession
 from appmode.session.hold import HoldToDrive
+from tests.support.sessions import session as open_board
 
 UP = "\x1b[A"
 CTRL_C = "\x03"
@@ -54,11 +55,12 @@ def run_console(
     url: str = "sim://",
     output: DummyOutput | None = None,
     **driving: Any,
-) -> tuple[Session, Path, list[float]]:
+) -> tuple[AppSession, Path, list[float]]:
     """Run the console with `keys` typed (text, pause after, and what to see before the
     pause, if anything); returns when it has quit."""
     record = tmp_path / "app.transcript"
-    session = Session(url, HoldToDrive(**driving), str(record))
+    session = open_board(url, HoldToDrive(**driving), str(record))
+    assert isinstance(session, AppSession)
     typed_at: list[float] = []
     consoles: list[Console] = []
 
@@ -207,15 +209,15 @@ def test_a_crash_in_the_console_still_sends_z_last(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls = {"n": 0}
-    real = Session.tick
+    real = AppSession.tick
 
-    def failing_tick(self: Session) -> None:
+    def failing_tick(self: AppSession) -> None:
         calls["n"] += 1
         if calls["n"] == 40:
             raise RuntimeError("boom")
         real(self)
 
-    monkeypatch.setattr(Session, "tick", failing_tick)
+    monkeypatch.setattr(AppSession, "tick", failing_tick)
     with pytest.raises(RuntimeError, match="boom"):
         run_console(tmp_path, [("w", 0.0), ("w", 5.0)], latched=True)
     payloads = [p for _, p in sent(tmp_path / "app.transcript")]

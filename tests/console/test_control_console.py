@@ -11,12 +11,13 @@ import pytest
 from prompt_toolkit.utils import get_cwidth
 
 from appmode.console.panel import status_fragments
-from appmode.host.state import BoardWarning, HostState
+from appmode.host.app.state import HostState
+from appmode.host.events import BoardWarning
 from appmode.protocol.directions import MOTIONS
 from appmode.protocol.params import DriveType
-from appmode.session.control_session import ControlSession, velocity_for
+from appmode.session.control.session import velocity_for
 from appmode.session.hold import HoldToDrive
-from appmode.session.status import WIDTH
+from appmode.session.rows import WIDTH
 from tests.console.test_console_tmux import (
     SESSION,
     _alive,
@@ -26,6 +27,7 @@ from tests.console.test_console_tmux import (
     wait_screen,
 )
 from tests.support.processes import board_process, run, wait_for
+from tests.support.sessions import session as open_board
 
 STOP_FRAME = "FF FE 01 00 00 00 00 00 00 00"
 
@@ -86,7 +88,7 @@ def test_both_ports_of_one_board_are_shown_and_recorded(tmp_path: Path) -> None:
 
 def test_the_panel_fits_80_columns_with_both_ports() -> None:
     url = "sim://?share=panel&drive=mecanum"
-    session = ControlSession(url + "&port=uart2", HoldToDrive(latched=True), app_url=url)
+    session = open_board(url, HoldToDrive(latched=True), url2=url + "&port=uart2")
     try:
         session.start()
         end = time.monotonic() + 1.5

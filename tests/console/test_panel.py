@@ -12,13 +12,14 @@ from prompt_toolkit.utils import get_cwidth
 
 from appmode.console.panel import status_fragments
 from appmode.console.waves import LEVELS
-from appmode.session.app_session import Session
+from appmode.session.base import BaseSession
 from appmode.session.hold import HoldToDrive
-from appmode.session.status import BAR, WIDTH
+from appmode.session.rows import BAR, WIDTH
+from tests.support.sessions import session as open_board
 
 
 def test_a_battery_out_of_range_fills_the_gauge_and_no_more() -> None:
-    session = Session("sim://")
+    session = open_board("sim://")
     try:
         for reading, filled in ((-740, 0), (250, BAR)):
             session.host.state.feed(b"{B0:0:0:%d}$" % reading, session.host.now())
@@ -31,8 +32,8 @@ def test_a_battery_out_of_range_fills_the_gauge_and_no_more() -> None:
         session.close()
 
 
-def _settled(url: str = "sim://", seconds: float = 1.2, letter: str | None = None) -> Session:
-    session = Session(url, HoldToDrive(latched=True))
+def _settled(url: str = "sim://", seconds: float = 1.2, letter: str | None = None) -> BaseSession:
+    session = open_board(url, HoldToDrive(latched=True))
     session.start()
     if letter:
         session.press(letter)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from appmode.errors import AppmodeError
-from appmode.host.client import Host
-from appmode.host.control_client import ControlHost
+from appmode.host.app.client import Host
+from appmode.host.control.client import ControlHost
 from appmode.ports.target import parse_target
 from appmode.protocol import app, control, params, settings
 from appmode.protocol.transcript import UART2_DIRECTIONS

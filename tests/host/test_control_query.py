@@ -7,9 +7,9 @@ import random
 import pytest
 
 from appmode.errors import AppmodeError
-from appmode.host.control_query import ReadDone, ReadQuery, rotation_done
-from appmode.host.control_state import OWED_FOR, ControlState
-from appmode.host.query import AGREE, QueryFailed
+from appmode.host.control.query import ReadDone, ReadQuery, rotation_done
+from appmode.host.control.state import OWED_FOR, ControlState
+from appmode.host.outcomes import AGREE, QueryFailed
 from appmode.protocol import control, control_decoders, settings
 
 

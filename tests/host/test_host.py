@@ -12,8 +12,9 @@ import pytest
 import serial
 
 from appmode.errors import AppmodeError
-from appmode.host.client import Host
-from appmode.host.state import HostState, LinkStatus
+from appmode.host.app.client import Host
+from appmode.host.app.state import HostState
+from appmode.host.events import LinkStatus
 from appmode.protocol.app import Attitude, ParamsRecord, Velocity
 from appmode.protocol.render import out_of_range
 from tests.support.processes import BoardProcess, board_process

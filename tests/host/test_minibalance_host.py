@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
 
 from appmode.board.profiles import MINIBALANCE
-from appmode.host.client import Host
-from appmode.host.state import BoardWarning
+from appmode.host.app.client import Host
+from appmode.host.events import BoardWarning
 from appmode.ports.sim import SimSerial
 
 URL = "sim://?profile=minibalance"
@@ -50,7 +51,8 @@ def test_s13_a_set_whose_read_is_lost_during_a_c_record_is_still_verified() -> N
 def _warnings_after_a_read_while_driving(frames_stop: bool) -> list[str]:
     """J A until the car moves, then {Q:P}: on the reference firmware the frame's `{`
     stops the car (§13), and it coasts to a stand."""
-    with Host(URL, layout=MINIBALANCE.a_layout, frames_stop=frames_stop) as host:
+    profile = MINIBALANCE if frames_stop else replace(MINIBALANCE, steer_in_frames=False)
+    with Host(URL, profile=profile) as host:
         list(host.events(2.0))  # the board boots: motors from 1.9 s (§13.1)
         host.send(b"JA")
         list(host.events(0.7))

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from appmode.host.query import NOISY_LEAD, ParamQuery, QueryDone, QueryFailed
-from appmode.host.state import HostState
+from appmode.host.app.query import NOISY_LEAD, ParamQuery, QueryDone
+from appmode.host.app.state import HostState
+from appmode.host.outcomes import QueryFailed
 from appmode.protocol import params
 from appmode.protocol.app import ParamsRecord, encode
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from appmode.host.stop_check import SETTLE, TRIES, StopCheck
+from appmode.host.app.stop_check import SETTLE, TRIES, StopCheck
 from appmode.protocol import app, session_end
 from appmode.protocol.layouts import SCALED, VELOCITY
 

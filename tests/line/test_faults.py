@@ -9,8 +9,8 @@ import pytest
 
 from appmode.board.firmware import Board
 from appmode.errors import AppmodeError
-from appmode.host.client import Host
-from appmode.host.state import HostState
+from appmode.host.app.client import Host
+from appmode.host.app.state import HostState
 from appmode.line.faults import Faults, FaultSpec, FaultyPort
 from appmode.ports.sim import SimSerial
 from appmode.ports.urls import open_link

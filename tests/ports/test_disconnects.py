@@ -12,8 +12,8 @@ import threading
 import time
 from pathlib import Path
 
-from appmode.host.client import Host
-from appmode.host.state import LinkStatus
+from appmode.host.app.client import Host
+from appmode.host.events import LinkStatus
 from appmode.protocol.app import Velocity
 from tests.support.processes import (
     ROOT,

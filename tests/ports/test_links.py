@@ -13,7 +13,7 @@ import serial
 
 import appmode  # noqa: F401 - registers sim://
 from appmode.errors import AppmodeError
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.ports.urls import explain_open_error, open_link
 from tests.support.processes import board_process
 from tests.support.rfc2217_server import Rfc2217Server

@@ -8,9 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from appmode.board.profiles import load
 from appmode.protocol import params
 from appmode.protocol.layouts import SCALED, VELOCITY
-from appmode.protocol.profile_file import SHIPPED, ProfileError, load, shipped_path
+from appmode.protocol.profile_file import SHIPPED, ProfileError
 from tests.support.processes import run
 
 
@@ -51,7 +52,8 @@ def test_profile_list_and_show_say_what_each_firmware_sends():
     assert row.split()[1:4] == ["velocity_ki", "0–21474836.47", "0.4"], row
     assert "no control port" in shown.stdout and "also sends ##$" in shown.stdout
     toml = run("profile", "show", "minibalance", "--toml")
-    assert toml.stdout == Path(shipped_path("minibalance")).read_text(encoding="utf-8")
+    shipped = Path(__file__).parents[2] / "appmode" / "protocol" / "profiles" / "minibalance.toml"
+    assert toml.stdout == shipped.read_text(encoding="utf-8")
 
 
 def test_a_user_s_file_is_checked_and_read_like_a_shipped_one(tmp_path: Path):

@@ -17,8 +17,8 @@ from appmode.protocol.transcript import (
     Directive,
     TranscriptError,
     parse_transcript,
-    read_transcript,
 )
+from appmode.transcript.reading import read_transcript
 
 
 def test_recorder_writes_one_unit_a_line_and_escapes_bytes() -> None:

@@ -14,10 +14,10 @@ import pytest
 
 from appmode.console.script import command_lines
 from appmode.protocol.recorder import Recorder
-from appmode.session.app_session import Session
-from appmode.session.commands import MAX_COMMAND
+from appmode.session.command_line import MAX_COMMAND
 from appmode.session.hold import HoldToDrive
 from tests.support.processes import BoardProcess, appmode_cmd, run, sent_lines
+from tests.support.sessions import session as open_board
 
 
 def test_script_mode_reads_commands_from_stdin(tmp_path: Path) -> None:
@@ -87,7 +87,7 @@ def test_script_mode_against_a_board_process_over_tcp(tmp_path: Path) -> None:
 
 def test_keys_do_not_pretend_while_the_link_is_lost(tmp_path: Path) -> None:
     board = BoardProcess("--listen", "0", "--quiet")
-    session = Session(board.url, HoldToDrive())
+    session = open_board(board.url, HoldToDrive())
     try:
         session.start()
         board.kill()
@@ -140,7 +140,7 @@ class _FailingStream(io.StringIO):
 
 
 def test_a_recording_failing_midway_stops_with_a_message_and_driving_goes_on() -> None:
-    session = Session("sim://", HoldToDrive(latched=True))
+    session = open_board("sim://", HoldToDrive(latched=True))
     try:
         session.recorder = Recorder(_FailingStream())
         session.start()
@@ -172,7 +172,7 @@ def test_a_console_recording_has_the_times_the_board_took_its_bytes(tmp_path: Pa
     it, counted from the session's start, not with the console's clock after the write
     (under load those differ by ms, and a replay on virtual time then differs)."""
     record = tmp_path / "s.transcript"
-    session = Session("sim://", HoldToDrive(), str(record))
+    session = open_board("sim://", HoldToDrive(), str(record))
     port = session.host.link
     assert port is not None
     write = port.write
@@ -221,7 +221,7 @@ def test_a_balance_car_s_session_shows_and_sets_its_own_fields(tmp_path: Path) -
     sent = [line.split(" > ")[1] for line in record.read_text().splitlines() if " > " in line]
     assert "{0:42}" in sent and sent[-1] == "Z"
 
-    session = Session("sim://?profile=balance", HoldToDrive(latched=True))
+    session = open_board("sim://?profile=balance", HoldToDrive(latched=True))
     try:
         session.start()
         deadline = time.monotonic() + 5

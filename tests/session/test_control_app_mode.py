@@ -11,10 +11,11 @@ from pathlib import Path
 
 import serial
 
-from appmode.host.control_state import APP_QUIET
-from appmode.session.control_session import ControlSession
+from appmode.host.control.state import APP_QUIET
+from appmode.session.control.session import ControlSession
 from appmode.session.hold import HoldToDrive
 from appmode.testing.served import ServedBoard
+from tests.support.sessions import session as open_board
 
 LEASE = 0.25
 """A page's heartbeat lease (web.bridge.HEARTBEAT)."""
@@ -42,7 +43,8 @@ def until(session: ControlSession, done: Callable[[], bool], what: str, timeout:
 def page_session(board: ServedBoard) -> ControlSession:
     """A session over the board's UART2 as `appmode web --uart2` makes it: a held key
     lasts a lease, and any motion only while the page beats."""
-    session = ControlSession(board.uart2, HoldToDrive(LEASE, LEASE))
+    session = open_board(board.uart2, HoldToDrive(LEASE, LEASE), uart2=True)
+    assert isinstance(session, ControlSession)
     session.lease = LEASE
     session.start()
     until(session, lambda: session.baseline is not None and not session.busy, "settings read")

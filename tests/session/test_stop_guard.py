@@ -13,8 +13,6 @@ from pathlib import Path
 
 import pytest
 
-from appmode.protocol.transcript import read_transcript
-from appmode.session.app_session import Session
 from appmode.session.authority import (
     LAPSE,
     STALL,
@@ -25,6 +23,8 @@ from appmode.session.authority import (
     thread_times,
 )
 from appmode.session.hold import HoldToDrive
+from appmode.transcript.reading import read_transcript
+from tests.support.sessions import session as open_board
 
 
 def test_the_guard_stops_a_moving_session_whose_ticks_stall() -> None:
@@ -56,7 +56,7 @@ def test_the_guard_leaves_a_stopped_car_alone() -> None:
 
 def test_a_latched_session_that_stops_ticking_is_stopped(tmp_path: Path) -> None:
     record = tmp_path / "s.transcript"
-    session = Session("sim://", HoldToDrive(latched=True), record=str(record))
+    session = open_board("sim://", HoldToDrive(latched=True), record=str(record))
     try:
         session.start()
         ticked = time.monotonic()
@@ -191,7 +191,7 @@ def test_a_key_let_go_stops_the_car_though_the_session_waits_for_a_cpu(
     monkeypatch.setattr(authority, "thread_times", lambda _: (0.0, time.monotonic() - started))
     monkeypatch.setattr(authority, "runnable", lambda _: True)
     record = tmp_path / "s.transcript"
-    session = Session("sim://", HoldToDrive(first_timeout=0.3), record=str(record))
+    session = open_board("sim://", HoldToDrive(first_timeout=0.3), record=str(record))
     try:
         session.start()
         session.tick()
@@ -248,7 +248,7 @@ def test_the_wait_for_a_recording_s_reader_counts_from_the_ending_signal(
 
     fifo = tmp_path / "rec"
     os.mkfifo(fifo)
-    session = Session("sim://", HoldToDrive(latched=True), record=str(fifo))
+    session = open_board("sim://", HoldToDrive(latched=True), record=str(fifo))
     session.start()
     monkeypatch.setattr(signals._ending, "since", time.monotonic() - 0.45)
     closing = time.monotonic()

@@ -6,7 +6,7 @@ from __future__ import annotations
 import statistics
 from pathlib import Path
 
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 from tests.support.processes import board_process, run
 
 SPACING = 0.017  # off the board's 50 ms slots: telemetry keeps arriving between sends

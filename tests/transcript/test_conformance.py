@@ -11,12 +11,14 @@ from pathlib import Path
 
 import pytest
 
-from appmode.host.client import Host
+from appmode.host.app.client import Host
 from appmode.ports.sim import SimSerial
+from appmode.ports.target import parse_target
 from appmode.protocol import params
 from appmode.protocol.recorder import Recorder
-from appmode.protocol.transcript import parse_transcript, read_transcript
+from appmode.protocol.transcript import parse_transcript
 from appmode.transcript import runner
+from appmode.transcript.reading import read_transcript
 from appmode.transcript.runner import run_live, run_virtual
 from tests.support.processes import ROOT, board_process, board_state, run
 
@@ -150,7 +152,7 @@ def test_board_drive_is_used_virtually_and_checked_live(tmp_path: Path) -> None:
     text = "@board drive=diff\n0.1 > JC\n1.0 < {A0:0:500:0}$\n"
     assert virtual(text)[0]
     with board_process("--pty", "--no-pace", "--quiet") as board:
-        result = run_live(parse_transcript(text, "needs_diff.transcript"), board.url)
+        result = run_live(parse_transcript(text, "needs_diff.transcript"), parse_target(board.url))
     assert not result.passed and result.failure is not None
     assert "needs_diff.transcript: needs a diff drive; the board at" in result.failure
     assert "reports omni" in result.failure
@@ -332,5 +334,5 @@ def test_a_power_up_transcript_keeps_a_simulated_board_s_time_however_slow_the_h
     monkeypatch.setattr(runner, "Host", SlowHost)
     text = (SUITE_DIR / "minibalance" / "s13_power_up.transcript").read_text()
     transcript = parse_transcript(text.replace("@tolerance 0.01", "@tolerance 0.05"))
-    result = run_live(transcript, "sim://?profile=minibalance")
+    result = run_live(transcript, parse_target("sim://?profile=minibalance"))
     assert result.passed, result.failure

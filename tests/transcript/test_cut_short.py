@@ -14,9 +14,10 @@ from pathlib import Path
 import pytest
 
 from appmode.errors import AppmodeError
-from appmode.protocol.recorder import Recorder
-from appmode.protocol.transcript import TranscriptError, parse_transcript, read_transcript
+from appmode.ports.recording import open_recorder
+from appmode.protocol.transcript import TranscriptError, parse_transcript
 from appmode.transcript.dump import run_dump
+from appmode.transcript.reading import read_transcript
 from appmode.writer import BoundedWriter
 from tests.support.processes import run
 
@@ -84,11 +85,11 @@ def test_a_recording_s_writer_scheduled_late_is_no_full_disk(
 
     monkeypatch.setattr(BoundedWriter, "_run", late)
     path = tmp_path / "late.transcript"
-    recorder = Recorder.create(path)
+    recorder = open_recorder(path)
     recorder.close()
     assert path.read_text().startswith("# appmode transcript v1\n")
     with pytest.raises(AppmodeError, match="No space left on device"):
-        Recorder.create("/dev/full")
+        open_recorder("/dev/full")
 
 
 def _dump_peak(path: Path, lines: int) -> int:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from appmode.protocol.transcript import read_transcript
+from appmode.transcript.reading import read_transcript
 from tests.support.processes import ROOT, run
 
 EXAMPLES = sorted((ROOT / "transcripts" / "examples").glob("*.transcript"))

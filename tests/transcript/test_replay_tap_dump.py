@@ -20,7 +20,8 @@ from pathlib import Path
 import pytest
 import serial
 
-from appmode.protocol.transcript import parse_transcript, read_transcript
+from appmode.protocol.transcript import parse_transcript
+from appmode.transcript.reading import read_transcript
 from appmode.transcript.replay import EARLY, plan, play
 from tests.support.processes import ROOT, board_process, run, wait_for
 
@@ -378,8 +379,8 @@ def test_plot_draws_a_uart2_transcript_s_encoder_reports(tmp_path: Path) -> None
 
 
 def test_plot_s_title_is_whole_and_its_labels_stand_apart() -> None:
-    from appmode.protocol.transcript import read_transcript
     from appmode.transcript.dump import _title
+    from appmode.transcript.reading import read_transcript
 
     path = ROOT / "transcripts" / "suite" / "s4_letters_omni.transcript"
     title = _title(str(path), read_transcript(path))

@@ -1,5 +1,0 @@
-"""pyserial looks up `ble://` here (serial.protocol_handler_packages)."""
-
-from appmode.bluetooth.ble_port import BleSerial as Serial
-
-__all__ = ["Serial"]

@@ -1,0 +1,110 @@
+"""The command line every session shares: what a command is (`CommandSpec`), the
+commands common to both ports (help, latch, record, wait, status, quit), and what a
+command asks of the view (`Quit`, `SHOW_STATUS`, `SHOW_HELP`, a `Wait`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Generic, TypeVar
+
+from appmode.errors import AppmodeError
+from appmode.files import new_recording, recordings_folder
+from appmode.host.app.tokens import parse_token
+from appmode.host.waits import Wait
+
+if TYPE_CHECKING:
+    from appmode.session.base import BaseSession
+
+SPEED_STEP = 100
+SPEED_KEYS = {"+": f"speed +{SPEED_STEP}", "=": f"speed +{SPEED_STEP}", "-": f"speed -{SPEED_STEP}"}
+"""The keys that change the speed, as command lines."""
+SPEED_COMPLETES = {f"+{SPEED_STEP}": None, f"-{SPEED_STEP}": None}
+LOG = 500
+"""Messages kept for scrolling back."""
+QUIT_WORDS = ("quit", "exit", "q")
+MAX_COMMAND = 1000
+"""Characters a command line may have (splitting one into words takes time that grows
+as the square of its length: a megabyte pasted or piped in would hang the session)."""
+ON_OFF = {"on": None, "off": None}
+
+
+class Quit(Exception):
+    """The user asked to leave."""
+
+
+class ShowStatus:
+    """`status` was asked for: the view prints the panel (script mode)."""
+
+
+SHOW_STATUS = ShowStatus()
+
+
+class ShowHelp:
+    """`help` was asked for: the view shows `help_lines()`."""
+
+
+SHOW_HELP = ShowHelp()
+
+Step = Wait | ShowStatus | ShowHelp | None
+S = TypeVar("S", bound="BaseSession")
+
+
+@dataclass(frozen=True, slots=True)
+class CommandSpec(Generic[S]):
+    """A command of the command line: its name, its arguments and help as `help` lists
+    them, what runs it, and what completes after its name."""
+
+    name: str
+    args: str
+    help: str
+    run: Callable[[S, list[str]], Step]
+    """Runs it on a session with its arguments; AppmodeError or ValueError for a mistake."""
+    completes: Mapping[str, object] | None = None
+
+
+def _latch(session: BaseSession, args: list[str]) -> None:
+    if args not in (["on"], ["off"]):
+        raise AppmodeError("usage: latch on|off")
+    session.driving.latched = args[0] == "on"
+    session.say(f"latched driving {args[0]}")
+
+
+def _record(session: BaseSession, args: list[str]) -> None:
+    if args == ["stop"]:
+        session.stop_recording()
+    elif session.names_files:
+        if len(args) != 1:
+            raise AppmodeError("usage: record FILE, or record stop")
+        session.start_recording(args[0])
+    elif args in ([], ["start"]):
+        session.start_recording(str(new_recording()))
+    else:
+        raise AppmodeError(
+            f"the page names no file: 'record' starts a recording in {recordings_folder()} "
+            "under a new name, 'record stop' ends it"
+        )
+
+
+def _wait(session: BaseSession, args: list[str]) -> Wait:
+    step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
+    assert isinstance(step, Wait)
+    return step
+
+
+def _quit(session: BaseSession, args: list[str]) -> None:
+    raise Quit
+
+
+COMMON: tuple[CommandSpec[BaseSession], ...] = (
+    CommandSpec("latch", "on|off", "latched driving: a direction stays until stop", _latch, ON_OFF),
+    CommandSpec(
+        "record", "FILE|stop", "start or stop recording a transcript", _record, {"stop": None}
+    ),
+    CommandSpec("wait", "SECONDS", "script mode: let time pass", _wait),
+    CommandSpec("status", "", "print the status panel (script mode)", lambda s, a: SHOW_STATUS),
+    CommandSpec("help", "", "list the commands and keys", lambda s, a: SHOW_HELP),
+    CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)", _quit),
+)
+"""The commands every session takes, listed after its own."""
+COMMON_ALIASES = {"?": "help", **{word: "quit" for word in QUIT_WORDS}}

@@ -1,0 +1,24 @@
+"""A driving session opened from a board choice: the one place a view (the console, the
+page, a test) gets its session."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from appmode.ports.choice import BoardChoice
+from appmode.session.app.session import AppSession
+from appmode.session.base import BaseSession
+from appmode.session.control.session import ControlSession
+from appmode.session.hold import HoldToDrive
+
+
+def open_session(
+    choice: BoardChoice,
+    driving: HoldToDrive | None = None,
+    on_message: Callable[[str], None] | None = None,
+    record: str | None = None,
+) -> BaseSession:
+    """The session `choice` asks for: the APP port's, or the control port's (with the APP
+    port of the same board beside it); `record` names its recording."""
+    kind = ControlSession if choice.control else AppSession
+    return kind(choice, driving, record, on_message)
