@@ -4,7 +4,7 @@ at each record) — timed in a loop and after sleeps of 1 to 100 ms, CPU time of
 thread. On a machine that runs other work while a process sleeps, the caches are cold
 when it wakes, and the longer it slept the colder: a board's record comes after the
 longest sleep of its pass (about 37 ms at 20 records/s), which is where a board costs
-more than its floor (bench/uart2.py's CPU row)."""
+more than its floor (bench/control_port.py's CPU row)."""
 
 from __future__ import annotations
 

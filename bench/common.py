@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 from appmode.ports.wakeups import exact_wakeups, select_exactly
+from appmode.testing.process import board_process
 
 
 @contextmanager
@@ -42,9 +43,9 @@ def started(command: str, *args: str) -> Iterator[tuple[subprocess.Popen[str], s
 
 @contextmanager
 def board(*args: str) -> Iterator[str]:
-    """Run `appmode board ARGS`; yield the URL it prints."""
-    with started("board", "--quiet", *args) as (_, url):
-        yield url
+    """Run `appmode board ARGS`; yield the URL of its APP port."""
+    with board_process("--quiet", *args) as served:
+        yield served.url
 
 
 def fitted_slope(xs: Sequence[float], ys: Sequence[float]) -> tuple[float, float]:

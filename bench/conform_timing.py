@@ -14,9 +14,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-from common import board, summary_ms
-
 from appmode.transcript.reading import read_transcript
+from bench.common import board, summary_ms
 
 SPACING = 0.017
 SENT = {bytes([c]) for c in b"ABCDEFGHJ"}

@@ -1,7 +1,7 @@
 """The console's picture for the README and the docs (docs/console.svg): `appmode drive`
 on the simulated board in tmux, ↑ held for a second, the screen as SVG.
 
-Needs tmux and rich (`pip install rich`): python bench/console_shot.py docs/console.svg
+Needs tmux and rich (`pip install rich`): python -m bench.console_shot docs/console.svg
 """
 
 from __future__ import annotations

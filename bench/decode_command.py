@@ -1,6 +1,6 @@
 """`appmode decode FILE` on a 10 MB board stream with 1 % noise, beside a plain Python
 loop that reads the same file byte by byte, finds the same events
-(bench/decoder.py's SameEventsByteLoop) and writes them with the same renderer: the
+(tests/support/byte_loops.py's SameEventsByteLoop) and writes them with the same renderer: the
 two outputs are byte-identical (checked: a run whose outputs differ is an error).
 
 Both are timed as processes, start-up included, writing to a file.
@@ -17,12 +17,12 @@ import tempfile
 import time
 from pathlib import Path
 
-import decoder
+from tests.support.byte_loops import make_stream
 
 LOOP = r"""
 import sys
 sys.path.insert(0, sys.argv[2])
-import decoder
+from tests.support.byte_loops import make_stream
 from appmode.protocol.layouts import VELOCITY
 from appmode.protocol.render import coalesce, json_line
 loop = decoder.SameEventsByteLoop()
@@ -45,11 +45,11 @@ def timed(args: list[str], out: Path) -> float:
 
 def compare(megabytes: float) -> dict[str, float]:
     """Seconds of each (the better of two runs), after checking identical output."""
-    stream, _ = decoder.make_stream(int(megabytes * 1e6), 0.01)
+    stream, _ = make_stream(int(megabytes * 1e6), 0.01)
     with tempfile.TemporaryDirectory() as tmp:
         path, mine, theirs = Path(tmp) / "stream.bin", Path(tmp) / "a", Path(tmp) / "b"
         path.write_bytes(stream)
-        here = str(Path(__file__).parent)
+        here = str(Path(__file__).parents[1])
         ours = min(
             timed([sys.executable, "-m", "appmode", "decode", str(path)], mine) for _ in range(2)
         )

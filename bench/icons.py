@@ -1,4 +1,4 @@
-"""Draw the page's icons: `python bench/icons.py appmode/web/static` writes icon.svg and,
+"""Draw the page's icons: `python -m bench.icons appmode/web/static` writes icon.svg and,
 from the same shapes, icon-192.png and icon-512.png (a home screen and a splash screen
 take PNG). The shapes sit inside the middle 80 % so a maskable icon's circle keeps them."""
 

@@ -14,7 +14,8 @@ import argparse
 import time
 
 import serial
-from common import board, fitted_slope
+
+from bench.common import board, fitted_slope
 
 LINE_RATE = 960.0
 

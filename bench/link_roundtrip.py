@@ -13,12 +13,11 @@ import math
 import random
 import time
 
-from common import board, summary_ms
-
 import appmode  # noqa: F401 - registers sim://
 from appmode.ports.urls import open_link
 from appmode.protocol.app import ParamsRecord
 from appmode.protocol.app_decoders import BoardDecoder
+from bench.common import board, summary_ms
 
 SLOT = 0.05
 

@@ -26,14 +26,13 @@ import tty
 from functools import partial
 from typing import Any
 
-from common import percentile
-
 from appmode.board.firmware import Board
 from appmode.board.profiles import SHEET
 from appmode.ports.endpoints import PtyEndpoint
 from appmode.ports.serve import BoardServer, switched_on
 from appmode.protocol.app import RECORDS
 from appmode.protocol.app_decoders import BoardDecoder
+from bench.common import percentile
 
 
 def serve(count: int) -> None:

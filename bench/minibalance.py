@@ -12,12 +12,11 @@ from __future__ import annotations
 import argparse
 import time
 
-from common import Row, board, percentile
-
 from appmode.host.app.client import Host
 from appmode.ports.urls import open_link
 from appmode.protocol.app import ParamsRecord
 from appmode.protocol.app_decoders import BoardDecoder
+from bench.common import Row, board, percentile
 
 
 def round_trips(url: str, trials: int) -> list[float]:

@@ -3,7 +3,7 @@ fail with a clear error, and how many report a wrong value (the target: none).
 
 Each seeded session reads the parameters, then sets velocity_kp to 4242, against
 `sim://?faults=HEAVY,seed:N&pace=0`; a reported value is wrong when it differs from the
-board's own. About 0.9 s a session: `python bench/noisy_reads.py --sessions 1000 --jobs 2`
+board's own. About 0.9 s a session: `python -m bench.noisy_reads --sessions 1000 --jobs 2`
 takes about 8 minutes (docs/protocol.md §3.3 gives the rule it checks).
 """
 

@@ -4,7 +4,7 @@ APP port and over UART2, at a phone's size; exit 1 below the targets or on any a
 violation. `.ci/run` runs it with both from npm:
 
     npm install --prefix DIR lighthouse@12.2.3 axe-core@4
-    python bench/page_audit.py --lighthouse DIR/node_modules/.bin/lighthouse \\
+    python -m bench.page_audit --lighthouse DIR/node_modules/.bin/lighthouse \\
         --axe DIR/node_modules/axe-core/axe.min.js
 """
 

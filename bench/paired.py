@@ -1,6 +1,6 @@
 """Two versions of `appmode board`, served at once and measured over the same seconds:
 what a change to the board or the server saves, free of this machine's load coming and
-going (which moves bench/uart2.py's both-ports row by ±0.2 % of a core from one run to
+going (which moves bench/control_port.py's both-ports row by ±0.2 % of a core from one run to
 the next, more than most single changes).
 
 Each version is a folder holding an `appmode` package (a `git worktree add` of a
@@ -23,8 +23,9 @@ from contextlib import ExitStack
 from pathlib import Path
 
 import serial
-from common import cpu_seconds
-from uart2 import drive_reporting, served
+
+from bench.common import cpu_seconds
+from bench.control_port import drive_reporting, served
 
 Ports = tuple[serial.Serial, serial.Serial]
 

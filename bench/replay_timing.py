@@ -28,9 +28,8 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from common import percentile
-
 from appmode.transcript.replay import play
+from bench.common import percentile
 
 PLAYERS = ("appmode play", "python-can MessageSync")
 ROOT = Path(__file__).resolve().parent.parent

@@ -113,10 +113,11 @@ def run(args: argparse.Namespace) -> int:
     from appmode.session.hold import HoldToDrive
     from appmode.session.opener import open_session
 
+    choice = board_choice(args)
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
     on_message = None if interactive else _print_message
-    session = open_session(board_choice(args), driving, on_message, args.record)
+    session = open_session(choice, driving, on_message, args.record)
     script = command_lines(sys.stdin, MAX_COMMAND)
     return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
 

@@ -5,18 +5,12 @@ where it matters, its drive type. `choose` holds every rule of how URLs, `--uart
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
-from itertools import count
 
 from appmode.board.profiles import Profile, profile_named
 from appmode.errors import AppmodeError
-from appmode.line.wire import APP, UART2
-from appmode.ports.target import Target
+from appmode.ports.target import Target, board_ports
 from appmode.protocol.params import DriveType
-
-_SHARES = count(1)
-"""Numbers the names that make two sim:// ports one simulated board, in this process."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,43 +41,15 @@ def choose(
     (the same board's control port, `url` then its APP port) — with the `profile` named
     (else a sim:// URL's, else the sheet) and the `drive` type given; AppmodeError says
     what does not fit together."""
-    board = url.with_sim(profile=profile, drive=drive)
-    chosen = profile_named(profile or board.profile or "sheet")
-    if url2 is None and not uart2:
-        if drive and not board.simulated:
+    driven, beside, control = board_ports(url, url2, uart2=uart2, profile=profile, drive=drive)
+    chosen = profile_named(profile or driven.profile or "sheet")
+    if not control:
+        if drive and not driven.simulated:
             raise AppmodeError(
                 "--drive on a real board's APP port: its drive type is part of "
                 "system_mode (appmode params URL --set system_mode=N), or add --uart2"
             )
-        return BoardChoice(board, chosen)
+        return BoardChoice(driven, chosen)
     chosen.check_uart2()
     fixed = DriveType.from_cli_name(drive) if drive else chosen.fixed_drive
-    if url2 is None:
-        return BoardChoice(board.for_uart2(), chosen, control=True, drive=fixed)
-    app, control = board, url2.with_sim(profile=profile, drive=drive)
-    if app.simulated and control.simulated:
-        app, control = _one_board(app, control)
-    return BoardChoice(control, chosen, control=True, app=app, drive=fixed)
-
-
-def _one_board(app: Target, uart2: Target) -> tuple[Target, Target]:
-    """Two sim:// targets as the two ports of one simulated board (its options given on
-    the first, or the same on both)."""
-    app_options, uart2_options = (
-        {k: v for k, v in t.sim.items() if k not in ("port", "share")} for t in (app, uart2)
-    )
-    if uart2_options and uart2_options != app_options:
-        raise AppmodeError(
-            f"{app} and {uart2} are one simulated board: give its options once, on "
-            f"the first URL (appmode drive '{uart2}' sim://)"
-        )
-    return both_ports(app)
-
-
-def both_ports(target: Target) -> tuple[Target, Target]:
-    """A sim:// target's board opened on both its ports: (the APP port, UART2), one board
-    (a name it shares, made here unless it names one)."""
-    if "share" not in target.sim:
-        target = target.with_sim(share=f"board-{os.getpid()}-{next(_SHARES)}")
-    app = target if "port" not in target.sim else target.on_port(APP)
-    return app, target.on_port(UART2)
+    return BoardChoice(driven, chosen, control=True, app=beside, drive=fixed)

@@ -6,9 +6,11 @@ parsed again."""
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from itertools import count
 from types import MappingProxyType
 from typing import TypeAlias
 from urllib.parse import parse_qsl, unquote, urlsplit
@@ -131,6 +133,50 @@ class Target:
     def on_port(self, port: str) -> Target:
         """The same simulated board's `port` (`app` or `uart2`)."""
         return replace(self, options=_frozen({**self.options, "port": port}))
+
+
+def board_ports(
+    url: Target,
+    url2: Target | None,
+    *,
+    uart2: bool,
+    profile: str | None,
+    drive: str | None,
+) -> tuple[Target, Target | None, bool]:
+    """The ports a command opens of the board `url` names: (the port it drives, the
+    same board's APP port beside it, whether it drives the control port). With `url2`
+    it drives that control port, `url` beside it (two sim:// URLs are one simulated
+    board); with `uart2`, `url`'s own control port. A simulated board takes `profile`
+    and `drive` (`with_sim`)."""
+    board = url.with_sim(profile=profile, drive=drive)
+    if url2 is None:
+        return (board.for_uart2(), None, True) if uart2 else (board, None, False)
+    control = url2.with_sim(profile=profile, drive=drive)
+    if not (board.simulated and control.simulated):
+        return control, board, True
+    options = [
+        {k: v for k, v in t.sim.items() if k not in ("port", "share")} for t in (board, control)
+    ]
+    if options[1] and options[1] != options[0]:
+        raise AppmodeError(
+            f"{board} and {control} are one simulated board: give its options once, on "
+            f"the first URL (appmode drive '{control}' sim://)"
+        )
+    app, uart2_port = both_ports(board)
+    return uart2_port, app, True
+
+
+def both_ports(target: Target) -> tuple[Target, Target]:
+    """A sim:// target's board opened on both its ports: (the APP port, UART2), one board
+    (a name it shares, made here unless it names one)."""
+    if "share" not in target.sim:
+        target = target.with_sim(share=f"board-{os.getpid()}-{next(_SHARES)}")
+    app = target if "port" not in target.sim else target.on_port(APP)
+    return app, target.on_port(UART2)
+
+
+_SHARES = count(1)
+"""Numbers the names that make two sim:// ports one simulated board, in this process."""
 
 
 AnyTarget: TypeAlias = "Target | str"

@@ -90,6 +90,31 @@ def _brace_run(
     return pos + count
 
 
+def _opening(
+    buf: bytes,
+    pos: int,
+    n: int,
+    most: int,
+    hold: bool,
+    out: list[E],
+    event: Callable[[bytes, str], E],
+    what: str,
+) -> tuple[int | None, int]:
+    """At a `{`: a run of `{` (`_brace_run`), or a `{` that another interrupts within
+    `most` bytes, reported as `event`s. Returns (where that left off: None to hold, -1
+    when it was neither; where the `{`'s `}` is before `n` and within `most` bytes, or
+    -1)."""
+    if pos + 1 < n and buf[pos + 1] == LBRACE:
+        return _brace_run(buf, pos, hold, out, event, what), -1
+    limit = min(n, pos + most)
+    close = buf.find(b"}", pos + 1, limit)
+    reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
+    if reopen < 0:
+        return -1, close
+    out.append(event(buf[pos:reopen], _interrupted(what, 1)))
+    return reopen, close
+
+
 def _interrupted(what: str, count: int) -> str:
     return f"{what} interrupted by '{{'" if count == 1 else f"{count} {what}s interrupted by '{{'"
 
@@ -175,18 +200,11 @@ class HostDecoder:
                 out += [single[b] for b in buf[pos:stop]]  # each byte means one thing
                 pos = stop
                 continue
-            if pos + 1 < n and buf[pos + 1] == LBRACE:
-                after = _brace_run(buf, pos, True, out, BadFrame, "frame")
-                if after is None:
-                    break
+            after, close = _opening(buf, pos, n, MAX_FRAME, True, out, BadFrame, "frame")
+            if after is None:
+                break
+            if after >= 0:
                 pos = after
-                continue
-            limit = min(n, pos + MAX_FRAME)
-            close = buf.find(b"}", pos + 1, limit)
-            reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
-            if reopen >= 0:
-                out.append(BadFrame(buf[pos:reopen], _interrupted("frame", 1)))
-                pos = reopen
             elif close >= 0:
                 out.append(_parse_frame(buf[pos : close + 1]))
                 pos = close + 1
@@ -350,18 +368,11 @@ class BoardDecoder:
                 out.append(Garbage(buf[pos:start]))
                 pos = start
                 continue
-            if pos + 1 < n and buf[pos + 1] == LBRACE:
-                after = _brace_run(buf, pos, hold, out, Malformed, "record")
-                if after is None:
-                    break
+            after, close = _opening(buf, pos, n, MAX_RECORD, hold, out, Malformed, "record")
+            if after is None:
+                break
+            if after >= 0:
                 pos = after
-                continue
-            limit = min(n, pos + MAX_RECORD)
-            close = buf.find(b"}", pos + 1, limit)
-            reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
-            if reopen >= 0:
-                out.append(Malformed(buf[pos:reopen], _interrupted("record", 1)))
-                pos = reopen
             elif close >= 0:
                 if close + 1 == n and hold:
                     break  # a '$' may follow
@@ -370,8 +381,10 @@ class BoardDecoder:
                 out.append(_parse_record(raw, raw[1 : close - pos], end == close + 2, *self._sizes))
                 pos = end
             elif n - pos >= MAX_RECORD:
-                out.append(Malformed(buf[pos:limit], f"over {MAX_RECORD} bytes without '}}'"))
-                pos = limit
+                out.append(
+                    Malformed(buf[pos : pos + MAX_RECORD], f"over {MAX_RECORD} bytes without '}}'")
+                )
+                pos += MAX_RECORD
             elif hold:
                 break
             else:

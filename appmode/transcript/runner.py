@@ -23,8 +23,7 @@ from appmode.host.app.client import Host
 from appmode.host.link import LinkLost
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
-from appmode.ports.choice import both_ports
-from appmode.ports.target import Target
+from appmode.ports.target import Target, both_ports
 from appmode.ports.urls import open_link
 from appmode.protocol import app, app_decoders, param_values, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader

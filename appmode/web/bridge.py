@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from typing import Any
 
 from appmode.errors import AppmodeError
@@ -33,6 +34,9 @@ MESSAGES = 50
 """Messages of the session sent to a page."""
 MAX_LINE = 200
 """Longest command line a page may send."""
+WATCHERS_MAY = ("alive", "take", "waves")
+"""What a watching page may send: the rest drives."""
+Handler = Callable[[object, dict[str, Any]], "dict[str, Any] | None"]
 
 
 def driving() -> HoldToDrive:
@@ -68,6 +72,18 @@ class Bridge:
         self.pages: dict[object, Bucket] = {}
         self.waves: set[object] = set()
         """Pages that draw waveforms: their status carries the traces."""
+        self._handlers: dict[str, Handler] = {
+            "alive": self._alive,
+            "take": self._take,
+            "waves": self._waves,
+            "press": self._press,
+            "hold": self._press,
+            "stick": self._stick,
+            "release": self._stop,
+            "stop": self._stop,
+            "command": self._command,
+        }
+        """What each kind of message (`messages.PAGE`) does."""
 
     def join(self, page: object) -> None:
         """A page opened: it drives if none does, else it watches."""
@@ -105,29 +121,28 @@ class Bridge:
         except (ValueError, UnicodeDecodeError):
             return {"t": "error", "text": "not JSON: ignored"}
         kind = message.get("t") if isinstance(message, dict) else None
-        if kind == "alive":
-            return None
-        if kind == "take":
-            return self._take(page)
-        if kind == "waves":
-            (self.waves.add if message.get("on") is True else self.waves.discard)(page)
-            return None
-        if kind not in ("press", "hold", "stick", "release", "stop", "command"):
+        handler = self._handlers.get(kind) if isinstance(kind, str) else None
+        if handler is None:
             return {"t": "error", "text": f"unknown message {kind!r}: ignored"}
-        if page is not self.driver:
+        if kind not in WATCHERS_MAY and page is not self.driver:
             return {"t": "error", "text": "this page watches: take over to drive"}
-        if kind in ("press", "hold"):
-            key = self._key(message.get("key"))
-            if key is None:
-                return {"t": "error", "text": f"no key {message.get('key')!r} here"}
-            self.session.press(key)
-        elif kind == "stick":
-            return self._stick(message.get("x"), message.get("y"))
-        elif kind in ("release", "stop"):
-            self.session.stop()
-        else:
-            return self._command(message.get("line"))
+        return handler(page, message)
+
+    def _alive(self, page: object, message: dict[str, Any]) -> None:
+        return None  # any message proves the driving page alive (above)
+
+    def _waves(self, page: object, message: dict[str, Any]) -> None:
+        (self.waves.add if message.get("on") is True else self.waves.discard)(page)
+
+    def _press(self, page: object, message: dict[str, Any]) -> dict[str, Any] | None:
+        key = self._key(message.get("key"))
+        if key is None:
+            return {"t": "error", "text": f"no key {message.get('key')!r} here"}
+        self.session.press(key)
         return None
+
+    def _stop(self, page: object, message: dict[str, Any]) -> None:
+        self.session.stop()
 
     def _key(self, name: object) -> str | None:
         """What the session's `press` takes for a key the page names: a cell of the grid
@@ -140,8 +155,9 @@ class Bridge:
                     return session.grid_key(r, c)
         return name if isinstance(name, str) and name in session.hold_keys.values() else None
 
-    def _stick(self, x: object, y: object) -> dict[str, Any] | None:
+    def _stick(self, page: object, message: dict[str, Any]) -> dict[str, Any] | None:
         """An analog stick's position, each axis −1…1 (repeated while it is held)."""
+        x, y = message.get("x"), message.get("y")
         if not (_unit(x) and _unit(y)):
             return {"t": "error", "text": "a stick's x and y are numbers in −1…1"}
         assert isinstance(x, (int, float)) and isinstance(y, (int, float))
@@ -151,7 +167,7 @@ class Bridge:
             return {"t": "error", "text": str(exc)}
         return None
 
-    def _take(self, page: object) -> dict[str, Any] | None:
+    def _take(self, page: object, message: dict[str, Any]) -> None:
         """A watcher takes over: the car stops first, and the page that drove sees it
         now watches (in its next status)."""
         if page is not self.driver:
@@ -159,9 +175,9 @@ class Bridge:
             self.driver = page
             self.session.keepalive()
             self.session.say("another page took over driving")
-        return None
 
-    def _command(self, line: object) -> dict[str, Any] | None:
+    def _command(self, page: object, message: dict[str, Any]) -> dict[str, Any] | None:
+        line = message.get("line")
         if not isinstance(line, str) or len(line) > MAX_LINE:
             return {"t": "error", "text": f"a command is text of at most {MAX_LINE} characters"}
         try:

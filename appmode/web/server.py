@@ -27,6 +27,7 @@ from aiohttp import WSMsgType, web
 from appmode.errors import AppmodeError
 from appmode.host import signals
 from appmode.session.base import BaseSession
+from appmode.web import messages
 from appmode.web.access import (
     COOKIE,
     host_allowed,
@@ -50,9 +51,20 @@ REFRESH = 0.02
 """Seconds between reads of the link (and checks of the heartbeat)."""
 SEND = 0.1
 """How often each page's status is checked, and sent if it changed."""
+SCRIPTS = (
+    "app.js",
+    "link.js",
+    "pad.js",
+    "stick.js",
+    "tilt.js",
+    "instruments.js",
+    "params.js",
+    "waves.js",
+)
+"""The page's script: ES modules, `app.js` first (index.html preloads the rest)."""
 ASSETS = (
     "index.html",
-    "app.js",
+    *SCRIPTS,
     "app.css",
     "offline.html",
     "app.webmanifest",
@@ -174,6 +186,9 @@ class WebServer:
 
     async def _static(self, request: web.Request) -> web.StreamResponse:
         name = request.match_info["name"]
+        if name == "messages.js":  # the vocabulary, made from Python
+            body = messages.module().encode()
+            return _compressed(web.Response(body=body, content_type="text/javascript"))
         if name not in ASSETS:
             raise web.HTTPNotFound()
         kind = TYPES[name[name.rindex(".") :]]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import selectors
 import signal
 import subprocess
 import sys
@@ -11,6 +10,9 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+
+from appmode.testing.process import BoardProcess
+from appmode.testing.process import board_process as appmode_board_process
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -42,65 +44,6 @@ def run(
     return done
 
 
-class BoardProcess:
-    """`appmode board ...` running; `url` is what it printed after 'port: ', `uart2`
-    after 'uart2: '."""
-
-    def __init__(self, *args: str) -> None:
-        self.proc = subprocess.Popen(
-            appmode_cmd("board", *args),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-            cwd=ROOT,
-        )
-        self.url = self._read_port_line()
-        self.clock_after = time.monotonic()
-        """At or after the board's clock zero (it printed the port line after it): a time
-        of its recording, t, happened at or before `clock_after + t` on this machine's
-        monotonic clock."""
-        self.uart2 = self._read_uart2_line()
-        self.details: dict[str, str] = {}
-        """With --bluetooth: the stand-in's `bus`, `ble` and `spp` lines; with
-        --advertise: the `ble` and `spp` lines."""
-        lines = 3 if "--bluetooth" in args else 2 if "--advertise" in args else 0
-        if lines:
-            assert self.proc.stdout is not None
-            for _ in range(lines):
-                name, _, value = self.proc.stdout.readline().strip().partition(": ")
-                self.details[name] = value
-
-    def _read_port_line(self, timeout: float = 20.0) -> str:
-        assert self.proc.stdout is not None
-        sel = selectors.DefaultSelector()
-        sel.register(self.proc.stdout, selectors.EVENT_READ)
-        if not sel.select(timeout):
-            self.stop()
-            raise AssertionError(f"board printed no port line in {timeout} s")
-        first = self.proc.stdout.readline()
-        if not first.startswith("port: "):
-            err = self.stop()
-            raise AssertionError(f"board said {first!r}; stderr: {err}")
-        return first[len("port: ") :].strip()
-
-    def _read_uart2_line(self) -> str:
-        """The control port's line, printed right after the port line."""
-        assert self.proc.stdout is not None
-        second = self.proc.stdout.readline()
-        if not second.startswith("uart2: "):
-            err = self.stop()
-            raise AssertionError(f"board said {second!r} after its port line; stderr: {err}")
-        return second[len("uart2: ") :].strip()
-
-    def stop(self, sig: int = signal.SIGTERM) -> str:
-        """Stop it (SIGTERM by default); return its stderr."""
-        return stop_process(self.proc, sig)
-
-    def kill(self) -> None:
-        self.proc.kill()
-        self.proc.communicate()
-
-
 def stop_process(proc: subprocess.Popen[str], sig: int = signal.SIGTERM) -> str:
     """Send `sig` to a process still running, wait for its end (kill it after 10 s);
     return its stderr."""
@@ -116,11 +59,8 @@ def stop_process(proc: subprocess.Popen[str], sig: int = signal.SIGTERM) -> str:
 
 @contextmanager
 def board_process(*args: str) -> Iterator[BoardProcess]:
-    board = BoardProcess(*args)
-    try:
+    with appmode_board_process(*args, cwd=ROOT) as board:
         yield board
-    finally:
-        board.stop()
 
 
 def wait_for(predicate: object, timeout: float = 10.0) -> None:

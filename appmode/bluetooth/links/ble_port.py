@@ -17,6 +17,7 @@ import contextlib
 import logging
 import threading
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from serial import SerialBase, SerialException, SerialTimeoutException
@@ -50,6 +51,10 @@ BAUD = 9600
 
 class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
     """A BLE UART module, opened by `ble://` URL."""
+
+    on_notified: Callable[[int], None] | None = None
+    """Called (on the port's loop) with the size of each notification as it comes, before
+    `read` can return it: a hook for timing the radio's part of a round trip."""
 
     def open(self) -> None:
         if self._port is None:
@@ -113,6 +118,8 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
         self._writer = asyncio.ensure_future(self._write_loop(client, write))
 
     def _notified(self, _: Any, data: bytearray) -> None:
+        if self.on_notified is not None:
+            self.on_notified(len(data))
         self._received.add(data)
 
     def _disconnected(self, _: Any) -> None:

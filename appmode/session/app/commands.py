@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from appmode.errors import AppmodeError
 from appmode.protocol import param_values, params
-from appmode.session.command_line import SPEED_COMPLETES, SPEED_STEP, CommandSpec
+from appmode.session.command_line import SPEED_COMPLETES, SPEED_KEYS, SPEED_STEP, CommandSpec
 
 if TYPE_CHECKING:
     from appmode.session.app.session import AppSession
@@ -73,3 +73,18 @@ COMMANDS: tuple[CommandSpec[AppSession], ...] = (
         lambda s, a: s.send_tokens(a),
     ),
 )
+
+
+KEYS_HELP = (
+    "arrows, q w e / a s d / z x c drive · space stop · i j k page · l latch\n"
+    "+ - speed · p params · v waveforms · : command · ? help · Ctrl-Q quit"
+)
+"""The console's keys, as its panel and help show them."""
+KEYS = {
+    "i": "page gravity",
+    "j": "page joystick",
+    "k": "page button",
+    "p": "params",
+    **SPEED_KEYS,
+}
+"""Keys that run a command line."""

@@ -28,21 +28,14 @@ from appmode.protocol.directions import (
 )
 from appmode.protocol.layouts import VELOCITY
 from appmode.session.app import status
-from appmode.session.app.commands import COMMANDS
+from appmode.session.app.commands import COMMANDS, KEYS, KEYS_HELP
 from appmode.session.base import BaseSession
-from appmode.session.command_line import SPEED_KEYS
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
 from appmode.session.rows import (
     Row,
     hold_mode,
 )
-
-KEYS_HELP = (
-    "arrows, q w e / a s d / z x c drive · space stop · i j k page · l latch\n"
-    "+ - speed · p params · v waveforms · : command · ? help · Ctrl-Q quit"
-)
-"""The console's keys, as its panel and help show them."""
 
 
 class AppSession(BaseSession):
@@ -51,13 +44,7 @@ class AppSession(BaseSession):
     host: Host
     commands = COMMANDS
     keys_help = KEYS_HELP
-    keys: ClassVar[dict[str, str]] = {
-        "i": "page gravity",
-        "j": "page joystick",
-        "k": "page button",
-        "p": "params",
-        **SPEED_KEYS,
-    }
+    keys = KEYS
     aliases: ClassVar[dict[str, str]] = {"read": "params"}
     waveforms = True
 

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from appmode.errors import AppmodeError
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import MOTIONS
-from appmode.session.command_line import SPEED_COMPLETES, SPEED_STEP, CommandSpec
+from appmode.session.command_line import SPEED_COMPLETES, SPEED_KEYS, SPEED_STEP, CommandSpec
 
 if TYPE_CHECKING:
     from appmode.session.control.session import ControlSession
@@ -114,3 +114,17 @@ def _degrees(args: list[str], usage: str) -> float:
     if not abs(degrees) <= control.U16 / 10:
         raise AppmodeError(usage)
     return degrees
+
+
+KEYS_HELP = (
+    "arrows, q w e / a s d / z x c drive · , . turn · space stop · l latch\n"
+    "r R rotate · + - speed · p settings · : command · ? help · Ctrl-Q quit"
+)
+"""The console's keys, as its panel and help show them."""
+KEYS = {
+    "r": "rotate",
+    "R": "rotate -",
+    "p": "settings",
+    **SPEED_KEYS,
+}
+"""Keys that run a command line."""

@@ -27,8 +27,7 @@ from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.params import DriveType
 from appmode.session.base import BaseSession
-from appmode.session.command_line import SPEED_KEYS
-from appmode.session.control.commands import COMMANDS, SETTING_NAMES
+from appmode.session.control.commands import COMMANDS, KEYS, KEYS_HELP, SETTING_NAMES
 from appmode.session.control.status import (
     STOP,
     Keys,
@@ -45,12 +44,6 @@ DEFAULT_SPEED = 300
 """Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""
 DEFAULT_ANGLE = 90.0
 REPORT_BIT = params.MODE_BIT["encoder_report"]
-
-
-KEYS_HELP = (
-    "arrows, q w e / a s d / z x c drive · , . turn · space stop · l latch\n"
-    "r R rotate · + - speed · p settings · : command · ? help · Ctrl-Q quit"
-)
 
 
 def velocity_for(motion: Motion, speed: int, drive: DriveType) -> dict[str, int]:
@@ -82,12 +75,7 @@ class ControlSession(BaseSession):
     host: ControlHost
     commands = COMMANDS
     keys_help = KEYS_HELP
-    keys: ClassVar[dict[str, str]] = {
-        "r": "rotate",
-        "R": "rotate -",
-        "p": "settings",
-        **SPEED_KEYS,
-    }
+    keys = KEYS
     hold_keys: ClassVar[dict[str, str]] = {",": "rotate-ccw", ".": "rotate-cw"}
 
     def __init__(

@@ -19,8 +19,9 @@ import tty
 from contextlib import AbstractContextManager
 from pathlib import Path
 
-from common import Row, board, cpu_seconds, percentile, started
 from playwright.sync_api import Browser, Page, sync_playwright
+
+from bench.common import Row, board, cpu_seconds, percentile, started
 
 CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).resolve().parent.parent

@@ -23,7 +23,10 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import serial
-from common import (
+
+from appmode.protocol import control, control_decoders, settings
+from appmode.protocol.params import DriveType
+from bench.common import (
     Row,
     fitted_slope,
     floor_row,
@@ -32,9 +35,6 @@ from common import (
     percentile,
     share_and_floor,
 )
-
-from appmode.protocol import control, control_decoders, settings
-from appmode.protocol.params import DriveType
 
 TICK = 0.010
 BYTE = 10 / 115200

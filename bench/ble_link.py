@@ -25,14 +25,15 @@ from contextlib import contextmanager
 from multiprocessing.connection import Connection
 from typing import Any
 
-import link_roundtrip
 import serial
-from common import Row, percentile, started
 
 import appmode  # noqa: F401 - registers ble://
-from appmode.bluetooth.links.ble_port import AHEAD, BleSerial
+from appmode.bluetooth.links.ble_port import AHEAD
 from appmode.bluetooth.module import CONNECTION_INTERVAL, PAYLOAD, UART_BYTES_PER_S
 from appmode.bluetooth.standin.endpoint import BluetoothEndpoint
+from appmode.testing.process import board_process
+from bench import link_roundtrip
+from bench.common import Row, percentile
 
 ANSWER = b"{C500:10000:20:0:10:10:10:0:0}$"
 SENT = 1920
@@ -42,13 +43,11 @@ SENT = 1920
 def ble_board() -> Iterator[str]:
     """`appmode board --bluetooth --no-pace`; yields its ble:// URL, with this process's
     DBUS_SYSTEM_BUS_ADDRESS set to its bus meanwhile."""
-    with started("board", "--quiet", "--bluetooth", "--no-pace") as (proc, url):
-        assert proc.stdout is not None
-        details = dict(proc.stdout.readline().strip().split(": ", 1) for _ in range(4))
+    with board_process("--quiet", "--bluetooth", "--no-pace") as served:
         before = os.environ.get("DBUS_SYSTEM_BUS_ADDRESS")
-        os.environ["DBUS_SYSTEM_BUS_ADDRESS"] = details["bus"]
+        os.environ["DBUS_SYSTEM_BUS_ADDRESS"] = served.details["bus"]
         try:
-            yield url
+            yield served.url
         finally:
             if before is None:
                 del os.environ["DBUS_SYSTEM_BUS_ADDRESS"]
@@ -110,15 +109,13 @@ def own_latency(trials: int) -> tuple[list[float], list[float], list[float]]:
 
     host: dict[str, float] = {}
     write_gatt_char = BleakClient.write_gatt_char
-    notified = BleSerial._notified
 
     async def timed_write(self: BleakClient, *args: Any, **kwargs: Any) -> None:
         host["gatt"] = time.monotonic()
         await write_gatt_char(self, *args, **kwargs)
 
-    def timed_notified(self: BleSerial, sender: Any, data: bytearray) -> None:
+    def timed_notified(size: int) -> None:
         host["callback"] = time.monotonic()
-        notified(self, sender, data)
 
     mine, theirs = multiprocessing.Pipe()
     child = multiprocessing.Process(target=echo_board, args=(theirs, trials), daemon=True)
@@ -126,8 +123,8 @@ def own_latency(trials: int) -> tuple[list[float], list[float], list[float]]:
     before = os.environ.get("DBUS_SYSTEM_BUS_ADDRESS")
     os.environ["DBUS_SYSTEM_BUS_ADDRESS"] = mine.recv()
     BleakClient.write_gatt_char = timed_write  # type: ignore[method-assign]
-    BleSerial._notified = timed_notified  # type: ignore[method-assign, assignment]
     port = serial.serial_for_url("ble://HC-08", timeout=1)
+    port.on_notified = timed_notified
     trips, platform, own = [], [], []
     rng = random.Random(1)
     try:
@@ -147,7 +144,6 @@ def own_latency(trials: int) -> tuple[list[float], list[float], list[float]]:
     finally:
         port.close()
         BleakClient.write_gatt_char = write_gatt_char  # type: ignore[method-assign]
-        BleSerial._notified = notified  # type: ignore[method-assign]
         child.join(10)
         if before is None:
             del os.environ["DBUS_SYSTEM_BUS_ADDRESS"]
@@ -158,7 +154,8 @@ def own_latency(trials: int) -> tuple[list[float], list[float], list[float]]:
 
 def rows(quick: bool) -> list[Row]:
     trials = 50 if quick else 200
-    with started("board", "--quiet", "--pty", "--no-pace") as (_, pty):
+    with board_process("--quiet", "--pty", "--no-pace") as served:
+        pty = served.url
         on_pty = [x * 1000 for x in link_roundtrip.measure(pty, trials)]
     trips, platform, own = own_latency(trials)
     with ble_board() as url:
