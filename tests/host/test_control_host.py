@@ -95,7 +95,13 @@ def test_a_board_that_does_not_answer_gives_one_clear_error() -> None:
 
 
 def test_reads_agree_on_a_noisy_link() -> None:
+    """What a read reports is the board's value, whatever the noise did to the replies.
+    (A frame to the board has no checksum: noise may make a read a set, whose value is
+    then the board's: the read is checked against the board's before and after it.)"""
     url = "sim://?drive=mecanum&faults=corrupt:0.01,drop:0.01,seed:4"
     with ControlHost(url, tries=20) as host:
+        board = host._port.board
         for _ in range(5):
-            assert host.settings()["max_speed"] == 500
+            before = board.core.params[params.MAX_SPEED]
+            read = host.settings()["max_speed"]
+            assert read in (before, board.core.params[params.MAX_SPEED])
