@@ -21,10 +21,11 @@ from appmode.host import signals
 from appmode.host.events import LinkStatus
 from appmode.line.pacing import Ahead
 from appmode.line.wire import Tap
+from appmode.ports.remote import WriteRefused
 from appmode.ports.target import Target, as_target
 
-Opener = Callable[[str], serial.SerialBase]
-"""Opens a port by URL (`ports.urls.open_link`, with options bound; any pyserial opener)."""
+Opener = Callable[[Target], serial.SerialBase]
+"""Opens a port by its Target (`ports.urls.open_link`, with options bound)."""
 RETRY = 0.5
 CHUNK = 64
 """Bytes written at once: 67 ms at 9600 bps, the longest an ending signal waits."""
@@ -43,6 +44,11 @@ can stop it now (the firmware has no time-out)."""
 
 class LinkLost(AppmodeError):
     """The link is down; the host is trying to get it back."""
+
+
+class Refused(AppmodeError):
+    """The far side of the link refused the bytes (a shared car another client drives):
+    nothing was sent; the link stays up."""
 
 
 UNHEARD = 256
@@ -71,12 +77,13 @@ class Link(Generic[E]):
         self.url = self.target.url
         self.tap = tap
         self._opener = opener
-        self._port: serial.SerialBase | None = opener(self.url)
+        self._port: serial.SerialBase | None = opener(self.target)
         self._writing = threading.RLock()  # the stop guard may write from its thread
         self._tapping = threading.Lock()
         self._unheard: list[tuple[float, bytes]] = []  # sends told once reads catch up
         # after opening: an in-process sim:// board booted just now, and its clock is ours
-        board_origin = getattr(self._port, "clock_origin", None)
+        # (a shared car's began when its share did: this session's time starts now)
+        board_origin = getattr(self._port, "clock_origin", None) if self.target.simulated else None
         self._origin = time.monotonic() if board_origin is None else float(board_origin)
         self._lost_at = 0.0
         self._ahead: Ahead | None = None  # the line's rate, known once the port is open
@@ -88,10 +95,18 @@ class Link(Generic[E]):
         board serving another client."""
         self.refusals = 0
         """Times in a row the far end closed the link before a byte."""
+        self.latency: float | None = None
+        """Milliseconds the last write took to be acknowledged, on a port that says (a
+        car shared over the network: its host acknowledges what it wrote)."""
 
     def now(self) -> float:
         """Seconds since the session started."""
         return time.monotonic() - self._origin
+
+    @property
+    def origin(self) -> float:
+        """`time.monotonic()` at this link's clock zero (`now()` counts from it)."""
+        return self._origin
 
     @property
     def connected(self) -> bool:
@@ -135,7 +150,7 @@ class Link(Generic[E]):
             return
         self._lost_at = self.now()
         try:
-            self._port = self._opener(self.url)
+            self._port = self._opener(self.target)
         except AppmodeError:
             return
         self._heard = False
@@ -153,7 +168,7 @@ class Link(Generic[E]):
         """The first thing a reopened link sends is the stop: the car kept its last
         command while the link was down (the firmware has no time-out)."""
         if self.stop_on_close and self._port is not None:
-            with self._writing, contextlib.suppress(LinkLost):
+            with self._writing, contextlib.suppress(LinkLost, Refused):
                 self._write_chunk(self._stop())
 
     def _proven_by_output(self) -> None:
@@ -183,9 +198,12 @@ class Link(Generic[E]):
                 raise LinkLost(f"link to {self.url} lost while sending")
             try:
                 port.write(chunk)
+            except WriteRefused as exc:
+                raise Refused(f"not sent to {self.url}: {exc}") from None
             except (serial.SerialException, OSError) as exc:
                 self._lost(exc)
                 raise LinkLost(f"link to {self.url} lost while sending: {exc}") from None
+            self.latency = getattr(port, "latency", None)
             if self.tap is not None:
                 self._tap_sent(port, chunk)
             self._sent(chunk)
@@ -330,6 +348,16 @@ class Link(Generic[E]):
         """The bytes that leave the car stopped, sent last when the session closes."""
         raise NotImplementedError
 
+    def send_stop(self) -> bytes | None:
+        """Send the port's stop now, as `close` ends with it (what was sent decides
+        it): the bytes sent, or None when the link is down."""
+        try:
+            stop = self._stop()
+            self.send(stop)
+        except (LinkLost, Refused):
+            return None
+        return stop
+
     def close(self) -> bytes | None:
         """Stop the car (`_stop()` is the last thing sent), check that it took where the
         protocol can (`_confirm`: AppmodeError if it did not), then close the port.
@@ -347,6 +375,8 @@ class Link(Generic[E]):
                     self.send(stop)
             except LinkLost:
                 return self.close()  # the port is gone: nothing was sent
+            except Refused:
+                stop = b""  # another client drives: not this one's to stop
             except AppmodeError:
                 pass  # written; only its recording failed, which must not keep it open
         try:

@@ -167,7 +167,7 @@ def _car(
     profile, nearest = firmware(one.sent)
     ports = [port]
 
-    def reopen(url: str) -> serial.SerialBase:
+    def reopen(url: Target) -> serial.SerialBase:
         return ports.pop() if ports else open_link(url, timeout=0.02, baud=one.baud)
 
     progress(f"reading the parameters at {one.baud} bps")

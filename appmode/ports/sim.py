@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import serial
-from serial import SerialBase, SerialException
+from serial import SerialException
 
 from appmode.board.firmware import Board
 from appmode.board.profiles import profile_named
@@ -31,6 +31,7 @@ from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec, FaultyLine
 from appmode.line.pacing import Line
 from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
+from appmode.ports.modemless import Modemless
 from appmode.ports.target import SIM_USAGE, Target
 from appmode.ports.urls import port_target
 from appmode.protocol import params
@@ -75,7 +76,7 @@ def _flag(name: str, text: str) -> bool:
     raise SerialException(f"sim:// option {name}={text!r}: use 1 or 0")
 
 
-class SimSerial(SerialBase):  # type: ignore[misc]
+class SimSerial(Modemless):
     """A pyserial port with the simulated board at the other end."""
 
     is_open: bool
@@ -309,28 +310,3 @@ class SimSerial(SerialBase):  # type: ignore[misc]
 
     def reset_output_buffer(self) -> None:
         """Bytes already on the simulated line cannot be called back."""
-
-    def _update_dtr_state(self) -> None:
-        """No modem lines."""
-
-    def _update_rts_state(self) -> None:
-        """No modem lines."""
-
-    def _update_break_state(self) -> None:
-        """No break."""
-
-    @property
-    def cts(self) -> bool:
-        return True
-
-    @property
-    def dsr(self) -> bool:
-        return True
-
-    @property
-    def ri(self) -> bool:
-        return False
-
-    @property
-    def cd(self) -> bool:
-        return True

@@ -13,21 +13,24 @@ from dataclasses import dataclass, field, replace
 from itertools import count
 from types import MappingProxyType
 from typing import TypeAlias
-from urllib.parse import parse_qsl, unquote, urlsplit
+from urllib.parse import parse_qsl, quote, unquote, urlsplit
 
 from appmode.errors import AppmodeError
 from appmode.line.wire import APP, PORTS, UART2
 from appmode.ports.radio import BadAddress, BleTarget, BtTarget, parse_ble, parse_bt
+from appmode.ports.remote import USAGE as REMOTE_USAGE
+from appmode.ports.remote import BadRemote, RemoteTarget, parse_remote
 from appmode.protocol import params
 
-SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt")
+SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt", "zenoh")
 NETWORK_SCHEMES = ("socket", "rfc2217")
 RADIO_SCHEMES = ("ble", "bt")
 NUMBERED_PTY = re.compile(r"/dev/(pts/\d+|ttys\d+)")
 """A pseudo-terminal named by its number (Linux, macOS)."""
 URL_HELP = (
     "use a device path (/dev/ttyUSB0, /dev/rfcomm0, COM3), socket://HOST:PORT, "
-    "rfc2217://HOST:PORT, ble://ADDRESS, bt://ADDRESS, loop:// or sim://"
+    "rfc2217://HOST:PORT, ble://ADDRESS, bt://ADDRESS, zenoh://NAME?connect=…&key=…, "
+    "loop:// or sim://"
 )
 SIM_OPTIONS = ("profile", "drive", "flash", "pace", "baud", "faults", "port", "share")
 """What a sim:// URL may set (ports/sim.py says what each does)."""
@@ -38,6 +41,8 @@ SIM_USAGE = (
 )
 
 NO_OPTIONS: Mapping[str, str] = MappingProxyType({})
+HIDDEN = "…"
+"""What a URL shows of a shared car's key: messages, pages and recordings never hold it."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -56,13 +61,18 @@ class Target:
     """A device's `?baud=N`."""
     radio: BleTarget | BtTarget | None = None
     """What a `ble://` or `bt://` URL names."""
+    remote: RemoteTarget | None = None
+    """What a `zenoh://` URL names: a car another machine shares."""
 
     @property
     def url(self) -> str:
         """The URL as it opens (and as messages show it)."""
         if not self.scheme:
             return self.path if self.baud is None else f"{self.path}?baud={self.baud}"
-        query = "&".join(f"{k}={v}" if v else k for k, v in self.options.items())
+        query = "&".join(
+            f"{k}={HIDDEN if k == 'key' and self.remote else quote(v, safe='/:,[]')}" if v else k
+            for k, v in self.options.items()
+        )
         return f"{self.scheme}://{self.address}{'?' if query else ''}{query}"
 
     def __str__(self) -> str:
@@ -85,12 +95,14 @@ class Target:
 
     @property
     def sim(self) -> Mapping[str, str]:
-        """A sim:// URL's options (none for any other URL)."""
+        """A sim:// URL's options (none for any other URL; a zenoh:// URL's port=)."""
+        if self.scheme == "zenoh":
+            return {"port": self.options["port"]} if "port" in self.options else NO_OPTIONS
         return self.options if self.simulated else NO_OPTIONS
 
     @property
     def sim_port(self) -> str:
-        """The port a sim:// URL opens: `app`, or `uart2` with `port=uart2`."""
+        """The port a sim:// (or zenoh://) URL opens: `app`, or `uart2` with `port=uart2`."""
         return self.sim.get("port", APP).lower()
 
     @property
@@ -126,9 +138,10 @@ class Target:
         return replace(self, options=_frozen({**self.options, **added})) if added else self
 
     def for_uart2(self) -> Target:
-        """The control port of this target: a sim:// URL without `port=` opens the
-        simulated board's UART2; anything else is the port it names."""
-        return self.on_port(UART2) if self.simulated and "port" not in self.sim else self
+        """The control port of this target: a sim:// or zenoh:// URL without `port=`
+        opens the board's UART2; anything else is the port it names."""
+        shared = self.simulated or self.remote is not None
+        return self.on_port(UART2) if shared and "port" not in self.options else self
 
     def on_port(self, port: str) -> Target:
         """The same simulated board's `port` (`app` or `uart2`)."""
@@ -203,6 +216,15 @@ def parse_target(url: str) -> Target:
         _check_sim(url, parts.netloc, parts.path, options)
     address = unquote(parts.netloc) + (parts.path if scheme in NETWORK_SCHEMES else "")
     radio: BleTarget | BtTarget | None = None
+    remote: RemoteTarget | None = None
+    if scheme == "zenoh":
+        if parts.path not in ("", "/"):
+            raise AppmodeError(f"expected {REMOTE_USAGE}, not {url!r}")
+        try:
+            remote = parse_remote(address, options, url)
+        except BadRemote as exc:
+            raise AppmodeError(str(exc)) from None
+        _check_port(url, options)
     if scheme in RADIO_SCHEMES:
         if parts.path not in ("", "/"):
             address = ""  # a path is no part of a module's address: the usage says so
@@ -211,7 +233,15 @@ def parse_target(url: str) -> Target:
             radio = parse(address, options, url)
         except BadAddress as exc:
             raise AppmodeError(str(exc)) from None
-    return Target(scheme, address, options, radio=radio)
+    return Target(scheme, address, options, radio=radio, remote=remote)
+
+
+def shared_car(name: str, connect: tuple[str, ...], key: str) -> Target:
+    """The car `name` shared on Zenoh, reached at `connect` (none: by scouting) with
+    `key`: the target its `zenoh://` URL names."""
+    options = {"connect": ",".join(connect)} if connect else {}
+    remote = RemoteTarget(name, connect, key)
+    return Target("zenoh", name, _frozen({**options, "key": key}), remote=remote)
 
 
 def as_target(url: AnyTarget) -> Target:
@@ -230,9 +260,13 @@ def _check_sim(url: str, netloc: str, path: str, options: Mapping[str, str]) -> 
     for name in options:
         if name not in SIM_OPTIONS:
             raise AppmodeError(f"unknown sim:// option {name!r}: use {', '.join(SIM_OPTIONS)}")
+    _check_port(url, options)
+
+
+def _check_port(url: str, options: Mapping[str, str]) -> None:
     side = options.get("port", APP).lower()
     if side not in PORTS:
-        raise AppmodeError(f"sim:// option port={side!r}: use {' or '.join(PORTS)}")
+        raise AppmodeError(f"port={side!r} in {url!r}: use {' or '.join(PORTS)}")
 
 
 def _check_address(url: str, scheme: str) -> None:

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 
 NO_PTY = "this system has no pseudo-terminals (Windows)"
 
-for _package in ("appmode.ports", "appmode.bluetooth.links"):  # sim://; ble:// and bt://
+for _package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):  # sim://, …
     if _package not in serial.protocol_handler_packages:
         serial.protocol_handler_packages.append(_package)
 
@@ -38,6 +38,7 @@ OWN_PORTS = {
     "sim": "appmode.ports.protocol_sim",
     "ble": "appmode.bluetooth.links.protocol_ble",
     "bt": "appmode.bluetooth.links.protocol_bt",
+    "zenoh": "appmode.net.protocol_zenoh",
 }
 """appmode's own port classes (pyserial's handlers for these schemes): they take the
 Target itself, and say themselves what went wrong and what to do."""

@@ -63,7 +63,6 @@ class BaseSession(ABC):
     ) -> None:
         self.target = target
         self.url = self.target.url
-        self.simulated = self.target.simulated
         self.driving = driving or HoldToDrive()
         self.messages: deque[str] = deque(maxlen=LOG)
         self._down_said = False  # "link is down" said in this outage
@@ -99,6 +98,11 @@ class BaseSession(ABC):
 
     host: Host | ControlHost
     """The host that drives (its clock is the session's)."""
+
+    @property
+    def simulated(self) -> bool:
+        """The board is the simulated one (here, or shared from another machine)."""
+        return self.target.simulated or getattr(self.host.link, "simulated", False) is True
 
     def now(self) -> float:
         """Seconds since the session started."""

@@ -37,9 +37,12 @@ class Link:
     age: float | None
     bytes_in: int
     bytes_out: int
+    latency: float | None = None
+    """Milliseconds a write took to reach a car shared over the network (None: a local
+    link)."""
 
 
-def link(connected: bool, stats: LinkStats, now: float) -> Link:
+def link(connected: bool, stats: LinkStats, now: float, latency: float | None = None) -> Link:
     """The link's state from its counters: the one rule every view follows."""
     age = stats.since_last(now)
     recent = stats.recent_errors(now)
@@ -52,7 +55,9 @@ def link(connected: bool, stats: LinkStats, now: float) -> Link:
         state = "degraded"
     else:
         state = "late" if age > LATE else "up"
-    return Link(state, stats.rate(now), stats.errors, recent, age, stats.bytes_in, stats.bytes_out)
+    return Link(
+        state, stats.rate(now), stats.errors, recent, age, stats.bytes_in, stats.bytes_out, latency
+    )
 
 
 @dataclass(frozen=True, slots=True)

@@ -62,10 +62,12 @@ def link_spans(
     now: float,
     noun: str = "records",
     brief: bool = False,
+    latency: float | None = None,
 ) -> tuple[Span, ...] | None:
     """Whether the link is up: counters (bytes unless `brief`), errors, how fresh what it
-    brings is; None while the port is open and nothing has come."""
-    state = link(connected, stats, now)
+    brings is, the network's latency to a shared car; None while the port is open and
+    nothing has come."""
+    state = link(connected, stats, now, latency)
     if state.state == "lost":
         return (("alert", " LINK LOST — retrying; keys do nothing "),)
     if state.age is None:
@@ -78,6 +80,8 @@ def link_spans(
         first = ("late" if state.state == "late" else "ok", " link up")
     sizes = "" if brief else f"in {_size(state.bytes_in)} · out {_size(state.bytes_out)} · "
     rate = f"  {state.rate:3.0f} {noun}/s · {sizes}errors {state.errors} · {last}"
+    if state.latency is not None:
+        rate += f" · latency {state.latency:.1f} ms"
     return first, ("", rate)
 
 
@@ -99,10 +103,11 @@ def link_rows(
     hint: str = SILENT_HINT,
     label: str = "",
     brief: bool = False,
+    latency: float | None = None,
 ) -> list[Row]:
     """The link row (under `label`); a port open with nothing received says so, and
     after SILENT what to check (it is not known to be up)."""
-    spans = link_spans(connected, stats, now, noun, brief)
+    spans = link_spans(connected, stats, now, noun, brief, latency)
     if spans is not None:
         return [Row(label, spans)]
     if link(connected, stats, now).state == "opening":

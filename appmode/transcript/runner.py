@@ -20,7 +20,7 @@ from appmode.board.store import MemoryStore
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.host.app.client import Host
-from appmode.host.link import LinkLost
+from appmode.host.link import LinkLost, Refused
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.target import Target, both_ports
@@ -156,7 +156,7 @@ def run_live(
                     else:
                         host.send(data)
                     _feed2(check, reader, SENT2 if port == UART2_PORT else SENT, data, now)
-            except LinkLost as exc:
+            except (LinkLost, Refused) as exc:
                 check.failure = f"{transcript.path}: at {now:.3f} s: {exc}"
                 break
             except (serial.SerialException, OSError) as exc:

@@ -20,6 +20,7 @@ import serial
 
 from appmode.host.app.client import Host
 from appmode.ports.sim import SimSerial
+from appmode.ports.target import Target
 from appmode.protocol import params
 from tests.support.processes import (
     ROOT,
@@ -160,8 +161,8 @@ def test_replay_ending_inside_a_frame_still_stops_the_car(tmp_path: Path) -> Non
 def test_host_close_ends_an_open_frame_then_stops() -> None:
     ports: list[SimSerial] = []
 
-    def opener(url: str) -> SimSerial:
-        ports.append(SimSerial(url, timeout=0.05))
+    def opener(url: Target) -> SimSerial:
+        ports.append(SimSerial(url.url, timeout=0.05))
         return ports[-1]
 
     with Host("sim://?pace=0", opener=opener) as host:

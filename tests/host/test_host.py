@@ -15,6 +15,7 @@ from appmode.errors import AppmodeError
 from appmode.host.app.client import Host
 from appmode.host.app.state import HostState
 from appmode.host.events import LinkStatus
+from appmode.ports.target import Target
 from appmode.protocol.app import Attitude, ParamsRecord, Velocity
 from appmode.protocol.render import out_of_range
 from tests.support.processes import BoardProcess, board_process
@@ -192,8 +193,8 @@ def test_a_numbered_pty_that_is_gone_is_never_opened_again() -> None:
     path = os.ttyname(slave)
     opened: list[str] = []
 
-    def opener(url: str) -> serial.SerialBase:
-        opened.append(url)
+    def opener(url: Target) -> serial.SerialBase:
+        opened.append(url.url)
         return open_link(url)
 
     host = Host(path, opener=opener)

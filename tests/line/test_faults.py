@@ -102,7 +102,7 @@ class DigitFlip:
 def test_a_write_corrupted_into_another_valid_frame_is_caught_and_retried() -> None:
     links: list[DigitFlip] = []
 
-    def opener(url: str) -> Any:
+    def opener(url: object) -> Any:
         links.append(DigitFlip(open_link(url)))
         return links[-1]
 

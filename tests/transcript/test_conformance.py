@@ -13,7 +13,7 @@ import pytest
 
 from appmode.host.app.client import Host
 from appmode.ports.sim import SimSerial
-from appmode.ports.target import parse_target
+from appmode.ports.target import Target, parse_target
 from appmode.protocol import params
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.transcript import parse_transcript
@@ -292,8 +292,8 @@ def test_a_recording_of_a_simulated_session_has_the_times_the_board_took_its_byt
     out = io.StringIO()
     recorder = Recorder(out, 0.0, ("board drive=mecanum",))
 
-    def opener(url: str) -> SimSerial:
-        port = _LateSimSerial(url, timeout=0.01)
+    def opener(url: Target) -> SimSerial:
+        port = _LateSimSerial(url.url, timeout=0.01)
         assert port._wire is not None
         port._wire.tap = lambda direction, when, data: (
             took.append((when, data)) if direction == ">" else None

@@ -16,7 +16,7 @@ from appmode.host.app.query import ParamQuery, QueryDone
 from appmode.host.app.state import HostState
 from appmode.host.app.tokens import parse_token
 from appmode.host.events import BoardWarning, LinkStatus
-from appmode.host.link import LinkLost
+from appmode.host.link import LinkLost, Refused
 from appmode.host.outcomes import QueryFailed
 from appmode.host.waits import Wait
 from appmode.ports.choice import BoardChoice
@@ -159,7 +159,7 @@ class AppSession(BaseSession):
         """Send; the host follows what left (the page, the letter in force)."""
         try:
             self.host.send(data)
-        except LinkLost as exc:
+        except (LinkLost, Refused) as exc:
             self.say(str(exc))
             self.driving.stop()
             return False

@@ -40,7 +40,7 @@ def app_rows(host: Host, hold: str) -> list[Row]:
     now = host.now()
     letter, page = in_force(host), page_of(host)
     moving = state.end.moving
-    rows = link_rows(host.connected, state.stats, now)
+    rows = link_rows(host.connected, state.stats, now, latency=host.latency)
     rows += telemetry(state, now)
     shown: tuple[Span, ...] = (
         ("", f" {page.value} ({state.end.page_letter} {page_name(host)})   "),
@@ -82,7 +82,7 @@ def app_instruments(host: Host, saved: tuple[int, ...] | None) -> Instruments:
     values = instruments.values(table, read, unsaved, [p.scale for p in specs])
     moving = state.end.moving
     return Instruments(
-        link=instruments.link(host.connected, state.stats, now),
+        link=instruments.link(host.connected, state.stats, now, host.latency),
         telemetry=instruments.telemetry(state, now),
         in_force=letter_name(page_of(host), in_force(host)) if moving else "stopped",
         moving=moving,

@@ -19,7 +19,7 @@ from appmode.host.control.query import ROTATE_POLL, ReadDone, rotation_done
 from appmode.host.control.state import PortMode
 from appmode.host.control.tokens import parse_token, perform
 from appmode.host.events import BoardWarning, LinkStatus
-from appmode.host.link import LinkLost
+from appmode.host.link import LinkLost, Refused
 from appmode.host.outcomes import QueryFailed
 from appmode.host.waits import Wait
 from appmode.ports.choice import BoardChoice
@@ -324,7 +324,7 @@ class ControlSession(BaseSession):
         """Run a send; a lost link becomes a message (what was in force stays)."""
         try:
             send()
-        except LinkLost as exc:
+        except (LinkLost, Refused) as exc:
             self.say(str(exc))
             self.driving.stop()
             return False

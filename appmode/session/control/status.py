@@ -53,7 +53,9 @@ class Keys:
 def control_rows(host: ControlHost, app: Host | None, keys: Keys) -> list[Row]:
     state = host.state
     now = host.now()
-    rows = link_rows(host.connected, state.stats, now, "messages", SILENT_HINT)
+    rows = link_rows(
+        host.connected, state.stats, now, "messages", SILENT_HINT, latency=host.latency
+    )
 
     drive = keys.drive
     by_drive: Span = ("", f" · drive {'? (reading)' if drive is None else drive.cli_name}")
@@ -134,7 +136,7 @@ def control_instruments(host: ControlHost, app: Host | None, keys: Keys) -> Inst
         pairs = zip(settings.WHEELS, report.targets, report.actuals, strict=False)
         wheels = tuple(Wheel(name, target, actual) for name, target, actual in pairs)
     return Instruments(
-        link=instruments.link(host.connected, state.stats, now),
+        link=instruments.link(host.connected, state.stats, now, host.latency),
         telemetry=None if app is None else instruments.telemetry(app.state, app.now()),
         in_force=in_force_text(host, keys),
         moving=keys.moving,

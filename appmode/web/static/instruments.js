@@ -36,7 +36,8 @@ function linkText(link, noun) {
   if (link.age === null) return LINK_WORDS[link.state];
   const errors = link.recent_errors ? ` · ${link.recent_errors} errors in 5 s` : "";
   const late = link.state === "late" ? ` · ${link.age.toFixed(1)} s ago` : "";
-  return `${LINK_WORDS[link.state]} · ${Math.round(link.rate)} ${noun}/s${errors}${late}`;
+  const latency = link.latency === null ? "" : ` · ${link.latency.toFixed(1)} ms`;
+  return `${LINK_WORDS[link.state]} · ${Math.round(link.rate)} ${noun}/s${errors}${late}${latency}`;
 }
 
 export function showInstruments(ins) {
