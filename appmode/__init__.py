@@ -31,7 +31,7 @@ import serial
 
 from appmode.errors import AppmodeError
 
-for _package in ("appmode.ports", "appmode.bluetooth.links"):  # sim://; ble:// and bt://
+for _package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):  # sim://, …
     if _package not in serial.protocol_handler_packages:
         serial.protocol_handler_packages.append(_package)
 

@@ -16,6 +16,7 @@ LAYERS = (
     "ports",
     "bluetooth",
     "host",
+    "net",
     "transcript",
     "session",
     "console",

@@ -21,6 +21,9 @@ COMMANDS: dict[str, str] = {
     "ports": "list serial ports (USB-UART adapters, Bluetooth rfcomm)",
     "scan": "list nearby Bluetooth modules (BLE and paired classic) and their URLs",
     "doctor": "find the car: check each serial port and say how to drive it or what to fix",
+    "share": "put a car on the network (Zenoh) for other machines to drive, watch and record",
+    "fleet": "list the cars shared on the network that a key opens; fleet stop stops them",
+    "router": "run a Zenoh router in-process, for shares and clients on other networks",
     "protocol": "print the protocol reference, or one of its sections",
     "profile": "list the firmware profiles, show one, check your own profile file",
     "completion": "print the shell's completion script (bash, zsh, fish)",
@@ -69,6 +72,12 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     "ports": ("appmode ports",),
     "scan": ("appmode scan", "appmode scan --time 10 --json"),
     "doctor": ("appmode doctor", "appmode doctor /dev/ttyUSB0 --json"),
+    "share": (
+        "appmode share sim:// --name car",
+        "appmode share /dev/ttyUSB0 --name car-1 --listen tcp/0.0.0.0:7450",
+    ),
+    "fleet": ("appmode fleet", "appmode fleet --json", "appmode fleet stop"),
+    "router": ("appmode router --listen tcp/0.0.0.0:7447",),
     "protocol": ("appmode protocol", "appmode protocol 8.3", "appmode protocol II"),
     "completion": (
         "appmode completion bash > ~/.local/share/bash-completion/completions/appmode",

@@ -218,7 +218,8 @@ def _at_rate(finding: probe.Finding, usual: int) -> str:
 def _drive_it(finding: probe.Finding) -> str:
     """The command that drives a car, or how to write a profile for a firmware that fits
     none."""
-    where = _at_rate(finding, 9600)
+    # a shared car's URL shows its key as …: the one given, which holds it, drives it
+    where = "URL" if finding.target.remote is not None else _at_rate(finding, 9600)
     nearest: identify.Judgement | None = finding.nearest
     if finding.profile is None and nearest is not None:
         name = nearest.profile.name
@@ -231,7 +232,8 @@ def _drive_it(finding: probe.Finding) -> str:
     flag = ""  # a sim:// URL names its own profile
     if finding.profile not in (None, "sheet") and not finding.target.simulated:
         flag = f" --profile {finding.profile}"
-    return f"drive it with: appmode drive {where}{flag}"
+    given = " (the zenoh:// URL given, its key included)" if where == "URL" else ""
+    return f"drive it with: appmode drive {where}{flag}{given}"
 
 
 def to_json(finding: probe.Finding) -> dict[str, object]:

@@ -73,15 +73,20 @@ def pytest_configure(config: pytest.Config) -> None:
 
 def _check_url(option: str, url: str) -> None:
     """A real board's URL opens (else one line, and no test runs)."""
+    target = None
     if not url.strip():
         raise pytest.UsageError(f"{option} is empty: give the board's device or URL")
     from appmode.errors import AppmodeError
+    from appmode.ports.target import as_target
     from appmode.ports.urls import open_link
 
     try:
-        open_link(url).close()
+        target = as_target(url)  # its url shows no key
+        open_link(target).close()
     except AppmodeError as exc:
-        raise pytest.UsageError(f"{option} {url}: {exc}") from None
+        raise pytest.UsageError(
+            f"{option} {url if target is None else target.url}: {exc}"
+        ) from None
 
 
 def _stop_real(board: RealBoard, profile: str | None) -> None:

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import os
 import re
-import selectors
 import signal
 import subprocess
 import time
@@ -14,11 +12,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tests.support.processes import (
-    ROOT,
     BoardProcess,
-    appmode_cmd,
     board_process,
     sent_lines,
+    serving,
     stop_process,
 )
 
@@ -78,26 +75,15 @@ def web_process(
         if bluetooth:
             address = board.details[bluetooth].split()[0]
             board.url = f"{'ble' if bluetooth == 'ble' else 'bt'}://{address}"
-        proc = subprocess.Popen(
-            appmode_cmd(
-                "web",
-                *((board.uart2, "--uart2") if uart2 else (board.url,)),
-                "--listen",
-                "127.0.0.1:0",
-                *args,
-            ),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-            cwd=ROOT,
-            env={**os.environ, "XDG_DATA_HOME": str(tmp_path / "data"), **bus},
+        proc, line = serving(
+            "web",
+            *((board.uart2, "--uart2") if uart2 else (board.url,)),
+            "--listen",
+            "127.0.0.1:0",
+            *args,
+            data=tmp_path / "data",
+            env=bus,
         )
-        assert proc.stdout is not None
-        sel = selectors.DefaultSelector()
-        sel.register(proc.stdout, selectors.EVENT_READ)
-        # its address within 45 s: beside a second suite (load 8 on two cores) a start took
-        # over 20 s
-        line = proc.stdout.readline() if sel.select(45) else ""
         found = re.match(r"web: (https?://\S+)", line)
         web = WebProcess(proc, found.group(1) if found else "", board, record)
         try:

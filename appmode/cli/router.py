@@ -1,0 +1,56 @@
+"""`appmode router`: a Zenoh router in this process, for a site with none: shares and
+clients on other networks meet at it (`--connect` on both sides)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from appmode.cli.commands import COMMANDS
+from appmode.cli.options import Subparsers
+
+DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    router = sub.add_parser(
+        "router",
+        help=COMMANDS["router"],
+        description="Run a Zenoh router (no zenohd needed): appmode share --connect and every "
+        "zenoh:// URL's connect= may name it, across networks a LAN's scouting does not "
+        "reach. It admits only clients with the key. Needs pip install 'appmode[net]'.",
+    )
+    router.add_argument(
+        "--listen",
+        metavar="tcp/ADDR:PORT",
+        default=DEFAULT_LISTEN,
+        help=f"where it listens (default {DEFAULT_LISTEN}; tcp/0.0.0.0:7447 for every network)",
+    )
+    router.add_argument("--key", help="the key (default: this machine's share key)")
+    return router
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.cli.share import kept_key
+    from appmode.errors import AppmodeError
+    from appmode.host import signals
+    from appmode.net.config import close_session, free_port, open_session, zenoh_module
+    from appmode.ports.remote import BadRemote, check_endpoint
+
+    zenoh_module()
+    try:
+        listen = free_port(check_endpoint(args.listen, listening=True))
+    except BadRemote as exc:
+        raise AppmodeError(f"--listen: {exc}") from None
+    session = open_session("router", args.key or kept_key(), listen=(listen,))
+    ended = [False]
+    try:
+        print(f"router: {listen}", flush=True)
+        print("appmode: Ctrl-C stops the router", file=sys.stderr, flush=True)
+        with signals.diverted(lambda: ended.__setitem__(0, True)):
+            while not ended[0]:
+                time.sleep(0.1)
+    finally:
+        close_session(session)
+    return 0

@@ -1,0 +1,267 @@
+"""`appmode share`: put a car this machine reaches on the network (Eclipse Zenoh), for
+other machines to drive, watch and record — this machine stays its stop authority."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import secrets
+import socket
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+from urllib.parse import quote
+
+from appmode.cli.commands import COMMANDS
+from appmode.cli.options import HOLDS, Subparsers, add_profile, target
+from appmode.errors import AppmodeError
+
+if TYPE_CHECKING:
+    from appmode.net.config import Tls
+    from appmode.ports.choice import BoardChoice
+    from appmode.ports.target import Target
+
+DEFAULT_LISTEN = "tcp/127.0.0.1:7450"
+KEY_FILE = "share.key"
+"""The share's key, kept in appmode's data folder (made on first use, the user's
+alone): the URL another machine pasted stays good from one share to the next."""
+KEY_BYTES = 18
+"""A new key's random bytes (24 characters of URL-safe text)."""
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    share = sub.add_parser(
+        "share",
+        help=COMMANDS["share"],
+        description="Share the car at URL (its APP port; URL2 its control port; sim:// both "
+        "ports of the simulated board) on the network as NAME, over Eclipse Zenoh: every "
+        "command on another machine then takes the zenoh:// URL this prints, as it takes "
+        "a local port. This machine stays the car's stop authority: when the remote "
+        "driver's heartbeats stop (its process killed, its machine asleep, the network "
+        "cut) it stops the car within half a second, and when share ends it stops the "
+        "car. Only a client with the key gets in (Zenoh's user-password authentication; "
+        "--tls also encrypts). Needs the net extra: pip install 'appmode[net]'.",
+    )
+    share.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
+    share.add_argument(
+        "url2", nargs="?", type=target, metavar="URL2", help="the same car's control port"
+    )
+    share.add_argument("--name", required=True, type=car_name, help="what the car is called")
+    share.add_argument(
+        "--listen",
+        metavar="tcp/ADDR:PORT",
+        default=DEFAULT_LISTEN,
+        help=f"where other machines connect (default {DEFAULT_LISTEN}: this machine only; "
+        "tcp/0.0.0.0:PORT for the LAN, where the car is also found by scouting; port 0 "
+        "picks a free one)",
+    )
+    share.add_argument(
+        "--connect",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help="connect to a Zenoh router, or to another share (shares route for each other): "
+        "tcp/HOST:PORT; may be given more than once",
+    )
+    share.add_argument(
+        "--key",
+        help="the key a client needs (any printable text; default: appmode's own, made on "
+        "first use and kept in its data folder)",
+    )
+    share.add_argument(
+        "--tls",
+        action="store_true",
+        help="listen on tls/ instead of tcp/, with appmode's own certificate: the key is "
+        "checked and everything encrypted (a client needs the certificate: ca= in the URL)",
+    )
+    add_profile(share, f"the car's profile, {HOLDS}", default=None)
+    return share
+
+
+def car_name(text: str) -> str:
+    from appmode.ports.remote import NAME
+
+    if not NAME.fullmatch(text):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a car's name: letters, digits, - and _ (at most 64), e.g. car-1"
+        )
+    return text
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.net.config import free_port, zenoh_module
+    from appmode.net.zenoh_log import zenoh_refusals
+    from appmode.ports.choice import choose
+    from appmode.ports.remote import BadRemote, check_endpoint
+
+    zenoh_module()
+    try:
+        for endpoint in args.connect:
+            check_endpoint(endpoint)
+        listen = check_endpoint(
+            args.listen.replace("tcp/", "tls/") if args.tls else args.listen, listening=True
+        )
+    except BadRemote as exc:
+        raise AppmodeError(f"--listen/--connect: {exc}") from None
+    listen = free_port(listen)
+    choice = choose(args.url, args.url2, profile=args.profile)
+    key = args.key if args.key is not None else kept_key()
+    if not key or not key.isprintable():
+        raise AppmodeError("--key: give printable text (a key is what a client pastes)")
+    host = listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]")
+    everywhere = host in ("0.0.0.0", "::")
+    tls = _tls(host) if args.tls else None
+    with zenoh_refusals(_log):
+        return _serve(args, choice, listen, key, everywhere, tls)
+
+
+def _serve(
+    args: argparse.Namespace,
+    choice: BoardChoice,
+    listen: str,
+    key: str,
+    everywhere: bool,
+    tls: Tls | None,
+) -> int:
+    from appmode.host import signals
+    from appmode.net.config import close_session, open_session
+    from appmode.net.share import Share
+
+    host = listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]")
+    session = open_session(
+        "peer", key, listen=(listen,), connect=tuple(args.connect), scout=everywhere, tls=tls
+    )
+    shared: Share | None = None
+    try:
+        shared = Share(session, args.name, _ports(choice), choice, _log)
+        print(remote_url(args.name, listen, key, everywhere), flush=True)
+        _announce(host, listen, everywhere)
+        ended = _Ended()
+        with signals.diverted(ended.set):
+            shared.run(ended.is_set)
+    finally:
+        if shared is not None:
+            shared.close()
+        close_session(session)
+    return 0
+
+
+class _Ended:
+    """Set by an ending signal (a flag: safe in a signal handler, unlike a lock)."""
+
+    def __init__(self) -> None:
+        self._set = False
+
+    def set(self) -> None:
+        self._set = True
+
+    def is_set(self) -> bool:
+        return self._set
+
+
+def _ports(choice: BoardChoice) -> dict[str, Target]:
+    """The car's ports to share: its APP port, and its control port when given (both of
+    a simulated board)."""
+    from appmode.ports.target import both_ports
+
+    if choice.control:
+        assert choice.app is not None
+        return {"app": choice.app, "uart2": choice.target}
+    if choice.target.simulated:
+        app, uart2 = both_ports(choice.target)
+        return {"app": app, "uart2": uart2}
+    return {"app": choice.target}
+
+
+def remote_url(name: str, listen: str, key: str, everywhere: bool) -> str:
+    """The URL another machine pastes (this machine's LAN address when it listens on all)."""
+    endpoint = listen
+    if everywhere:
+        scheme, rest = listen.split("/", 1)
+        endpoint = f"{scheme}/{_lan_address()}:{rest.rsplit(':', 1)[1]}"
+    return f"zenoh://{name}?connect={endpoint}&key={quote(key, safe='')}"
+
+
+def _lan_address() -> str:
+    """This machine's first address on a network (not loopback), else its name."""
+    try:
+        from appmode.web.certificate import lan_addresses
+
+        found = lan_addresses(ipv6=False)
+    except ImportError:  # psutil comes with the web extra
+        found = []
+    return found[0] if found else socket.gethostname()
+
+
+def kept_key() -> str:
+    """appmode's own share key: made on first use, the user's alone, then the same."""
+    from appmode.files import data_folder
+
+    path = data_folder() / KEY_FILE
+    try:
+        return path.read_text(encoding="utf-8").strip()
+    except FileNotFoundError:
+        pass
+    except OSError as exc:
+        raise AppmodeError(f"cannot read the share key {path}: {exc.strerror}") from None
+    key = secrets.token_urlsafe(KEY_BYTES)
+    _write_private(path, key)
+    return key
+
+
+def _write_private(path: Path, text: str) -> None:
+    try:
+        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w", encoding="utf-8") as file:
+            file.write(text + "\n")
+    except OSError as exc:
+        raise AppmodeError(f"cannot keep the share key in {path}: {exc.strerror}") from None
+
+
+def _tls(host: str) -> Tls:
+    """appmode's own certificate (as `web` makes it) for a `tls/` listener; where it is
+    and its fingerprint said, for the clients' `ca=`."""
+    from appmode.net.config import Tls
+
+    try:
+        from appmode.web.certificate import fingerprint, grouped, machine_names, own_certificate
+    except ImportError:
+        raise AppmodeError(
+            "--tls makes a certificate with cryptography: pip install 'appmode[web]'"
+        ) from None
+    cert, key = own_certificate(machine_names(host))
+    lines = "".join(f"\nappmode:   {line}" for line in grouped(fingerprint(cert)))
+    print(
+        f"appmode: a client needs this share's certificate, {cert}: copy it to the client's "
+        f"machine and add &ca=FILE to the URL (its SHA-256 fingerprint is{lines})",
+        file=sys.stderr,
+    )
+    return Tls(certificate=str(cert), private_key=str(key))
+
+
+def _announce(host: str, listen: str, everywhere: bool) -> None:
+    loopback = host in ("127.0.0.1", "::1", "localhost")
+    if not loopback:
+        print(
+            f"appmode: WARNING: the car is shared on {listen}: every device that reaches "
+            "this machine there can try to connect; only the key keeps it from driving "
+            "the car" + ("" if listen.startswith("tls/") else " (and tcp/ is not encrypted)"),
+            file=sys.stderr,
+        )
+    if everywhere:
+        print("appmode: found on this LAN by scouting, too", file=sys.stderr)
+    where = (
+        "in another program on this machine (--listen tcp/0.0.0.0:7450 shares it on the LAN)"
+        if loopback
+        else "into appmode on another machine"
+    )
+    print(
+        f"appmode: paste that URL {where}; Ctrl-C stops the car and the share",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def _log(text: str) -> None:
+    print(f"share: {text}", file=sys.stderr, flush=True)

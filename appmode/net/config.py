@@ -1,0 +1,153 @@
+"""A Zenoh session as appmode opens one: its mode, where it listens and connects, its
+key (Zenoh's user-password authentication: a session without the right key is refused
+at the transport, before any key expression is seen), TLS, and whether it scouts the
+LAN by multicast. Also what a failure to open says, in a line."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import socket
+import tempfile
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal
+
+from appmode.errors import AppmodeError
+from appmode.net.names import USER
+
+if TYPE_CHECKING:
+    import zenoh
+
+Mode = Literal["peer", "client", "router"]
+NO_ZENOH = (
+    "the network needs eclipse-zenoh: pip install 'appmode[net]' (wheels for Linux, "
+    "macOS and Windows on x86-64 and ARM: a Raspberry Pi too)"
+)
+CLOSING = 1.0
+"""Seconds a session is given to close: Zenoh waits up to ten for a peer whose network
+is gone to hear it, and nothing of the car's safety waits on that (its stop is sent
+before)."""
+SOURCE = re.compile(r"\s+at \S+\.rs:\d+\.?")
+"""Where in Zenoh's Rust sources an error was raised: no help to a user."""
+
+
+@dataclass(frozen=True, slots=True)
+class Tls:
+    """TLS for `tls/` endpoints: a listener's certificate and key, a client's CA."""
+
+    certificate: str | None = None
+    private_key: str | None = None
+    root_ca: str | None = None
+
+
+def zenoh_module() -> object:
+    """The zenoh package; AppmodeError with what to install when it is not there."""
+    try:
+        import zenoh
+    except ImportError:
+        raise AppmodeError(NO_ZENOH) from None
+    return zenoh
+
+
+def open_session(
+    mode: Mode,
+    key: str,
+    listen: tuple[str, ...] = (),
+    connect: tuple[str, ...] = (),
+    scout: bool = False,
+    tls: Tls | None = None,
+) -> zenoh.Session:
+    """A Zenoh session; AppmodeError (one line, no source paths) when it cannot open:
+    nothing listens where it connects, or the key was refused."""
+    import zenoh
+
+    config = zenoh.Config()
+    config.insert_json5("mode", json.dumps(mode))
+    config.insert_json5("listen/endpoints", json.dumps(list(listen)))
+    config.insert_json5("connect/endpoints", json.dumps(list(connect)))
+    config.insert_json5("scouting/multicast/enabled", json.dumps(scout))
+    if tls is not None:
+        if tls.root_ca is not None and not Path(tls.root_ca).is_file():
+            raise AppmodeError(
+                f"ca={tls.root_ca}: no such file: give the certificate appmode share --tls "
+                "named, copied to this machine"
+            )
+        _tls(config, tls)
+    with tempfile.TemporaryDirectory(prefix="appmode-zenoh-") as folder:
+        auth: dict[str, str] = {"user": USER, "password": key}
+        if listen or mode == "router":  # who may connect: the key's holders
+            users = Path(folder) / "users"
+            fd = os.open(users, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            with os.fdopen(fd, "w", encoding="utf-8") as file:
+                file.write(f"{USER}:{key}\n")
+            auth["dictionary_file"] = str(users)
+        config.insert_json5("transport/auth/usrpwd", json.dumps(auth))
+        try:
+            return zenoh.open(config)
+        except zenoh.ZError as exc:
+            bare = any(e.startswith("tls/") for e in connect) and (tls is None or not tls.root_ca)
+            raise AppmodeError(opening_failed(str(exc), listen, connect, bare)) from None
+
+
+def free_port(listen: str) -> str:
+    """`listen` with a free port in place of port 0 (Zenoh does not say which it took)."""
+    prefix, _, port = listen.rpartition(":")
+    if port != "0":
+        return listen
+    host = prefix.split("/", 1)[1].strip("[]")
+    with socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET) as probe:
+        probe.bind((host, 0))
+        return f"{prefix}:{probe.getsockname()[1]}"
+
+
+def close_session(session: zenoh.Session, within: float = CLOSING) -> None:
+    """Close `session`, waiting at most `within` seconds (the rest happens in the
+    background, or not at all when the process ends first)."""
+
+    def close() -> None:
+        with contextlib.suppress(Exception):  # a peer that did not hear the close
+            session.close()  # type: ignore[no-untyped-call]
+
+    closing = threading.Thread(target=close, name="zenoh close", daemon=True)
+    closing.start()
+    closing.join(within)
+
+
+def _tls(config: zenoh.Config, tls: Tls) -> None:
+    parts = {
+        "listen_certificate": tls.certificate,
+        "listen_private_key": tls.private_key,
+        "root_ca_certificate": tls.root_ca,
+    }
+    for name, value in parts.items():
+        if value is not None:
+            config.insert_json5(f"transport/link/tls/{name}", json.dumps(value))
+
+
+def trimmed(text: str) -> str:
+    """Zenoh's message without where in its sources it was raised."""
+    return SOURCE.sub("", text).strip().rstrip(".!")
+
+
+def opening_failed(
+    text: str, listen: tuple[str, ...], connect: tuple[str, ...], tls_without_ca: bool = False
+) -> str:
+    """What a Zenoh session that did not open means, and what to do."""
+    why = trimmed(text)
+    if tls_without_ca:
+        return (
+            f"cannot reach {', '.join(connect)}: a tls/ endpoint needs the share's "
+            "certificate: add &ca=FILE to the URL (the file appmode share --tls named)"
+        )
+    if connect and "connect" in why.lower():
+        return (
+            f"cannot reach {', '.join(connect)}: nothing listens there, or it refused this "
+            "key (use the URL appmode share printed, key included)"
+        )
+    if listen and ("bind" in why.lower() or "in use" in why.lower()):
+        return f"cannot listen on {', '.join(listen)} ({why}): pick another with --listen"
+    return f"cannot open the Zenoh session: {why}"

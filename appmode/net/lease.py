@@ -1,0 +1,84 @@
+"""Who drives a shared car, as a state machine with no I/O. One client at a time holds
+the lease; its heartbeats renew it. A lease that lapses (LAPSE without a heartbeat: the
+driver's process killed, its machine asleep, the network cut) is the car's host's to
+act on: it stops the car. A client that writes while nobody drives becomes the driver;
+while another's lease is live it drives only after taking over (`take`), which the
+other hears of."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+LAPSE = 0.3
+"""Seconds without a heartbeat after which a driver's lease has lapsed (a driver beats
+every 0.1 s): the car is stopped within 0.5 s of its last sign of life."""
+
+
+@dataclass(frozen=True, slots=True)
+class Driver:
+    """The client that drives: its id, its machine's name (for people), since when."""
+
+    client: str
+    machine: str
+    since: float
+
+
+@dataclass(frozen=True, slots=True)
+class Granted:
+    """The client drives; `took_from` is the driver it took over from, if any."""
+
+    took_from: Driver | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Refused:
+    """Another client drives, its lease live."""
+
+    driver: Driver
+
+
+class Lease:
+    """The car's one driver, and when it was last heard."""
+
+    def __init__(self) -> None:
+        self.driver: Driver | None = None
+        self._heard = 0.0
+
+    def ask(self, client: str, machine: str, now: float, take: bool = False) -> Granted | Refused:
+        """`client` asks to drive (`take`: even though another does)."""
+        driver = self.driver
+        if driver is not None and driver.client == client:
+            self._heard = now
+            return Granted()
+        if driver is not None and not self.lapsed_at(now) and not take:
+            return Refused(driver)
+        took = driver if driver is not None and not self.lapsed_at(now) else None
+        self.driver, self._heard = Driver(client, machine, now), now
+        return Granted(took)
+
+    def beat(self, client: str, now: float) -> None:
+        """A heartbeat: the driver's renews its lease (others are only watching)."""
+        if self.driver is not None and self.driver.client == client:
+            self._heard = now
+
+    def drives(self, client: str, now: float) -> bool:
+        """Whether `client` holds a live lease."""
+        return self.driver is not None and self.driver.client == client and not self.lapsed_at(now)
+
+    def lapsed_at(self, now: float) -> bool:
+        return self.driver is not None and now - self._heard > LAPSE
+
+    def lapsed(self, now: float) -> Driver | None:
+        """The driver whose lease has just lapsed (it drives no more), or None."""
+        if not self.lapsed_at(now):
+            return None
+        driver, self.driver = self.driver, None
+        return driver
+
+    def let_go(self, client: str) -> Driver | None:
+        """`client` ends its lease (it closed, or its Zenoh session ended): the driver it
+        was, or None."""
+        if self.driver is None or self.driver.client != client:
+            return None
+        driver, self.driver = self.driver, None
+        return driver

@@ -1,0 +1,77 @@
+"""The key expressions of a shared car, `appmode/NAME/…`, one table: what the car's host
+publishes and answers, and what a client sends it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+ROOT = "appmode"
+USER = "appmode"
+"""The user name of Zenoh's user-password authentication: the key is the password."""
+
+
+@dataclass(frozen=True, slots=True)
+class Keys:
+    """The keys of the car called `name`."""
+
+    name: str
+
+    def _key(self, *parts: str) -> str:
+        return "/".join((ROOT, self.name, *parts))
+
+    def bytes(self, port: str) -> str:
+        """Every byte `port` (`app`, `uart2`) carried, both ways, timed at the car."""
+        return self._key(port, "bytes")
+
+    def write(self, port: str) -> str:
+        """Where the driver's bytes for `port` go (a query: the reply says when they left)."""
+        return self._key(port, "write")
+
+    @property
+    def lease(self) -> str:
+        """Ask to drive, take over, or let go (a query)."""
+        return self._key("lease")
+
+    @property
+    def alive(self) -> str:
+        """The driver's heartbeats."""
+        return self._key("alive")
+
+    @property
+    def events(self) -> str:
+        """What the car's host says: who drives, a lease that lapsed, a stop it sent."""
+        return self._key("events")
+
+    @property
+    def info(self) -> str:
+        """The car as `fleet` shows it (a query)."""
+        return self._key("info")
+
+    @property
+    def stop(self) -> str:
+        """Stop the car now (a query: the reply says whether it took)."""
+        return self._key("stop")
+
+    @property
+    def records(self) -> str:
+        """The APP port's records, decoded (JSON)."""
+        return self._key("records")
+
+    @property
+    def presence(self) -> str:
+        """The car's host's liveliness token: the car is shared."""
+        return self._key("presence")
+
+    def driver(self, client: str) -> str:
+        """A driver's liveliness token: its Zenoh session is alive."""
+        return self._key("driver", client)
+
+
+ANY_INFO = f"{ROOT}/*/info"
+ANY_STOP = f"{ROOT}/*/stop"
+ANY_PRESENCE = f"{ROOT}/*/presence"
+
+
+def name_of(key: str) -> str:
+    """The car's name in one of its keys."""
+    return key.split("/")[1]

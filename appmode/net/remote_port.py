@@ -1,0 +1,322 @@
+"""`zenoh://NAME?connect=…&key=…`: a car another machine shares (`appmode share`), as a
+pyserial port, so that every host and session drives it as a local one.
+
+What the car's port sends arrives with the car's own times of it (a recording made here
+is timed at the car); a write is a query the car's host answers when the bytes have left
+for the car (the reply's time is the car's), or refuses (another client drives, its
+link to the car is down). While the port is open it beats (`names.Keys.alive`) and holds
+a liveliness token: when both stop — this process killed, this machine asleep, the
+network cut — the car's host stops the car itself. When the car's host is gone, or
+another client takes the driving over, the port says so as a lost link."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import secrets
+import socket
+import threading
+import time
+from collections import deque
+from typing import TYPE_CHECKING, Any
+
+import serial
+from serial import SerialException
+
+from appmode.errors import AppmodeError
+from appmode.net.config import Tls, close_session, open_session, zenoh_module
+from appmode.net.names import Keys
+from appmode.net.share import unstamp
+from appmode.ports.modemless import Modemless
+from appmode.ports.remote import RemoteTarget, WriteRefused
+from appmode.ports.urls import port_target
+
+if TYPE_CHECKING:
+    import zenoh
+
+BEAT = 0.1
+"""Seconds between two heartbeats (the car's host stops the car after 0.3 s without)."""
+FIND = 3.0
+"""Seconds to wait for the car's host to answer when the port opens."""
+SILENT = 3.0
+"""Seconds without a word from the car's host (it publishes its info every second) after
+which the port is lost: the network between is cut (its host stops the car)."""
+WRITE_TIMEOUT = 1.0
+"""Seconds a write waits for the car's host to say the bytes left."""
+CLIENT = f"{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(3)}"
+"""This process, as the car's host knows it (its machine's name first)."""
+_TOOK: set[str] = set()
+"""The cars this process took the driving of (take=1 takes once: a reconnection after
+another client took it back does not take it again)."""
+
+
+class RemoteSerial(Modemless):
+    """A shared car's port (`port=app`, the default, or `port=uart2`)."""
+
+    target: Any = None
+    """The board to open, parsed once (`ports.urls.port_target`)."""
+
+    def open(self) -> None:
+        if self._port is None:
+            raise SerialException("port must be configured before use")
+        zenoh_module_or_serial_error()
+        target = port_target(self)
+        remote = target.remote
+        if not isinstance(remote, RemoteTarget):
+            raise SerialException(f"{target.url!r} names no shared car")
+        self._remote, self._side = remote, target.sim_port
+        self._keys = Keys(remote.name)
+        self._ready = threading.Condition()
+        self._rx = bytearray()
+        self._rx_times: deque[list[float]] = deque()
+        self._heard = 0.0
+        self._joined = self._side != "app"
+        """Whether the car's stream has been joined (the APP port's, at a record's
+        start: bytes before the first `{` are the tail of a record sent before)."""
+        self._host_heard = time.monotonic()
+        self._lost: str | None = None
+        self.latency: float | None = None
+        """Milliseconds the last write took to be acknowledged by the car's host."""
+        self.written_at = 0.0
+        self.read_runs: list[tuple[float, int]] = []
+        try:
+            self._session = open_session(
+                "client",
+                remote.key,
+                connect=remote.connect,
+                scout=not remote.connect,
+                tls=None if remote.ca is None else Tls(root_ca=remote.ca),
+            )
+        except AppmodeError as exc:
+            raise SerialException(str(exc)) from None
+        try:
+            self._found()
+            self._declare()
+        except BaseException:
+            close_session(self._session)
+            raise
+        self.is_open = True
+
+    def _where(self) -> str:
+        return ", ".join(self._remote.connect) or "this network (scouting)"
+
+    def _found(self) -> None:
+        """The car's host answers and shares this port; the car's clock, from its info."""
+        name = self._remote.name
+        sent = time.monotonic()
+        replies = list(self._session.get(self._keys.info, timeout=FIND))
+        found = next((r.ok for r in replies if r.ok is not None), None)
+        if found is None:
+            raise SerialException(
+                f"no car named {name} answers at {self._where()}: is 'appmode share --name "
+                f"{name}' running there, with this key?"
+            )
+        info = json.loads(found.payload.to_string())
+        self.simulated = info.get("simulated") is True
+        """The car shared is a simulated board (the views say so)."""
+        if self._side not in info.get("ports", ()):
+            shared = ", ".join(info.get("ports", ()))
+            raise SerialException(f"{name} shares no {self._side} port (it shares {shared})")
+        now = time.monotonic()
+        self._origin = now - (now - sent) / 2 - float(info["time"])
+        """`time.monotonic()` at the car's clock zero, as seen here: the car's times of
+        its bytes plus this are this machine's (a recording here is timed at the car)."""
+
+    def _declare(self) -> None:
+        session, keys = self._session, self._keys
+        self._declared: list[Any] = [
+            session.declare_subscriber(keys.bytes(self._side), self._on_bytes),
+            session.declare_subscriber(keys.events, self._on_event),
+            session.liveliness().declare_subscriber(keys.presence, self._on_presence, history=True),
+            session.liveliness().declare_token(keys.driver(CLIENT)),
+        ]
+        self._writer = session.declare_querier(keys.write(self._side), timeout=WRITE_TIMEOUT)
+        self._beating = threading.Event()
+        self._beats = threading.Thread(target=self._beat, name="zenoh beat", daemon=True)
+        self._beats.start()
+
+    # ------------------------------------------------------------ what comes
+
+    def _on_bytes(self, sample: zenoh.Sample) -> None:
+        if sample.attachment is None:
+            return
+        at, direction = unstamp(sample.attachment.to_bytes())
+        if direction not in ("<", "2<"):
+            return
+        data = sample.payload.to_bytes()
+        self._host_heard = time.monotonic()
+        if not self._joined:  # the APP port's stream is joined at a record's start
+            start = data.find(b"{")
+            if start < 0:
+                return
+            data, self._joined = data[start:], True
+        with self._ready:
+            self._rx += data
+            self._rx_times.append([at, len(data)])
+            self._heard = max(self._heard, at)
+            self._ready.notify_all()
+
+    def _on_event(self, sample: zenoh.Sample) -> None:
+        self._host_heard = time.monotonic()
+        event = json.loads(sample.payload.to_string())
+        if event.get("t") == "dropped" and event.get("client") == CLIENT:
+            self._lose(str(event.get("why")))
+
+    def _on_presence(self, sample: zenoh.Sample) -> None:
+        import zenoh
+
+        if sample.kind == zenoh.SampleKind.DELETE:
+            self._lose(
+                f"the car's host is gone (appmode share of {self._remote.name} ended, or its "
+                "machine or network is down): the car keeps its last command"
+            )
+
+    def _lose(self, why: str) -> None:
+        with self._ready:
+            self._lost = why
+            self._ready.notify_all()
+
+    def _beat(self) -> None:
+        alive = self._keys.alive
+        while not self._beating.wait(BEAT):
+            if time.monotonic() - self._host_heard > SILENT:
+                self._lose(
+                    f"the car's host has not been heard for {SILENT:g} s (the network between "
+                    "is cut?): it stops the car when this client falls silent to it"
+                )
+                return
+            try:
+                self._session.put(alive, CLIENT)
+            except Exception:  # a session closing under it: the port is closing too
+                return
+
+    # ------------------------------------------------------------ pyserial
+
+    @property
+    def clock_origin(self) -> float:
+        return self._origin
+
+    @property
+    def heard_until(self) -> tuple[float, bool]:
+        with self._ready:
+            if self._rx_times:
+                return self._rx_times[0][0], False
+            return max(self._heard, time.monotonic() - self._origin - 0.001), True
+
+    @property
+    def in_waiting(self) -> int:
+        self._check()
+        return len(self._rx)
+
+    def read(self, size: int = 1) -> bytes:
+        deadline = None if self._timeout is None else time.monotonic() + self._timeout
+        with self._ready:
+            while len(self._rx) < size and self._lost is None:
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    break
+                self._ready.wait(left)
+            if not self._rx:
+                self._check()
+            data = bytes(self._rx[:size])
+            del self._rx[:size]
+            self.read_runs = []
+            left_over = len(data)
+            while left_over:
+                run = self._rx_times[0]
+                taken = min(left_over, int(run[1]))
+                self.read_runs.append((run[0], taken))
+                run[1] -= taken
+                left_over -= taken
+                if not run[1]:
+                    self._rx_times.popleft()
+        return data
+
+    def write(self, data: bytes) -> int:
+        self._check()
+        payload = serial.to_bytes(data)
+        if self._remote.take and self._remote.name not in _TOOK:
+            self._take()
+        sent = time.monotonic()
+        replies = list(self._writer.get(payload=payload, attachment=CLIENT))
+        self.latency = (time.monotonic() - sent) * 1000
+        if not replies:
+            self._lose(f"the car's host did not answer within {WRITE_TIMEOUT:g} s")
+            self._check()
+        reply = replies[0]
+        if reply.ok is None:
+            raise _write_error(reply.err)
+        self.written_at = float(json.loads(reply.ok.payload.to_string())["at"])
+        return len(payload)
+
+    def _take(self) -> None:
+        """Take the driving over (`take=1`), once: the car's host stops the car first."""
+        body = json.dumps({"take": True})
+        replies = list(
+            self._session.get(
+                self._keys.lease, payload=body, attachment=CLIENT, timeout=WRITE_TIMEOUT
+            )
+        )
+        error = replies[0].err if replies else None
+        if not replies or error is not None:
+            why = "no answer" if error is None else error.payload.to_string()
+            raise SerialException(f"cannot take the driving of {self._remote.name}: {why}")
+        _TOOK.add(self._remote.name)
+
+    def _check(self) -> None:
+        if self._lost is not None:
+            raise SerialException(self._lost)
+
+    def flush(self) -> None:
+        """Every write is acknowledged when it returns."""
+
+    def reset_input_buffer(self) -> None:
+        with self._ready:
+            self._rx.clear()
+            self._rx_times.clear()
+
+    def reset_output_buffer(self) -> None:
+        """What was written has left."""
+
+    def _reconfigure_port(self, force_update: bool = False) -> None:
+        """The car's host sets its own port's rate."""
+
+    @property
+    def out_waiting(self) -> int:
+        return 0
+
+    def close(self) -> None:
+        """Let go of the driving (the car's host stops the car if this client drove),
+        then close the session."""
+        if not self.is_open:
+            return
+        self.is_open = False
+        self._beating.set()
+        with contextlib.suppress(Exception):  # a session already gone has nothing to close
+            body = json.dumps({"let_go": True})
+            list(self._session.get(self._keys.lease, payload=body, attachment=CLIENT, timeout=0.5))
+            for declared in self._declared:
+                declared.undeclare()
+            close_session(self._session)
+
+
+def _write_error(error: zenoh.ReplyError | None) -> SerialException:
+    """What the car's host's refusal of a write means: another client drives (the link
+    stays up), or the car's link is down at its host."""
+    try:
+        said = json.loads(error.payload.to_string()) if error is not None else {}
+    except ValueError:
+        said = {}
+    if not isinstance(said, dict):
+        said = {}
+    if "refused" in said:
+        return WriteRefused(str(said["refused"]))
+    return SerialException(str(said.get("down", "the car's host did not take the bytes")))
+
+
+def zenoh_module_or_serial_error() -> None:
+    try:
+        zenoh_module()
+    except AppmodeError as exc:
+        raise SerialException(str(exc)) from None

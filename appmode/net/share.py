@@ -1,0 +1,399 @@
+"""A car shared on Zenoh from the machine it is wired to (`appmode share`): its ports'
+bytes, both ways, timed at the car; its records decoded; who drives; and the stop
+authority. A remote client drives by sending bytes (`names.Keys.write`), which the car's
+host writes to the car while the client holds the lease (`lease.Lease`); when the lease
+lapses, when the driver's Zenoh session ends, and when the share ends, the car's host
+sends the port's stop itself — no remote host is trusted to."""
+
+from __future__ import annotations
+
+import json
+import socket
+import struct
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from appmode.errors import AppmodeError
+from appmode.host.app.client import Host
+from appmode.host.app.state import STILL
+from appmode.host.app.stop_check import SETTLE
+from appmode.host.control.client import ControlHost
+from appmode.host.events import LinkStatus
+from appmode.host.link import Link, LinkLost
+from appmode.net.lease import Driver, Granted, Lease, Refused
+from appmode.net.names import Keys
+from appmode.protocol import app
+from appmode.protocol.control_view import describe
+from appmode.protocol.directions import PAGE_LETTERS, letter_name
+from appmode.protocol.render import to_json
+
+if TYPE_CHECKING:
+    import zenoh
+
+    from appmode.ports.choice import BoardChoice
+    from appmode.ports.target import Target
+
+TICK = 0.02
+"""Seconds between the share's looks at the car and at the lease."""
+INFO_EVERY = 1.0
+"""Seconds between two `info` samples published while nothing changes."""
+STAMP = struct.Struct("<d")
+"""A byte sample's attachment: the car's time of it (seconds, its host's clock), then
+its direction (`>`, `<`, `2>`, `2<`)."""
+Log = Callable[[str], None]
+
+
+def stamp(time: float, direction: str) -> bytes:
+    return STAMP.pack(time) + direction.encode()
+
+
+def unstamp(attachment: bytes) -> tuple[float, str]:
+    """A byte sample's (time at the car, direction)."""
+    return STAMP.unpack_from(attachment)[0], attachment[STAMP.size :].decode()
+
+
+@dataclass
+class Port:
+    """One of the car's ports as the share holds it."""
+
+    name: str
+    """`app` or `uart2`."""
+    host: Host | ControlHost
+
+
+class Share:
+    """The car of `choice`'s ports shared as `name` on `session` until `close`."""
+
+    def __init__(
+        self,
+        session: zenoh.Session,
+        name: str,
+        ports: dict[str, Target],
+        choice: BoardChoice,
+        log: Log,
+    ) -> None:
+        self.session = session
+        self.keys = Keys(name)
+        self.choice = choice
+        self.log = log
+        self.lease = Lease()
+        self._lock = threading.RLock()  # the lease and the writes, from Zenoh's threads
+        self._origin = time.monotonic()
+        self.ports: dict[str, Port] = {}
+        self._written: dict[str, float | None] = {}
+        self._used: set[str] = set()
+        """The ports clients have written to: the ones a stop is for (a zero frame on an
+        unused control port would take the motion over from the APP port, §8.3)."""
+        """When each port's last bytes were written (the tap's time of them)."""
+        self._velocity: app.Velocity | None = None
+        self._battery: int | None = None
+        self._closed = threading.Event()
+        try:
+            for port, target in ports.items():
+                host = self._host(port, target)
+                host.stop_on_close = not self.ports  # the first port's, until another is used
+                self.ports[port] = Port(port, host)
+            self._declare()
+        except BaseException:
+            self.close()
+            raise
+
+    def _host(self, port: str, target: Target) -> Host | ControlHost:
+        tap = self._tap(port)
+        if port == "app":
+            return Host(target, tap=tap, profile=self.choice.profile)
+        return ControlHost(target, tap=tap, profile=self.choice.profile, drive=self.choice.drive)
+
+    def now(self) -> float:
+        """The car's time: seconds since the share began (every sample carries it)."""
+        return time.monotonic() - self._origin
+
+    # ------------------------------------------------------------ Zenoh
+
+    def _declare(self) -> None:
+        keys, session = self.keys, self.session
+        self._declared: list[Any] = [
+            session.declare_queryable(keys.lease, self._on_lease),
+            session.declare_queryable(keys.info, self._on_info),
+            session.declare_queryable(keys.stop, self._on_stop),
+            session.declare_subscriber(keys.alive, self._on_alive),
+            session.liveliness().declare_subscriber(keys.driver("*"), self._on_driver),
+            session.liveliness().declare_token(keys.presence),
+        ]
+        for port in self.ports:
+            self._declared.append(session.declare_queryable(keys.write(port), self._writer(port)))
+        self._publishers = {
+            port: session.declare_publisher(keys.bytes(port)) for port in self.ports
+        }
+        self._records = session.declare_publisher(keys.records)
+        self._events = session.declare_publisher(keys.events)
+
+    def _tap(self, port: str) -> Callable[[str, float, bytes], None]:
+        """Each byte the car's port carries, published with the car's time of it."""
+
+        def tap(direction: str, at: float, data: bytes) -> None:
+            link = self.ports[port].host if port in self.ports else None
+            publisher = getattr(self, "_publishers", {}).get(port)
+            if link is None or publisher is None or self._closed.is_set():
+                return
+            when = at + link.origin - self._origin
+            if direction in (">", "2>"):
+                self._written[port] = when
+            publisher.put(data, attachment=stamp(when, direction))
+
+        return tap
+
+    def _writer(self, port: str) -> Callable[[zenoh.Query], None]:
+        def on_write(query: zenoh.Query) -> None:
+            client = _text(query.attachment)
+            data = b"" if query.payload is None else query.payload.to_bytes()
+            with self._lock:
+                refused = self._may_drive(client, take=False)
+                if refused is not None:
+                    query.reply_err(json.dumps({"refused": refused}))
+                    return
+                host = self.ports[port].host
+                self._used.add(port)
+                host.stop_on_close = True
+                self._written[port] = None
+                try:
+                    host.send(data)
+                except LinkLost as exc:
+                    why = f"the car's {port} link is down at its host ({exc})"
+                    query.reply_err(json.dumps({"down": why}))
+                    return
+                except AppmodeError:
+                    pass  # written: only the share's own recording failed
+                written = self._written.get(port)
+                reply = {"at": self.now() if written is None else written, "driving": True}
+            query.reply(query.key_expr, json.dumps(reply))
+
+        return on_write
+
+    def _may_drive(self, client: str, take: bool) -> str | None:
+        """None when `client` may drive (the lease granted it), else why not."""
+        machine = client.rsplit("-", 2)[0]
+        answer = self.lease.ask(client, machine, self.now(), take)
+        if isinstance(answer, Refused):
+            held = self.now() - answer.driver.since
+            return (
+                f"{self.keys.name} is driven from {answer.driver.machine} (for {held:.0f} s): "
+                "watch it, or take the driving over with take=1 in the URL"
+            )
+        assert isinstance(answer, Granted)
+        if answer.took_from is not None:
+            self._stop_car(f"{machine} took the driving over from {answer.took_from.machine}")
+            self._dropped(
+                answer.took_from,
+                f"{machine} took the driving over: this client watches (take it back with take=1)",
+            )
+        return None
+
+    def _on_lease(self, query: zenoh.Query) -> None:
+        client = _text(query.attachment)
+        asked = _json(query)
+        with self._lock:
+            if asked.get("let_go"):
+                driver = self.lease.let_go(client)
+                if driver is not None:
+                    self._stop_car(f"the driver on {driver.machine} let go of the driving")
+                query.reply(query.key_expr, json.dumps({"granted": False}))
+                return
+            refused = self._may_drive(client, take=bool(asked.get("take")))
+        if refused is not None:
+            query.reply_err(refused)
+        else:
+            query.reply(query.key_expr, json.dumps({"granted": True}))
+
+    def _on_alive(self, sample: zenoh.Sample) -> None:
+        with self._lock:
+            self.lease.beat(sample.payload.to_string(), self.now())
+
+    def _on_driver(self, sample: zenoh.Sample) -> None:
+        """A client's Zenoh session ended (its liveliness token went): if it drove, the
+        car stops now, without waiting for the lease to lapse."""
+        import zenoh
+
+        if sample.kind != zenoh.SampleKind.DELETE:
+            return
+        client = str(sample.key_expr).rsplit("/", 1)[1]
+        with self._lock:
+            driver = self.lease.let_go(client)
+            if driver is not None:
+                self._stop_car(f"the driver on {driver.machine} left (its session ended)")
+
+    def _on_info(self, query: zenoh.Query) -> None:
+        query.reply(self.keys.info, json.dumps(self.info()))
+
+    def _on_stop(self, query: zenoh.Query) -> None:
+        """`fleet stop`: stop the car and say whether it took (on its A records, when
+        they come), in a thread of its own: a confirmation takes up to SETTLE s."""
+        who = _text(query.attachment) or "a client"
+
+        def stop() -> None:
+            with self._lock:
+                driver = self.lease.driver
+                if driver is not None:
+                    self.lease.let_go(driver.client)
+                sent = self._stop_car(f"stopped by {who} (fleet stop)")
+                if driver is not None:
+                    self._dropped(driver, f"{who} stopped every car (fleet stop)")
+            confirmed = self._confirmed() if sent else None
+            reply = {"name": self.keys.name, "sent": sent, "confirmed": confirmed}
+            query.reply(self.keys.stop, json.dumps(reply))
+
+        threading.Thread(target=stop, name="fleet stop", daemon=True).start()
+
+    # ------------------------------------------------------------ the stop authority
+
+    def _stop_car(self, why: str) -> bool:
+        """Send the stop of every port a client used (the APP port's when none was):
+        whether each went out (a port whose link is down cannot be stopped: said)."""
+        ports = [port for name, port in self.ports.items() if name in self._stopping()]
+        sent = all(port.host.send_stop() is not None for port in ports)
+        text = f"stopped: {why}" if sent else f"{why}: the stop was NOT delivered (link down)"
+        self.log(text)
+        self._event("stopped" if sent else "unstopped", text=text)
+        return sent
+
+    def _stopping(self) -> set[str]:
+        """The ports a stop goes to: those written to, or in motion, else the first."""
+        moving = {name for name, port in self.ports.items() if in_force(port.host)}
+        return (self._used | moving) or {next(iter(self.ports))}
+
+    def _confirmed(self) -> bool | None:
+        """Whether an A record of the APP port showed the car at rest within SETTLE s of
+        the stop, as the local host judges it (None: it sends none here)."""
+        port = self.ports.get("app")
+        if port is None or not isinstance(port.host, Host):
+            return None
+        layout = port.host.state.layout
+        end = time.monotonic() + SETTLE
+        self._velocity = None
+        while time.monotonic() < end:
+            time.sleep(TICK)
+            velocity = self._velocity
+            if velocity is not None and layout.speed(app.record_fields(velocity)[1]) <= STILL:
+                return True
+        return False if self._velocity is not None else None
+
+    def _dropped(self, driver: Driver, why: str) -> None:
+        """Tell `driver` it drives no more, and why (its port is lost: it says so)."""
+        self._event("dropped", client=driver.client, why=why)
+
+    def _event(self, kind: str, **fields: object) -> None:
+        if not self._closed.is_set():
+            self._events.put(json.dumps({"t": kind, "at": round(self.now(), 3), **fields}))
+
+    def info(self) -> dict[str, object]:
+        """The car as `fleet` shows it."""
+        driver = self.lease.driver
+        links = {name: port.host.connected for name, port in self.ports.items()}
+        motions = [in_force(port.host) for port in self.ports.values()]
+        return {
+            "name": self.keys.name,
+            "profile": self.choice.profile.name,
+            "simulated": all(port.host.target.simulated for port in self.ports.values()),
+            "ports": list(self.ports),
+            "links": links,
+            "machine": socket.gethostname(),
+            "driver": None if driver is None else _driver(driver),
+            "battery": self._battery,
+            "in_force": next(filter(None, motions), None),
+            "moving": any(motions),
+            "params": self._params(),
+            "time": round(self.now(), 3),
+        }
+
+    def _params(self) -> dict[str, Any] | None:
+        """The parameters as the car last sent them (its C record), when it has."""
+        port = self.ports.get("app")
+        if port is None or not isinstance(port.host, Host) or port.host.state.params is None:
+            return None
+        body = to_json(port.host.state.params, port.host.state.layout)
+        return {k: v for k, v in body.items() if k not in ("kind", "raw")}
+
+    # ------------------------------------------------------------ running
+
+    def run(self, ended: Callable[[], bool]) -> None:
+        """Read the car's ports, publish what they bring, watch the lease, until `ended()`
+        (or `close`)."""
+        next_info = 0.0
+        while not ended() and not self._closed.is_set():
+            for port in self.ports.values():
+                for event in port.host.poll(TICK / len(self.ports)):
+                    self._seen(port, event)
+            with self._lock:
+                lapsed = self.lease.lapsed(self.now())
+                if lapsed is not None:
+                    self._stop_car(f"the driver on {lapsed.machine} went silent")
+                    self._dropped(
+                        lapsed,
+                        "the car's host stopped the car: this client's heartbeats stopped "
+                        "reaching it",
+                    )
+            if time.monotonic() >= next_info:
+                next_info = time.monotonic() + INFO_EVERY
+                self._event("info", **self.info())
+
+    def _seen(self, port: Port, event: object) -> None:
+        if isinstance(event, LinkStatus):
+            self.log(f"{port.name}: {event.text}")
+            self._event("link", port=port.name, up=event.up, text=event.text)
+            return
+        if isinstance(event, app.Velocity):
+            self._velocity = event
+        if isinstance(event, app.Attitude):
+            self._battery = event.battery
+        if isinstance(event, app.RECORDS) and isinstance(port.host, Host):
+            body = to_json(event, port.host.state.layout)
+            self._records.put(json.dumps({"t": round(self.now(), 3), **body}))
+
+    def close(self) -> None:
+        """Stop sharing: the car's stop last on every port (its hosts close), then the
+        Zenoh declarations."""
+        self._closed.set()
+        stopping = self._stopping()
+        for name, port in self.ports.items():
+            port.host.stop_on_close = name in stopping
+            port.host.close()
+        for declared in getattr(self, "_declared", []):
+            declared.undeclare()
+
+
+def in_force(host: Link[Any]) -> str | None:
+    """What the car was last told to do on this port, in words (None: stop)."""
+    if isinstance(host, Host):
+        end = host.state.end
+        return (
+            f"{end.letter} {letter_name(PAGE_LETTERS[end.page_letter], end.letter)}"
+            if (end.moving and end.letter)
+            else None
+        )
+    if isinstance(host, ControlHost):
+        state = host.state
+        if state.in_force is not None:
+            return describe(state.in_force)
+        if state.letter is not None:
+            page = PAGE_LETTERS[state.app_end.page_letter]
+            return f"{state.letter} {letter_name(page, state.letter)} (APP letter)"
+    return None
+
+
+def _driver(driver: Driver) -> dict[str, object]:
+    return {"machine": driver.machine, "client": driver.client, "since": round(driver.since, 1)}
+
+
+def _text(data: zenoh.ZBytes | None) -> str:
+    return "" if data is None else data.to_string()
+
+
+def _json(query: zenoh.Query) -> dict[str, Any]:
+    try:
+        found = json.loads(_text(query.payload))
+    except ValueError:
+        return {}
+    return found if isinstance(found, dict) else {}

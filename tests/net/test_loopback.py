@@ -1,0 +1,127 @@
+"""A shared car reached over this machine's loopback (no namespaces needed): TLS and its
+certificate, a router between client and car, the ports a share's stop goes to, the
+pytest plugin on a zenoh:// URL — each judged on the board's own recording."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tests.support.processes import ROOT, appmode_cmd, run, stop_process
+from tests.support.shares import KEY, shared_board
+from tests.testing.test_plugin import pytest_in
+
+pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
+
+
+def test_tls_checks_the_key_and_needs_the_share_s_certificate(tmp_path: Path) -> None:
+    with shared_board(tmp_path, "car", "--tls") as car:
+        assert "connect=tls/127.0.0.1:" in car.url
+        cert = tmp_path / "data" / "appmode" / "web-cert.pem"
+        done = run("params", f"{car.url}&ca={cert}", "--json")
+        assert done.returncode == 0 and '"max_speed": 500' in done.stdout, done.stderr
+        for url, said in (
+            (car.url, "a tls/ endpoint needs the share's certificate: add &ca=FILE"),
+            (f"{car.url}&ca={tmp_path / 'none.pem'}", "no such file"),
+            (f"{car.url.replace('key=fleet', 'key=wrong')}&ca={cert}", "refused this key"),
+        ):
+            refused = run("params", url)
+            assert refused.returncode == 2 and said in refused.stderr, refused.stderr
+            assert len(refused.stderr.splitlines()) == 1
+        err = car.stop()
+    assert "a client needs this share's certificate" in err and "fingerprint" in err
+
+
+def test_a_car_through_a_router_is_driven_and_listed(tmp_path: Path) -> None:
+    router = subprocess.Popen(
+        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert router.stdout is not None
+        endpoint = router.stdout.readline().split()[-1]
+        assert endpoint.startswith("tcp/127.0.0.1:") and not endpoint.endswith(":0")
+        with shared_board(tmp_path, "car", "--connect", endpoint) as car:
+            listed = run("fleet", "--connect", endpoint, "--key", KEY, "--json")
+            assert '"name": "car"' in listed.stdout, listed.stderr
+            url = f"zenoh://car?connect={endpoint}&key={KEY.replace(' ', '%20')}"
+            done = run("send", url, "J", "A", "wait:0.5")
+            assert done.returncode == 0, done.stderr
+            assert "A" in car.sent() and car.sent()[-1] == "Z", car.sent()
+    finally:
+        err = stop_process(router)
+    assert router.returncode == 0 and "Traceback" not in err, err
+
+
+def test_a_share_stops_only_the_ports_used_so_letters_still_drive_after(tmp_path: Path) -> None:
+    """A zero frame on the control port takes the motion over from the APP port for good
+    (§8.3): a share whose clients drove with letters never sends one."""
+    with shared_board(tmp_path, "car", uart2=True) as car:
+        for _ in range(2):
+            done = run("send", car.url, "J", "A", "wait:1.2", "--json")
+            assert done.returncode == 0, done.stderr
+            assert '"y": 500' in done.stdout, "the car did not move on its letters"
+        car.stop()
+        assert not [line for line in car.record.read_text().splitlines() if " 2> " in line]
+        assert car.sent()[-1] == "Z"
+
+
+def test_the_pytest_plugin_runs_against_a_shared_car(tmp_path: Path) -> None:
+    project = tmp_path / "project"
+    project.mkdir()
+    (project / "pytest.ini").write_text("[pytest]\n")
+    (project / "test_car.py").write_text(
+        "import serial\n\n"
+        "def test_records(appmode_board):\n"
+        "    with serial.serial_for_url(appmode_board.port, 9600, timeout=1) as port:\n"
+        "        port.write(b'{Q:P}')\n"
+        "        assert b'{C' in port.read_until(b'{C', 400)\n\n"
+        "def test_drive(appmode_board):\n"
+        "    with serial.serial_for_url(appmode_board.port, 9600, timeout=1) as port:\n"
+        "        port.write(b'JA')\n"
+        "        port.read(200)\n"
+    )
+    with shared_board(tmp_path, "car") as car:
+        done = pytest_in(project, "--appmode-board", car.url)
+        assert done.returncode == 0, done.stdout + done.stderr
+        assert "2 passed" in done.stdout
+        assert car.sent()[-1] == "Z", "the plugin's stop after the test that drove"
+        wrong = pytest_in(project, "--appmode-board", car.url.replace("key=fleet", "key=guess"))
+        assert wrong.returncode == 4 and "key=…" in wrong.stderr and "guess" not in wrong.stderr
+
+
+def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fleet() -> None:
+    """A key holder's own 'share' answering with terminal escapes, a driver that is not
+    an object, and no JSON at all: `fleet` lists what it can, escaped, in one piece."""
+    import zenoh
+
+    from appmode.net.config import close_session, free_port, open_session
+
+    endpoint = free_port("tcp/127.0.0.1:0")
+    evil = "evil\x1b]52;c;bm9wZQ==\x07\x1b[2J"
+    answers = {
+        f"appmode/{evil}/info": {"profile": "\x1b[31mred", "battery": "\x1b[8m", "driver": "x"},
+        "appmode/junk/info": None,
+    }
+    session = open_session("peer", KEY, listen=(endpoint,))
+
+    def answer(query: zenoh.Query) -> None:
+        for key, body in answers.items():
+            query.reply(key, "{not json" if body is None else json.dumps(body))
+
+    queryable = session.declare_queryable("appmode/*/info", answer)
+    try:
+        listed = run("fleet", "--connect", endpoint, "--key", KEY)
+    finally:
+        queryable.undeclare()
+        close_session(session)
+    assert listed.returncode == 0, listed.stderr
+    assert "\x1b" not in listed.stdout and "\x07" not in listed.stdout
+    assert "evil\\x1b]52;c;bm9wZQ==\\x07\\x1b[2J" in listed.stdout, listed.stdout
+    assert "junk" not in listed.stdout and "Traceback" not in listed.stderr

@@ -1,0 +1,44 @@
+"""`python -m tests.support.many_cars N LISTEN KEY`: N simulated cars shared from one
+process on one Zenoh session (as N `appmode share sim://` would share them, without N
+interpreters on a two-core machine), named car-01…; prints `ready` when all are shared,
+runs until SIGTERM, then stops every car as `share` does."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+
+from appmode.net.config import close_session, open_session
+from appmode.net.share import Share
+from appmode.ports.choice import choose
+from appmode.ports.target import both_ports, parse_target
+
+
+def main(count: int, listen: str, key: str) -> None:
+    session = open_session("peer", key, listen=(listen,), scout=True)
+    ended = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: ended.set())
+    shares: list[Share] = []
+    try:
+        for n in range(1, count + 1):
+            choice = choose(parse_target("sim://"))
+            app, uart2 = both_ports(choice.target)
+            shares.append(
+                Share(session, f"car-{n:02}", {"app": app, "uart2": uart2}, choice, print)
+            )
+        runs = [threading.Thread(target=s.run, args=(ended.is_set,), daemon=True) for s in shares]
+        for run in runs:
+            run.start()
+        print("ready", flush=True)
+        ended.wait()
+        for run in runs:
+            run.join()
+    finally:
+        for share in shares:
+            share.close()
+        close_session(session)
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]), sys.argv[2], sys.argv[3])
