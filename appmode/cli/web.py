@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, target
 from appmode.errors import AppmodeError
+
+if TYPE_CHECKING:
+    import ssl
 
 DEFAULT_LISTEN = "127.0.0.1:8080"
 
@@ -33,6 +37,23 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "phone on the same Wi-Fi) the page is served over HTTPS, which a phone's tilt "
         "sensor needs: with appmode's own certificate, made on first use, unless --cert "
         "and --key give yours",
+    )
+    web.add_argument(
+        "--fleet",
+        action="store_true",
+        help="show every car shared with appmode share that the key opens, as cards with "
+        "a stop-all button; tapping a card drives that car (needs the net extra)",
+    )
+    web.add_argument(
+        "--connect",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help="with --fleet: a share or a router to reach the cars through, tcp/HOST:PORT "
+        "(default: scout this LAN)",
+    )
+    web.add_argument(
+        "--fleet-key", metavar="KEY", help="with --fleet: the cars' key (default: this machine's)"
     )
     web.add_argument("--cert", metavar="FILE", help="serve HTTPS with this PEM certificate")
     web.add_argument("--key", metavar="FILE", help="the private key of --cert (PEM)")
@@ -67,5 +88,55 @@ def run(args: argparse.Namespace) -> int:
     elif not is_loopback(host):
         cert, key = certificate.own_certificate(certificate.machine_names(host))
         tls, fingerprint = certificate.server_context(cert, key), certificate.fingerprint(cert)
+    if args.fleet:
+        return _serve_fleet(args, host, port, tls, tuple(addresses), fingerprint)
+    if args.connect or args.fleet_key is not None:
+        raise AppmodeError("--connect and --fleet-key go with --fleet")
     session = open_session(board_choice(args), driving(), record=args.record)
     return serve_web(session, host, port, tls, tuple(addresses), fingerprint)
+
+
+def _serve_fleet(
+    args: argparse.Namespace,
+    host: str,
+    port: int,
+    tls: ssl.SSLContext | None,
+    addresses: tuple[str, ...],
+    fingerprint: str | None,
+) -> int:
+    """The fleet page: the cars the key opens; a car chosen there driven as URL is."""
+    from appmode.cli.share import kept_key
+    from appmode.net.config import close_session, open_session, zenoh_module
+    from appmode.ports.choice import choose
+    from appmode.ports.remote import BadRemote, check_endpoint
+    from appmode.ports.target import shared_car
+    from appmode.session.base import BaseSession
+    from appmode.session.opener import open_session as open_car_session
+    from appmode.web.bridge import driving
+    from appmode.web.fleet import Fleet
+    from appmode.web.server import serve_web
+
+    if args.url2 is not None or args.url != target("sim://") or args.uart2 or args.record:
+        raise AppmodeError(
+            "--fleet shows the shared cars: give no URL, --uart2 or --record with it"
+        )
+    zenoh_module()
+    try:
+        connect = tuple(check_endpoint(e) for e in args.connect)
+    except BadRemote as exc:
+        raise AppmodeError(f"--connect: {exc}") from None
+    key = args.fleet_key or kept_key()
+    zenoh = open_session("client", key, connect=connect, scout=not connect)
+
+    def open_car(name: str) -> BaseSession:
+        choice = choose(shared_car(name, connect, key), profile=args.profile)
+        session = open_car_session(choice, driving())
+        session.start()
+        return session
+
+    try:
+        return serve_web(
+            None, host, port, tls, addresses, fingerprint, fleet=Fleet(zenoh, open_car)
+        )
+    finally:
+        close_session(zenoh)

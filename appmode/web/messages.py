@@ -24,16 +24,32 @@ SERVER = {
     "error": "`text`: what a message of the page could not do",
 }
 """What the server sends a page: `{"t": KIND, …}`."""
+FLEET_PAGE = {
+    "stop_all": "stop every car the key opens (each car's host confirms its stop)",
+}
+"""What the fleet page (`web --fleet`) sends."""
+FLEET_SERVER = {
+    "fleet": "`cars`: each car as its host describes it; `driving`: the car driven here",
+    "stopped": "`answers`: each car's answer to a stop-all (`name`, `sent`, `confirmed`)",
+    "error": "`text`: what a message of the page could not do",
+}
+"""What the server sends the fleet page."""
 
 
 def module() -> str:
     """The vocabulary as an ES module: `SEND.press` is `"press"`, `RECEIVE.status`
     `"status"`; a kind a module of the page names and this does not is `undefined`."""
-    send = json.dumps({kind: kind for kind in PAGE}, indent=1)
-    receive = json.dumps({kind: kind for kind in SERVER}, indent=1)
-    return (
-        "// Made by appmode.web.messages: the kinds of message the page and the server\n"
-        "// exchange, declared once in Python.\n"
-        f"export const SEND = Object.freeze({send});\n"
-        f"export const RECEIVE = Object.freeze({receive});\n"
-    )
+    tables = {
+        "SEND": PAGE,
+        "RECEIVE": SERVER,
+        "FLEET_SEND": FLEET_PAGE,
+        "FLEET_RECEIVE": FLEET_SERVER,
+    }
+    lines = [
+        "// Made by appmode.web.messages: the kinds of message the pages and the server",
+        "// exchange, declared once in Python.",
+    ]
+    for name, table in tables.items():
+        kinds = json.dumps({kind: kind for kind in table}, indent=1)
+        lines.append(f"export const {name} = Object.freeze({kinds});")
+    return "\n".join(lines) + "\n"

@@ -13,10 +13,8 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
-import math
 import ssl
 import sys
-import time
 from collections.abc import Awaitable, Callable
 from contextlib import suppress
 from importlib import resources
@@ -38,6 +36,8 @@ from appmode.web.access import (
 )
 from appmode.web.bridge import MAX_MESSAGE, Bridge
 from appmode.web.certificate import grouped
+from appmode.web.fleet import Fleet, FleetRoutes
+from appmode.web.server_log import OneLine, one_line
 
 HEADER_TIMEOUT = 10.0
 """Seconds a connection may take to send a whole request (aiohttp's keep-alive timeout
@@ -45,8 +45,6 @@ also closes a connection whose first request never completes)."""
 MAX_CONNECTIONS = 64
 """Connections served at once: more are closed as they come (a flood of half-sent
 requests would otherwise use up the server's open files and lock its owner out)."""
-LOG_EVERY = 10.0
-"""Seconds between two log lines of one kind (a flood of bad requests logs one)."""
 REFRESH = 0.02
 """Seconds between reads of the link (and checks of the heartbeat)."""
 SEND = 0.1
@@ -64,6 +62,8 @@ SCRIPTS = (
 """The page's script: ES modules, `app.js` first (index.html preloads the rest)."""
 ASSETS = (
     "index.html",
+    "fleet.html",
+    "fleet.js",
     *SCRIPTS,
     "app.css",
     "offline.html",
@@ -93,26 +93,35 @@ def _asset(name: str) -> bytes:
 
 
 class WebServer:
-    """The page and its websocket over one session."""
+    """The page and its websocket over one session (with `fleet`: over the session of
+    the car chosen on the fleet page, if any)."""
 
     def __init__(
         self,
-        session: BaseSession,
+        session: BaseSession | None,
         host: str,
         port: int,
         tls: ssl.SSLContext | None = None,
         token: str | None = None,
+        fleet: Fleet | None = None,
     ):
-        self.bridge = Bridge(session)
+        self.session: BaseSession | None = None
+        self.bridge: Bridge | None = None
+        self.car: str | None = None
+        """The fleet's car the session drives."""
+        if session is not None:
+            self.attach(session)
         self.tls = tls
-        self.session = session
         self.host = host
         self.port = port
         self.token = token or new_token()
         self._sockets: set[web.WebSocketResponse] = set()
         self._runner: web.AppRunner | None = None
         self.app = web.Application(middlewares=[self._guard], client_max_size=MAX_MESSAGE)
-        self.app.router.add_get("/", self._index)
+        self.fleet = None if fleet is None else FleetRoutes(self, fleet)
+        self.app.router.add_get("/", self._index if self.fleet is None else self.fleet.index)
+        if self.fleet is not None:
+            self.fleet.add(self.app.router)
         self.app.router.add_get("/static/{name}", self._static)
         self.app.router.add_get("/sw.js", self._worker)
         self.app.router.add_get("/ws", self._websocket)
@@ -151,6 +160,28 @@ class WebServer:
         if self._runner is not None:
             await self._runner.cleanup()
 
+    def attach(self, session: BaseSession, fleet: str | None = None) -> None:
+        """Drive `session` (the fleet's car `fleet`) from now on."""
+        self.session, self.bridge, self.car = session, Bridge(session), fleet
+
+    async def detach(self) -> BaseSession | None:
+        """Stop serving the session (its pages' connections close): the session, for
+        the caller to close."""
+        session, self.session, self.bridge, self.car = self.session, None, None, None
+        for socket in list(self._sockets):
+            await socket.close()
+        return session
+
+    def page(self, name: str) -> web.Response:
+        """One of the HTML pages."""
+        return _compressed(web.Response(body=_asset(name), content_type="text/html"))
+
+    def origin_refused(self, request: web.Request) -> web.Response | None:
+        """A 403 for a websocket whose Origin is not this page, else None."""
+        if origin_matches(request.headers.get("Origin"), request.host, request.scheme):
+            return None
+        return _refused("the websocket takes this page only (Origin)")
+
     # ------------------------------------------------------------ who may come in
 
     @web.middleware
@@ -182,7 +213,7 @@ class WebServer:
     # ------------------------------------------------------------ routes
 
     async def _index(self, request: web.Request) -> web.StreamResponse:
-        return _compressed(web.Response(body=_asset("index.html"), content_type="text/html"))
+        return self.page("index.html")
 
     async def _static(self, request: web.Request) -> web.StreamResponse:
         name = request.match_info["name"]
@@ -199,32 +230,38 @@ class WebServer:
         return _compressed(web.Response(body=_asset("sw.js"), content_type="text/javascript"))
 
     async def _websocket(self, request: web.Request) -> web.StreamResponse:
-        if not origin_matches(request.headers.get("Origin"), request.host, request.scheme):
-            return _refused("the websocket takes this page only (Origin)")
+        refused = self.origin_refused(request)
+        if refused is not None:
+            return refused
+        bridge = self.bridge
+        if bridge is None:
+            return web.Response(
+                status=409, text="409: no car is chosen: pick one on the fleet page\n"
+            )
         socket = web.WebSocketResponse(max_msg_size=MAX_MESSAGE, heartbeat=5.0)
         await socket.prepare(request)
         self._sockets.add(socket)
-        self.bridge.join(socket)
-        sender = asyncio.ensure_future(self._send_status(socket))
+        bridge.join(socket)
+        sender = asyncio.ensure_future(self._send_status(socket, bridge))
         try:
             async for message in socket:
                 if message.type in (WSMsgType.TEXT, WSMsgType.BINARY):
-                    reply = self.bridge.handle(socket, message.data)
+                    reply = bridge.handle(socket, message.data)
                     if reply is not None:
                         await socket.send_str(json.dumps(reply))
         finally:
             sender.cancel()
             self._sockets.discard(socket)
-            self.bridge.leave(socket)
+            bridge.leave(socket)
         return socket
 
-    async def _send_status(self, socket: web.WebSocketResponse) -> None:
+    async def _send_status(self, socket: web.WebSocketResponse, bridge: Bridge) -> None:
         """The page's status whenever it changed, until its connection ends (a send to a
         connection that broke ends it too: the receiving side then sees it close)."""
         shown = ""
         with suppress(ConnectionError, RuntimeError):
             while not socket.closed:
-                text = json.dumps(self.bridge.status(socket))
+                text = json.dumps({**bridge.status(socket), "fleet": self.car})
                 if text != shown:
                     shown = text
                     await socket.send_str(text)
@@ -235,7 +272,7 @@ class WebServer:
     async def run(self, announce: Callable[[WebServer], None]) -> None:
         """Serve until an ending signal (or Ctrl-C); the session ticks meanwhile."""
         loop = asyncio.get_running_loop()
-        loop.set_exception_handler(_one_line)
+        loop.set_exception_handler(one_line)
         ended = asyncio.Event()
 
         def on_signal() -> None:
@@ -246,7 +283,8 @@ class WebServer:
             announce(self)
             try:
                 while not ended.is_set():
-                    self.session.tick()
+                    if self.session is not None:
+                        self.session.tick()
                     with suppress(asyncio.TimeoutError):
                         await asyncio.wait_for(ended.wait(), REFRESH)
             finally:
@@ -269,42 +307,6 @@ class _CappedRunner(web.AppRunner):
         return server
 
 
-class Throttle:
-    """One log line of a kind every LOG_EVERY seconds; how many were left out between."""
-
-    def __init__(self, every: float = LOG_EVERY) -> None:
-        self.every = every
-        self._last: dict[str, float] = {}
-        self._left_out: dict[str, int] = {}
-
-    def allow(self, kind: str) -> int | None:
-        """None to leave this line out; else how many of its kind were left out."""
-        now = time.monotonic()
-        if now - self._last.get(kind, -math.inf) < self.every:
-            self._left_out[kind] = self._left_out.get(kind, 0) + 1
-            return None
-        self._last[kind] = now
-        return self._left_out.pop(kind, 0)
-
-
-_throttle = Throttle()
-
-
-def _say_throttled(kind: str, text: str) -> None:
-    left_out = _throttle.allow(kind)
-    if left_out is not None:
-        more = f" ({left_out:,} more like it left out)" if left_out else ""
-        print(f"appmode web: {text}{more}", file=sys.stderr)
-
-
-def _one_line(loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
-    """What the event loop would print with a traceback, in a line (a flood, once per
-    LOG_EVERY seconds: accept errors while open files run out)."""
-    error = context.get("exception")
-    message = str(context.get("message"))
-    _say_throttled(message, f"{message}{f': {error!r}' if error else ''}")
-
-
 def _compressed(response: web.Response) -> web.Response:
     """The page's own files, compressed for a browser that takes it (a third of the
     bytes over a phone's Wi-Fi); none holds a secret (the token is in a cookie)."""
@@ -315,17 +317,6 @@ def _compressed(response: web.Response) -> web.Response:
 
 def _refused(text: str) -> web.Response:
     return web.Response(status=403, text=f"403: {text}\n", headers=HEADERS)
-
-
-class _OneLine(logging.Handler):
-    """The server's own complaints (a handler that failed, a malformed request), one line
-    each, and one of a kind every LOG_EVERY seconds."""
-
-    def emit(self, record: logging.LogRecord) -> None:
-        text = record.getMessage()
-        if record.exc_info and record.exc_info[1] is not None:
-            text += f": {record.exc_info[1]!r}"
-        _say_throttled(f"{record.name} {record.msg}", text)
 
 
 def qr_code(address: str) -> str:
@@ -340,21 +331,23 @@ def qr_code(address: str) -> str:
 
 
 def serve_web(
-    session: BaseSession,
+    session: BaseSession | None,
     host: str,
     port: int,
     tls: ssl.SSLContext | None = None,
     names: tuple[str, ...] = (),
     fingerprint: str | None = None,
+    fleet: Fleet | None = None,
 ) -> int:
     """Start the session, serve the page until ended, and always close the session: its
     stop is the last thing sent (exit status 1 if the recording stopped on its own, or
-    the stop could not be sent to a car last told to move).
+    the stop could not be sent to a car last told to move). With `fleet` (and no
+    session) the page shows the fleet, and drives the car chosen there.
     `names` are other addresses the page is reached at; a self-signed certificate's
     `fingerprint` is printed for the owner to check."""
     for name in ("aiohttp", "asyncio"):
         server_log = logging.getLogger(name)
-        server_log.addHandler(_OneLine())
+        server_log.addHandler(OneLine())
         server_log.propagate = False
 
     def announce(server: WebServer) -> None:
@@ -387,15 +380,30 @@ def serve_web(
             flush=True,
         )
 
+    server: WebServer | None = None
     try:
-        session.start()
-        asyncio.run(WebServer(session, host, port, tls).run(announce))
+        if session is not None:
+            session.start()
+        if fleet is not None:
+            fleet.start()
+        server = WebServer(session, host, port, tls, fleet=fleet)
+        asyncio.run(server.run(announce))
     finally:
-        session.close()
-        for note in session.closing_notes:
-            print(f"appmode: WARNING: {note}", file=sys.stderr)
-        if session.recording_failure is not None:
-            print(f"appmode: error: {session.recording_failure}", file=sys.stderr)
-        if session.undelivered is not None:
-            print(f"appmode: {session.undelivered}", file=sys.stderr)
-    return 1 if session.recording_failure is not None or session.left_moving else 0
+        if fleet is not None:
+            fleet.close()
+        last = session if server is None else server.session
+        failed = last is not None and _close(last)
+    return 1 if failed else 0
+
+
+def _close(session: BaseSession) -> bool:
+    """Close the session (its stop last), saying what went wrong: whether it failed (the
+    recording stopped on its own, or the car last told to move did not get the stop)."""
+    session.close()
+    for note in session.closing_notes:
+        print(f"appmode: WARNING: {note}", file=sys.stderr)
+    if session.recording_failure is not None:
+        print(f"appmode: error: {session.recording_failure}", file=sys.stderr)
+    if session.undelivered is not None:
+        print(f"appmode: {session.undelivered}", file=sys.stderr)
+    return session.recording_failure is not None or session.left_moving

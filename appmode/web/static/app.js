@@ -20,7 +20,9 @@ function showTab(name) {
 }
 
 function showStatus(message) {
-  $("title").textContent = message.title.replace("appmode drive", "appmode web");
+  const title = message.title.replace("appmode drive", "appmode web");
+  $("title").textContent = message.fleet ? `${message.fleet} · ${title}` : title;
+  $("fleet-link").hidden = !message.fleet;
   $("badge").textContent = message.simulated ? "SIMULATED" : "REAL BOARD";
   $("badge").className = `badge ${message.simulated ? "simulated" : "real"}`;
   $("url").textContent = message.url;
