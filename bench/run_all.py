@@ -2,7 +2,8 @@
 
 Decoder throughput, CPU cost of `appmode board` and `appmode drive`, boards one process
 serves, board-model steps, console key-to-byte latency, 60 s floods, paced throughput,
-{Q:P} round trip, replay timing, start-up, the control port and the web page in Chromium.
+{Q:P} round trip, replay timing, start-up, the control port, the web page in Chromium and
+a car shared over Zenoh across network namespaces.
 `--quick` shortens the long ones.
 """
 
@@ -27,6 +28,7 @@ from bench import (
     link_pacing,
     link_roundtrip,
     minibalance,
+    network,
     page,
     replay_timing,
     startup,
@@ -246,6 +248,7 @@ def main() -> None:
         ("uart2", lambda: control_port.rows(quick)),
         ("web", lambda: page.rows(quick)),
         ("bluetooth", lambda: ble_link.rows(quick)),
+        ("network", lambda: network.bench_network(quick)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

@@ -2,7 +2,8 @@
 order, and prints what the document shows (issue 52: wherever an example moves).
 
 Each document runs in a folder of its own. Boards a document starts (`$ appmode board
-…`) are started, and the pty names it shows stand for theirs. An example's output
+…`) are started, and the pty names it shows stand for theirs; so are the shares and
+routers it starts, shown by their first line. An example's output
 matches when its lines come in order (`…` alone on a line stands for any lines, `…` in a
 line for any text there). On a line of readings from a board in real time (a timed
 `0.123 <` line, the console's velocity row) a number may differ from the document's by
@@ -58,6 +59,8 @@ NOT_RUN = {
 }
 """Examples not run here, and why."""
 
+SERVERS = ("appmode share", "appmode router")
+"""Servers a document starts, shown by their first line (the URL a share prints)."""
 SWITCH = 2.0
 """Seconds between starting a board and the next command: the documents' board logs show
 a person switching to another shell."""
@@ -179,6 +182,21 @@ class Boards:
         time.sleep(SWITCH)
         return shown
 
+    def serve(self, example: Example) -> list[str]:
+        """A server a document starts (`appmode share`, `appmode router`): its first line,
+        as the document shows it."""
+        proc = subprocess.Popen(
+            [sys.executable, "-m", *shlex.split(example.command)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+            cwd=self.cwd,
+        )
+        self.procs.append(proc)
+        shown = [_line(proc.stdout)]
+        time.sleep(SWITCH)
+        return shown
+
     def to_run(self, command: str) -> str:
         return PTY.sub(lambda m: self.names.get(m.group(0), m.group(0)), command)
 
@@ -239,6 +257,9 @@ def test_every_example_runs_and_prints_what_its_document_shows(
             if example.command.startswith("appmode board"):
                 out = "\n".join(boards.start(example))
                 expected = example.expected[:3]
+            elif example.command.startswith(SERVERS):
+                out = "\n".join(boards.serve(example))
+                expected = example.expected[:1]
             else:
                 out = run_shell(boards.to_run(example.command), tmp_path)
                 expected = example.expected
