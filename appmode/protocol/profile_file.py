@@ -97,6 +97,9 @@ class ProfileFile(NamedTuple):
     (`speed_param = ""` in a file that is `like` one that has it)."""
     boot: str
     """Text its start-up output holds (the sensor's messages), or ""."""
+    velocity_si: tuple[float, float]
+    """What one velocity unit is: metres a second of x and y, radians a second of z
+    (WHEELTEC's firmware counts mm/s and mrad/s: 0.001 each, the default)."""
     path: str
     """Where it was read from (a file's path, or a shipped profile's name)."""
     text: str
@@ -134,7 +137,10 @@ def parse(text: str, where: str) -> ProfileFile:
 TOP = {
     "name", "description", "source", "like", "baud", "period_ms", "control_port", "saves",
     "replies", "pages", "speed_keys", "records", "params", "defaults", "boot", "speed_param",
+    "velocity_si",
 }  # fmt: skip
+SI_DEFAULT = (0.001, 0.001)
+"""A velocity unit, when a profile does not say: mm/s and mrad/s, as WHEELTEC counts."""
 FIELD_KEYS = {"name", "label", "unit", "scale", "signed", "wrap", "motion", "battery"}
 PARAM_KEYS = {"name", "label", "minimum", "maximum", "default", "scale"}
 
@@ -189,6 +195,7 @@ def _build(
     names = [p.name for p in params or ()]
     if speed_param is not None and speed_param not in names:
         problem(f"speed_param = {speed_param!r}: name one of the parameters ({', '.join(names)})")
+    velocity_si = _velocity_si(data, base, problem)
     if not isinstance(name, str) or a is None or b is None or params is None:
         return None
     return ProfileFile(
@@ -207,9 +214,29 @@ def _build(
         params,
         speed_param,
         boot,
+        velocity_si,
         where,
         "",
     )
+
+
+def _velocity_si(
+    data: dict[str, Any], base: ProfileFile | None, problem: Callable[[str], None]
+) -> tuple[float, float]:
+    """What one velocity unit is (m/s of x and y, rad/s of z): the file's, its base's,
+    or SI_DEFAULT."""
+    given = data.get("velocity_si", list(base.velocity_si) if base else list(SI_DEFAULT))
+    if not (
+        isinstance(given, list)
+        and len(given) == 2
+        and all(_number(v) and 1e-9 <= v <= 1e3 for v in given)
+    ):
+        problem(
+            f"velocity_si = {given!r}: [metres a second, radians a second] one velocity "
+            "unit of x and y, and of z, is, such as [0.001, 0.001]"
+        )
+        return SI_DEFAULT
+    return float(given[0]), float(given[1])
 
 
 def _under(at: str, problem: Callable[[str], None]) -> Callable[[str], None]:

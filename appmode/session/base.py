@@ -89,6 +89,8 @@ class BaseSession(ABC):
         self.lease: float | None = None
         """Seconds any motion lasts without `keepalive` (a page's heartbeats); None: the
         view's own ticks prove it alive (the console, a script)."""
+        self.lease_source = "the page"
+        """What proves the motion alive, as messages name it (`cmd_vel` for a ROS node)."""
         self._alive_at = 0.0
         self._quiet_said = False
         self.guard = StopGuard(self._stoppable, self._guard_stop, self._lapsed)
@@ -194,7 +196,7 @@ class BaseSession(ABC):
         self.stop()
         if not self._quiet_said:
             self._quiet_said = True
-            self.say(f"stopped: no heartbeat from the page for {quiet:.2f} s")
+            self.say(f"stopped: no heartbeat from {self.lease_source} for {quiet:.2f} s")
         return True
 
     def _lapsed(self) -> str | None:
@@ -206,7 +208,7 @@ class BaseSession(ABC):
         if late is not None and late > LAPSE:
             return ""
         if self.lease is not None and (quiet := now - self._alive_at) > self.lease + LAPSE:
-            return f"no heartbeat from the page for {quiet:.2f} s"
+            return f"no heartbeat from {self.lease_source} for {quiet:.2f} s"
         return None
 
     def steer(self, x: float, y: float) -> None:

@@ -15,7 +15,7 @@ from appmode.host.app.state import HostState
 from appmode.host.events import BoardWarning
 from appmode.protocol.directions import MOTIONS
 from appmode.protocol.params import DriveType
-from appmode.session.control.session import velocity_for
+from appmode.session.control.motion import velocity_for
 from appmode.session.hold import HoldToDrive
 from appmode.session.rows import WIDTH
 from tests.console.test_console_tmux import (

@@ -14,6 +14,7 @@ from typing import ClassVar
 
 from appmode.errors import AppmodeError
 from appmode.host.app.client import Host
+from appmode.host.app.state import HostState
 from appmode.host.control.client import ControlHost
 from appmode.host.control.query import ROTATE_POLL, ReadDone, rotation_done
 from appmode.host.control.state import PortMode
@@ -28,6 +29,7 @@ from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETT
 from appmode.protocol.params import DriveType
 from appmode.session.base import BaseSession
 from appmode.session.control.commands import COMMANDS, KEYS, KEYS_HELP, SETTING_NAMES
+from appmode.session.control.motion import velocity_for
 from appmode.session.control.status import (
     STOP,
     Keys,
@@ -44,23 +46,6 @@ DEFAULT_SPEED = 300
 """Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""
 DEFAULT_ANGLE = 90.0
 REPORT_BIT = params.MODE_BIT["encoder_report"]
-
-
-def velocity_for(motion: Motion, speed: int, drive: DriveType) -> dict[str, int]:
-    """The velocity frame's fields (`ControlHost.velocity` keywords) that drive `motion`
-    at `speed` on `drive`: x, y, z on omni and mecanum, y and z duties on diff, left
-    and right duties on diff-gyro (each within ±MAX_DUTY)."""
-    if not drive.differential:
-        x, y, z = (round(f * speed) for f in motion.holonomic)
-        return {"x": x, "y": y, "z": z}
-    fy, fz = (f * speed for f in motion.differential)
-
-    def duty(value: float) -> int:
-        return max(-control.MAX_DUTY, min(control.MAX_DUTY, round(value)))
-
-    if drive is DriveType.DIFF_GYRO:
-        return {"left": duty(fy + fz), "right": duty(fy - fz)}
-    return {"y": duty(fy), "z": duty(fz)}
 
 
 NO_READS = (
@@ -280,6 +265,20 @@ class ControlSession(BaseSession):
             return
         motion = Motion("stick", (x, y, 0.0), (y, x))
         self._drive_motion(motion, f"stick x {x:+.2f} y {y:+.2f}", drive)
+
+    def telemetry_state(self) -> HostState | None:
+        """The APP port's state beside, when it is open (its records drawn as waves)."""
+        return None if self.app is None else self.app.state
+
+    def hold_velocity(self, shown: str, **fields: int) -> None:
+        """A velocity frame of the given fields (`ControlHost.velocity`'s) that lasts
+        while it is repeated, as a stick's does (a ROS node's `cmd_vel`)."""
+        if self.link_down():
+            return
+        self.driving.press("velocity", self.now())
+        if self._send(lambda: self.host.velocity(**fields)):
+            self.in_force = shown
+            self.rotation = None
 
     def _drive_motion(self, motion: Motion, shown: str, drive: DriveType) -> None:
         fields = velocity_for(motion, self.speed, drive)
