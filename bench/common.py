@@ -97,6 +97,22 @@ def cpu_seconds(pid: int) -> float:
         return int(stat.read().split()[0]) / 1e9
 
 
+def threads_cpu_seconds(pid: int) -> float:
+    """CPU seconds process `pid` has run, all its threads (Zenoh's and the shares')."""
+    total = 0
+    for task in os.listdir(f"/proc/{pid}/task"):
+        with open(f"/proc/{pid}/task/{task}/schedstat") as stat:
+            total += int(stat.read().split()[0])
+    return total / 1e9
+
+
+def cpu_share(pid: int, seconds: float) -> float:
+    """Process `pid`'s share of a core (%, all its threads) over the next `seconds`."""
+    start, at = threads_cpu_seconds(pid), time.monotonic()
+    time.sleep(seconds)
+    return (threads_cpu_seconds(pid) - start) / (time.monotonic() - at) * 100
+
+
 def wakeups(pid: int) -> int:
     """How many times process `pid` has gone to sleep and woken (its voluntary context
     switches): a served board's wake-ups."""

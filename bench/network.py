@@ -26,7 +26,7 @@ import tty
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from bench.common import Row, percentile
+from bench.common import Row, cpu_share, percentile
 from tests.support.netns import Machine, lan, why_not
 
 KEY = "bench key"
@@ -184,35 +184,20 @@ def bench_latency(keys: int) -> list[Row]:
     return rows
 
 
-def _process_cpu(pid: int) -> float:
-    """CPU seconds process `pid` has run, all its threads (Zenoh's and the shares')."""
-    total = 0
-    for task in os.listdir(f"/proc/{pid}/task"):
-        with open(f"/proc/{pid}/task/{task}/schedstat") as stat:
-            total += int(stat.read().split()[0])
-    return total / 1e9
-
-
-def _cpu(pid: int, seconds: float) -> float:
-    start, at = _process_cpu(pid), time.monotonic()
-    time.sleep(seconds)
-    return (_process_cpu(pid) - start) / (time.monotonic() - at) * 100
-
-
 def bench_cpu(seconds: float) -> list[Row]:
     cars = 10
     with lan("car", "laptop") as machines:
         many = [sys.executable, "-m", "tests.support.many_cars", str(cars), "tcp/0.0.0.0:7450", KEY]
         with _started(machines["car"], *many) as proc:
             time.sleep(2)
-            idle = _cpu(proc.pid, seconds)
+            idle = cpu_share(proc.pid, seconds)
             url = f"zenoh://car-01?connect=tcp/{machines['car'].address}:7450&key=bench%20key"
             monitor = machines["laptop"].command(
                 sys.executable, "-m", "appmode", "monitor", url, "--json"
             )
             with subprocess.Popen(monitor, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE):
                 time.sleep(3)
-                watched = _cpu(proc.pid, seconds)
+                watched = cpu_share(proc.pid, seconds)
                 subprocess.run(["pkill", "-f", "appmode monitor zenoh://car-01"], check=False)
     per_car = idle / cars
     return [

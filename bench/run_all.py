@@ -3,7 +3,7 @@
 Decoder throughput, CPU cost of `appmode board` and `appmode drive`, boards one process
 serves, board-model steps, console key-to-byte latency, 60 s floods, paced throughput,
 {Q:P} round trip, replay timing, start-up, the control port, the web page in Chromium and
-a car shared over Zenoh across network namespaces.
+a car shared over Zenoh across network namespaces, the car as a ROS 2 node.
 `--quick` shortens the long ones.
 """
 
@@ -31,6 +31,7 @@ from bench import (
     network,
     page,
     replay_timing,
+    ros,
     startup,
 )
 from bench.board_load import (
@@ -249,6 +250,7 @@ def main() -> None:
         ("web", lambda: page.rows(quick)),
         ("bluetooth", lambda: ble_link.rows(quick)),
         ("network", lambda: network.bench_network(quick)),
+        ("ros", lambda: ros.rows(quick)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

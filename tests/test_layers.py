@@ -19,6 +19,7 @@ LAYERS = (
     "net",
     "transcript",
     "session",
+    "ros",
     "console",
     "web",
     "testing",

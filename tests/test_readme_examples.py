@@ -2,8 +2,8 @@
 order, and prints what the document shows (issue 52: wherever an example moves).
 
 Each document runs in a folder of its own. Boards a document starts (`$ appmode board
-…`) are started, and the pty names it shows stand for theirs; so are the shares and
-routers it starts, shown by their first line. An example's output
+…`) are started, and the pty names it shows stand for theirs; so are the shares,
+routers and ROS nodes it starts, shown by their first line. An example's output
 matches when its lines come in order (`…` alone on a line stands for any lines, `…` in a
 line for any text there). On a line of readings from a board in real time (a timed
 `0.123 <` line, the console's velocity row) a number may differ from the document's by
@@ -59,7 +59,7 @@ NOT_RUN = {
 }
 """Examples not run here, and why."""
 
-SERVERS = ("appmode share", "appmode router")
+SERVERS = ("appmode share", "appmode router", "appmode ros")
 """Servers a document starts, shown by their first line (the URL a share prints)."""
 SWITCH = 2.0
 """Seconds between starting a board and the next command: the documents' board logs show

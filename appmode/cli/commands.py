@@ -24,6 +24,7 @@ COMMANDS: dict[str, str] = {
     "share": "put a car on the network (Zenoh) for other machines to drive, watch and record",
     "fleet": "list the cars shared on the network that a key opens; fleet stop stops them",
     "router": "run a Zenoh router in-process, for shares and clients on other networks",
+    "ros": "run the car as a ROS 2 node (rmw_zenoh's wire; no ROS installed here)",
     "protocol": "print the protocol reference, or one of its sections",
     "profile": "list the firmware profiles, show one, check your own profile file",
     "completion": "print the shell's completion script (bash, zsh, fish)",
@@ -78,6 +79,10 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     ),
     "fleet": ("appmode fleet", "appmode fleet --json", "appmode fleet stop"),
     "router": ("appmode router --listen tcp/0.0.0.0:7447",),
+    "ros": (
+        "appmode ros sim:// --router",
+        "appmode ros /dev/ttyUSB0 /dev/ttyAMA0 --namespace robot1",
+    ),
     "protocol": ("appmode protocol", "appmode protocol 8.3", "appmode protocol II"),
     "completion": (
         "appmode completion bash > ~/.local/share/bash-completion/completions/appmode",

@@ -25,7 +25,9 @@ from appmode.host import signals
 OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
 
-DRIVES = frozenset({"drive", "web", "demo", "send", "params", "replay", "conform", "tap", "share"})
+DRIVES = frozenset(
+    {"drive", "web", "demo", "send", "params", "replay", "conform", "tap", "share", "ros"}
+)
 """The commands that can move a car: their output goes through bounded writers
 (`outlet`), so that no reader of it can hold up the stop."""
 Handler = Callable[[argparse.Namespace], int]

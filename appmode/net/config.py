@@ -55,16 +55,26 @@ def zenoh_module() -> object:
 
 def open_session(
     mode: Mode,
-    key: str,
+    key: str | None,
     listen: tuple[str, ...] = (),
     connect: tuple[str, ...] = (),
     scout: bool = False,
     tls: Tls | None = None,
+    config_file: str | None = None,
 ) -> zenoh.Session:
-    """A Zenoh session; AppmodeError (one line, no source paths) when it cannot open:
-    nothing listens where it connects, or the key was refused."""
+    """A Zenoh session (`key` None: no authentication, as ROS's own sessions; a
+    `config_file` is Zenoh's own configuration, used as it is); AppmodeError (one line,
+    no source paths) when it cannot open: nothing listens where it connects, or the key
+    was refused."""
     import zenoh
 
+    if config_file is not None:
+        try:
+            return zenoh.open(zenoh.Config.from_file(config_file))
+        except zenoh.ZError as exc:
+            raise AppmodeError(
+                f"the Zenoh configuration {config_file}: {trimmed(str(exc))}"
+            ) from None
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps(mode))
     config.insert_json5("listen/endpoints", json.dumps(list(listen)))
@@ -78,19 +88,27 @@ def open_session(
             )
         _tls(config, tls)
     with tempfile.TemporaryDirectory(prefix="appmode-zenoh-") as folder:
-        auth: dict[str, str] = {"user": USER, "password": key}
-        if listen or mode == "router":  # who may connect: the key's holders
-            users = Path(folder) / "users"
-            fd = os.open(users, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-            with os.fdopen(fd, "w", encoding="utf-8") as file:
-                file.write(f"{USER}:{key}\n")
-            auth["dictionary_file"] = str(users)
-        config.insert_json5("transport/auth/usrpwd", json.dumps(auth))
+        if key is not None:  # None: as ROS's sessions, anyone who reaches it
+            auth = _auth(key, Path(folder), admits=bool(listen) or mode == "router")
+            config.insert_json5("transport/auth/usrpwd", json.dumps(auth))
         try:
             return zenoh.open(config)
         except zenoh.ZError as exc:
             bare = any(e.startswith("tls/") for e in connect) and (tls is None or not tls.root_ca)
             raise AppmodeError(opening_failed(str(exc), listen, connect, bare)) from None
+
+
+def _auth(key: str, folder: Path, admits: bool) -> dict[str, str]:
+    """User-password authentication with `key`; a session that `admits` others (it
+    listens, or routes) takes only the key's holders (a file in `folder`, yours alone)."""
+    auth = {"user": USER, "password": key}
+    if admits:
+        users = folder / "users"
+        fd = os.open(users, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w", encoding="utf-8") as file:
+            file.write(f"{USER}:{key}\n")
+        auth["dictionary_file"] = str(users)
+    return auth
 
 
 def free_port(listen: str) -> str:

@@ -1,0 +1,195 @@
+"""`appmode ros`: the car as a ROS 2 node on rmw_zenoh's wire, with no ROS installed
+here — `cmd_vel` drives it (the same stop authority as every session), `odom`, `tf`,
+`battery_state`, `imu` and `~/raw` come from its records."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import TYPE_CHECKING
+
+from appmode.cli.commands import COMMANDS
+from appmode.cli.options import HOLDS, Subparsers, add_profile, add_uart2, target
+from appmode.errors import AppmodeError
+
+if TYPE_CHECKING:
+    from appmode.ports.target import Target
+
+ROUTER = "tcp/localhost:7447"
+"""Where rmw_zenoh's sessions find their router (docs/design.md: the default config)."""
+LISTEN = "tcp/localhost:0"
+"""Where the node's session takes peers: this machine only, as rmw_zenoh's does."""
+
+
+def register(sub: Subparsers) -> argparse.ArgumentParser:
+    ros = sub.add_parser(
+        "ros",
+        help=COMMANDS["ros"],
+        description="Run the car at URL as a ROS 2 node on rmw_zenoh (ROS_DOMAIN_ID, the "
+        "router on tcp/localhost:7447, CDR, rmw_zenoh's liveliness tokens), with no ROS "
+        "installed here: ROS 2 machines with RMW_IMPLEMENTATION=rmw_zenoh_cpp see the "
+        "node, its topics and their types. cmd_vel (geometry_msgs/Twist) drives the car, "
+        "over the control port as velocity frames (URL2, --uart2, or a sim:// board), on "
+        "the APP port as the nearest of its eight directions at the speed asked; with no "
+        "cmd_vel for --cmd-vel-timeout seconds the car stops. odom, tf (odom → "
+        "base_link), battery_state, imu and ~/raw come from its records. Ctrl-C or "
+        "SIGTERM stops the car and withdraws the node. Needs the ros extra: "
+        "pip install 'appmode[ros]'.",
+    )
+    ros.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
+    ros.add_argument(
+        "url2", nargs="?", type=target, metavar="URL2", help="the same car's control port"
+    )
+    add_uart2(ros, "drive over the URL's own control port (a sim:// board's, a zenoh:// car's)")
+    ros.add_argument(
+        "--connect",
+        action="append",
+        metavar="ENDPOINT",
+        help=f"the Zenoh router (default {ROUTER}, as rmw_zenoh; may be given more than once)",
+    )
+    ros.add_argument(
+        "--router",
+        action="store_true",
+        help="run the router in this process, listening where --connect says: for a "
+        "machine that runs no `ros2 run rmw_zenoh_cpp rmw_zenohd`",
+    )
+    ros.add_argument(
+        "--domain",
+        type=_domain,
+        default=None,
+        metavar="N",
+        help="the ROS domain (default: ROS_DOMAIN_ID, else 0)",
+    )
+    ros.add_argument("--namespace", default="/", metavar="NS", help="the node's namespace")
+    ros.add_argument("--node", default="appmode", metavar="NAME", help="the node's name")
+    ros.add_argument(
+        "--distro",
+        choices=("jazzy", "humble"),
+        default="jazzy",
+        help="the ROS the graph runs: jazzy and later write RIHS01 type hashes, humble's "
+        "rmw_zenoh none (default jazzy)",
+    )
+    ros.add_argument(
+        "--stamped",
+        action="store_true",
+        help="cmd_vel is geometry_msgs/TwistStamped (as Jazzy's Nav2 sends it)",
+    )
+    ros.add_argument(
+        "--cmd-vel-timeout",
+        type=float,
+        default=0.5,
+        metavar="SECONDS",
+        help="stop the car after this long without a cmd_vel (default 0.5)",
+    )
+    add_profile(ros, f"the car's profile, {HOLDS}", default=None)
+    return ros
+
+
+def _domain(text: str) -> int:
+    if not text.isdigit() or not 0 <= int(text) <= 232:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a ROS domain: 0 to 232")
+    return int(text)
+
+
+def run(args: argparse.Namespace) -> int:
+    from appmode.net.config import zenoh_module
+    from appmode.ros.graph import BadName, namespace, node_name
+
+    zenoh_module()
+    _ros_module()
+    if not 0.05 <= args.cmd_vel_timeout <= 10:
+        raise AppmodeError("--cmd-vel-timeout: between 0.05 and 10 seconds")
+    try:
+        names = (namespace(args.namespace), node_name(args.node))
+    except BadName as exc:
+        raise AppmodeError(str(exc)) from None
+    domain = args.domain if args.domain is not None else _env_domain()
+    return _serve(args, domain, *names)
+
+
+def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
+    from appmode.host import signals
+    from appmode.net.config import close_session, open_session
+    from appmode.ports.choice import choose
+    from appmode.ports.remote import BadRemote, check_endpoint
+    from appmode.ros.graph import Node
+    from appmode.ros.node import Options, RosNode
+    from appmode.session.hold import HoldToDrive
+    from appmode.session.opener import open_session as open_car
+
+    try:
+        connect = tuple(check_endpoint(e) for e in args.connect or [ROUTER])
+    except BadRemote as exc:
+        raise AppmodeError(f"--connect: {exc}") from None
+    config_file = os.environ.get("ZENOH_SESSION_CONFIG_URI") or None
+    router = open_session("router", None, listen=connect) if args.router else None
+    zenoh = None
+    try:
+        zenoh = open_session("peer", None, (LISTEN,), connect, config_file=config_file)
+        if not list(zenoh.info.routers_zid()):
+            raise AppmodeError(
+                f"no Zenoh router at {', '.join(connect)}: start one (ros2 run rmw_zenoh_cpp "
+                "rmw_zenohd), or add --router to run it here"
+            )
+        url, url2 = _ports(args)
+        choice = choose(url, url2, uart2=args.uart2 and url2 is None, profile=args.profile)
+        timeout = args.cmd_vel_timeout
+        session = open_car(choice, HoldToDrive(first_timeout=timeout, repeat_timeout=timeout))
+        session.lease, session.lease_source = timeout, "cmd_vel"
+        graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
+        ros = RosNode(session, zenoh, graph, Options(args.stamped, timeout), _log)
+        ended = [False]
+        try:
+            session.start()
+            ros.declare()
+            where = ", ".join(connect)
+            print(f"ros: node {ns.rstrip('/')}/{node} on domain {domain} via {where}", flush=True)
+            with signals.diverted(lambda: ended.__setitem__(0, True)):
+                ros.run(lambda: ended[0])
+        finally:
+            session.close()  # the car's stop, then the node leaves the graph
+            ros.withdraw()
+            for note in session.closing_notes:
+                _log(f"WARNING: {note}")
+            if session.undelivered is not None:
+                print(f"appmode: {session.undelivered}", file=sys.stderr)
+        return 1 if session.left_moving else 0
+    finally:
+        if zenoh is not None:
+            close_session(zenoh)
+        if router is not None:
+            close_session(router)
+
+
+def _ports(args: argparse.Namespace) -> tuple[Target, Target | None]:
+    """The car's ports: URL and URL2; both ports of a sim:// board (its records give
+    odom), and of a zenoh:// car with --uart2."""
+    url, url2 = args.url, args.url2
+    if url2 is None and (url.simulated or (args.uart2 and url.remote is not None)):
+        url2 = url.for_uart2()
+    return url, url2
+
+
+def _env_domain() -> int:
+    text = os.environ.get("ROS_DOMAIN_ID", "").strip()
+    if not text:
+        return 0
+    try:
+        return _domain(text)
+    except argparse.ArgumentTypeError as exc:
+        raise AppmodeError(f"ROS_DOMAIN_ID: {exc}") from None
+
+
+def _ros_module() -> None:
+    try:
+        import rosbags  # noqa: F401
+        import xxhash  # noqa: F401
+    except ImportError:
+        raise AppmodeError(
+            "appmode ros needs rosbags and xxhash: pip install 'appmode[ros]'"
+        ) from None
+
+
+def _log(text: str) -> None:
+    print(f"ros: {text}", file=sys.stderr, flush=True)

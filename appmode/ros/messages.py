@@ -1,0 +1,203 @@
+"""The ROS messages the node sends and takes, as CDR (little-endian, with its 4-byte
+encapsulation header, as rmw_zenoh carries it), through rosbags' type store of the
+distro spoken: what each is for, and its RIHS01 type hash (REP-2016) as rosbags
+computes it from the type's definition."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+import numpy as np
+from rosbags.typesys import Stores, get_typestore
+
+TWIST = "geometry_msgs/msg/Twist"
+TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
+ODOMETRY = "nav_msgs/msg/Odometry"
+BATTERY = "sensor_msgs/msg/BatteryState"
+IMU = "sensor_msgs/msg/Imu"
+TF = "tf2_msgs/msg/TFMessage"
+STRING = "std_msgs/msg/String"
+TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING)
+STORES = {"jazzy": Stores.ROS2_JAZZY, "humble": Stores.ROS2_HUMBLE}
+UNKNOWN = -1.0
+"""A covariance's first element when the quantity is not measured (REP 145)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Pose2D:
+    """Where the car is in `odom` (metres, radians counter-clockwise) and how it moves
+    in `base_link` (m/s forward and left, rad/s counter-clockwise)."""
+
+    x: float
+    y: float
+    yaw: float
+    forward: float
+    left: float
+    turn: float
+
+
+class Messages:
+    """The node's messages for one distro."""
+
+    def __init__(self, distro: str) -> None:
+        self.store = _store(distro)
+        self.types = self.store.types
+
+    def type_hash(self, ros_type: str) -> str:
+        return str(self.store.hash_rihs01(ros_type))
+
+    def _make(self, ros_type: str, **fields: Any) -> Any:
+        return self.types[ros_type](**fields)
+
+    def _header(self, time_ns: int, frame: str) -> Any:
+        stamp = self._make(
+            "builtin_interfaces/msg/Time", sec=time_ns // 10**9, nanosec=time_ns % 10**9
+        )
+        return self._make("std_msgs/msg/Header", stamp=stamp, frame_id=frame)
+
+    def _cdr(self, message: Any, ros_type: str) -> bytes:
+        return bytes(self.store.serialize_cdr(message, ros_type))
+
+    def _vector(self, x: float, y: float, z: float) -> Any:
+        return self._make("geometry_msgs/msg/Vector3", x=x, y=y, z=z)
+
+    def _quaternion(self, roll: float, pitch: float, yaw: float) -> Any:
+        cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+        cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+        cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+        return self._make(
+            "geometry_msgs/msg/Quaternion",
+            x=sr * cp * cy - cr * sp * sy,
+            y=cr * sp * cy + sr * cp * sy,
+            z=cr * cp * sy - sr * sp * cy,
+            w=cr * cp * cy + sr * sp * sy,
+        )
+
+    def odometry(
+        self, pose: Pose2D, time_ns: int, frame: str, child: str, variance: float
+    ) -> bytes:
+        """Dead reckoning: the pose's x, y and yaw with a variance of `variance` (m², rad²,
+        growing with the distance driven), the twist's from the board's velocity."""
+        position = self._make("geometry_msgs/msg/Point", x=pose.x, y=pose.y, z=0.0)
+        orientation = self._quaternion(0.0, 0.0, pose.yaw)
+        pose_covariance = _diagonal(6, (variance, variance, 1e6, 1e6, 1e6, variance))
+        twist_covariance = _diagonal(6, (1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3))
+        message = self._make(
+            ODOMETRY,
+            header=self._header(time_ns, frame),
+            child_frame_id=child,
+            pose=self._make(
+                "geometry_msgs/msg/PoseWithCovariance",
+                pose=self._make(
+                    "geometry_msgs/msg/Pose", position=position, orientation=orientation
+                ),
+                covariance=pose_covariance,
+            ),
+            twist=self._make(
+                "geometry_msgs/msg/TwistWithCovariance",
+                twist=self._make(
+                    TWIST,
+                    linear=self._vector(pose.forward, pose.left, 0.0),
+                    angular=self._vector(0.0, 0.0, pose.turn),
+                ),
+                covariance=twist_covariance,
+            ),
+        )
+        return self._cdr(message, ODOMETRY)
+
+    def transform(self, pose: Pose2D, time_ns: int, frame: str, child: str) -> bytes:
+        """`frame` → `child` as a TFMessage of one transform."""
+        stamped = self._make(
+            "geometry_msgs/msg/TransformStamped",
+            header=self._header(time_ns, frame),
+            child_frame_id=child,
+            transform=self._make(
+                "geometry_msgs/msg/Transform",
+                translation=self._vector(pose.x, pose.y, 0.0),
+                rotation=self._quaternion(0.0, 0.0, pose.yaw),
+            ),
+        )
+        return self._cdr(self._make(TF, transforms=[stamped]), TF)
+
+    def battery(self, percent: float, time_ns: int, frame: str) -> bytes:
+        """The battery as the board reports it: a percentage (REP: 0–1), nothing else
+        measured (NaN)."""
+        kind = self.types[BATTERY]
+        nan = math.nan
+        message = self._make(
+            BATTERY,
+            header=self._header(time_ns, frame),
+            voltage=nan,
+            temperature=nan,
+            current=nan,
+            charge=nan,
+            capacity=nan,
+            design_capacity=nan,
+            percentage=max(0.0, min(1.0, percent / 100)),
+            power_supply_status=kind.POWER_SUPPLY_STATUS_UNKNOWN,
+            power_supply_health=kind.POWER_SUPPLY_HEALTH_UNKNOWN,
+            power_supply_technology=kind.POWER_SUPPLY_TECHNOLOGY_UNKNOWN,
+            present=True,
+            cell_voltage=np.zeros(0, dtype=np.float32),
+            cell_temperature=np.zeros(0, dtype=np.float32),
+            location="",
+            serial_number="",
+        )
+        return self._cdr(message, BATTERY)
+
+    def imu(self, roll: float, pitch: float, yaw: float, time_ns: int, frame: str) -> bytes:
+        """The board's attitude (radians, REP 103) as an orientation with whole degrees'
+        variance; angular velocity and acceleration not given (covariance −1)."""
+        degree = math.radians(1.0) ** 2
+        unknown = np.zeros(9)
+        unknown[0] = UNKNOWN
+        message = self._make(
+            IMU,
+            header=self._header(time_ns, frame),
+            orientation=self._quaternion(roll, pitch, yaw),
+            orientation_covariance=_diagonal(3, (degree, degree, degree)),
+            angular_velocity=self._vector(0.0, 0.0, 0.0),
+            angular_velocity_covariance=unknown,
+            linear_acceleration=self._vector(0.0, 0.0, 0.0),
+            linear_acceleration_covariance=unknown.copy(),
+        )
+        return self._cdr(message, IMU)
+
+    def text(self, data: str) -> bytes:
+        return self._cdr(self._make(STRING, data=data), STRING)
+
+    def twist(self, payload: bytes, stamped: bool) -> tuple[float, float, float, float]:
+        """A Twist's (or TwistStamped's) linear x and y and angular z, and its angular x
+        and y summed (a car ignores them); ValueError if it is not one."""
+        ros_type = TWIST_STAMPED if stamped else TWIST
+        try:
+            message = self.store.deserialize_cdr(payload, ros_type)
+        except Exception as exc:  # bytes from anyone: whatever rosbags raises of them
+            raise ValueError(f"not a {ros_type}: {type(exc).__name__}") from None
+        twist = message.twist if stamped else message
+        values = (twist.linear.x, twist.linear.y, twist.angular.z)
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"a Twist of {values}: not finite")
+        return (*values, abs(twist.angular.x) + abs(twist.angular.y))
+
+    def make_twist(self, forward: float, left: float, turn: float) -> bytes:
+        """A Twist's CDR (what a ROS side sends; for the benchmark and the docs' check)."""
+        message = self._make(
+            TWIST, linear=self._vector(forward, left, 0.0), angular=self._vector(0.0, 0.0, turn)
+        )
+        return self._cdr(message, TWIST)
+
+
+@cache
+def _store(distro: str) -> Any:
+    return get_typestore(STORES[distro])
+
+
+def _diagonal(size: int, values: tuple[float, ...]) -> Any:
+    matrix = np.zeros(size * size)
+    for i, value in enumerate(values):
+        matrix[i * size + i] = value
+    return matrix

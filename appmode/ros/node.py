@@ -1,0 +1,323 @@
+"""The car as a ROS 2 node on rmw_zenoh's wire: a driving session (the same stop
+authority as every view: a `cmd_vel` is a held key whose repeats keep it alive) and a
+Zenoh session that ROS sees as a node — its liveliness tokens, `cmd_vel` taken, `odom`,
+`tf`, `battery_state`, `imu` and `~/raw` published from the board's records.
+
+`cmd_vel` samples arrive on Zenoh's threads and wait in a short queue; the session is
+driven from the node's own loop, as a view drives it, so nothing of Zenoh's can hold up
+the car's stop."""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from appmode.protocol import app, params
+from appmode.protocol.params import DriveType
+from appmode.protocol.render import to_json
+from appmode.ros import command
+from appmode.ros.graph import Node, Qos
+from appmode.ros.messages import (
+    BATTERY,
+    IMU,
+    ODOMETRY,
+    STRING,
+    TF,
+    TWIST,
+    TWIST_STAMPED,
+    Messages,
+)
+from appmode.ros.odometry import Odometry
+from appmode.ros.wire import attachment, gid
+from appmode.session.app.session import AppSession
+from appmode.session.control.session import ControlSession
+
+if TYPE_CHECKING:
+    import zenoh
+
+    from appmode.host.app.state import HostState
+    from appmode.session.base import BaseSession
+
+TICK = 0.01
+"""Seconds between two turns of the node's loop (the session's reads, the queue)."""
+QUEUE = 8
+"""cmd_vel samples kept waiting at most (the newest count: a twist replaces the last)."""
+SPEED_CHANGE = 0.1
+"""On the APP port, how far (a share of it) the speed asked must be from max_speed for
+a new `{0:N}` to be sent."""
+Log = Callable[[str], None]
+
+
+@dataclass(frozen=True, slots=True)
+class Options:
+    """How the node is seen and what it takes: `stamped` cmd_vel (TwistStamped, as
+    Jazzy's Nav2 sends it), the frames it names, the silence after which it stops."""
+
+    stamped: bool = False
+    timeout: float = 0.5
+    odom_frame: str = "odom"
+    base_frame: str = "base_link"
+
+
+@dataclass
+class Publisher:
+    topic: str
+    ros_type: str
+    key: str
+    token: str
+    gid: bytes
+    zenoh: Any = None
+    sequence: int = 0
+
+
+class RosNode:
+    """`session` (started, driving the car) as the node `graph` on `zenoh_session`."""
+
+    def __init__(
+        self,
+        session: BaseSession,
+        zenoh_session: zenoh.Session,
+        graph: Node,
+        options: Options,
+        log: Log,
+    ) -> None:
+        self.session = session
+        self.zenoh = zenoh_session
+        self.graph = graph
+        self.options = options
+        self.log = log
+        self.messages = Messages(graph.distro)
+        state = session.telemetry_state()
+        profile = (state.layout.profile if state is not None else None) or None
+        si = profile.velocity_si if profile is not None else (0.001, 0.001)
+        self.si = si
+        self.odometry = Odometry(*si)
+        self._queue: deque[bytes] = deque(maxlen=QUEUE)
+        self._woken = threading.Event()
+        """Set by a cmd_vel: the loop takes it at once, not at its next turn."""
+        self._lock = threading.Lock()
+        self.received = 0
+        """cmd_vel samples taken (for the status and the tests)."""
+        self.refused = 0
+        """cmd_vel samples that were no Twist."""
+        self._seen: dict[str, float] = {"A": -math.inf, "B": -math.inf}
+        self._declared: list[Any] = []
+        self.publishers: dict[str, Publisher] = {}
+        self._said: set[str] = set()
+
+    # ------------------------------------------------------------ the graph
+
+    def declare(self) -> None:
+        """The node's token, a token and a Zenoh publisher per topic, the cmd_vel
+        subscription and its token (what `ros2 node list` and `topic info` show)."""
+        liveliness = self.zenoh.liveliness()
+        self._declared.append(liveliness.declare_token(self.graph.node_token()))
+        topics = [
+            ("odom", ODOMETRY, Qos(depth=10)),
+            ("/tf", TF, Qos(depth=100)),
+            ("battery_state", BATTERY, Qos(depth=10)),
+            ("imu", IMU, Qos(depth=10)),
+            ("~/raw", STRING, Qos(depth=10)),
+        ]
+        for entity_id, (topic, ros_type, qos) in enumerate(topics, start=1):
+            type_hash = self.messages.type_hash(ros_type)
+            token = self.graph.entity_token(entity_id, "MP", topic, ros_type, type_hash, qos)
+            key = self.graph.topic_key(topic, ros_type, type_hash)
+            publisher = Publisher(topic, ros_type, key, token, gid(token))
+            publisher.zenoh = self.zenoh.declare_publisher(key)
+            self._declared += [publisher.zenoh, liveliness.declare_token(token)]
+            self.publishers[topic] = publisher
+        twist = TWIST_STAMPED if self.options.stamped else TWIST
+        type_hash = self.messages.type_hash(twist)
+        entity_id = len(topics) + 1
+        token = self.graph.entity_token(entity_id, "MS", "cmd_vel", twist, type_hash, Qos())
+        key = self.graph.topic_key("cmd_vel", twist, type_hash)
+        self.cmd_vel_key = key
+        self._declared += [
+            self.zenoh.declare_subscriber(key, self._on_cmd_vel),
+            liveliness.declare_token(token),
+        ]
+
+    def _on_cmd_vel(self, sample: zenoh.Sample) -> None:
+        with self._lock:
+            self._queue.append(sample.payload.to_bytes())
+        self._woken.set()
+
+    def withdraw(self) -> None:
+        """Undeclare every token and entity (ROS sees the node leave)."""
+        for declared in reversed(self._declared):
+            declared.undeclare()
+        self._declared.clear()
+
+    # ------------------------------------------------------------ running
+
+    def run(self, ended: Callable[[], bool]) -> None:
+        """Drive the session and the graph until `ended()`."""
+        while not ended():
+            self.session.tick()
+            self._take_commands()
+            self._publish_records()
+            self._woken.wait(TICK)
+            self._woken.clear()
+
+    def _take_commands(self) -> None:
+        with self._lock:
+            payloads = list(self._queue)
+            self._queue.clear()
+        for payload in payloads:
+            try:
+                forward, left, turn, ignored = self.messages.twist(payload, self.options.stamped)
+            except ValueError:
+                self.refused += 1
+                self._say_once("refused", "a cmd_vel that is no Twist was ignored")
+                continue
+            self.received += 1
+            self.session.keepalive()
+            if ignored:
+                self._say_once("3d", "cmd_vel's angular x and y are ignored: a car turns in z")
+            self._drive(forward, left, turn)
+
+    def _drive(self, forward: float, left: float, turn: float) -> None:
+        session = self.session
+        if isinstance(session, ControlSession):
+            self._drive_control(session, forward, left, turn)
+        elif isinstance(session, AppSession):
+            self._drive_app(session, forward, left, turn)
+
+    def _drive_control(
+        self, session: ControlSession, forward: float, left: float, turn: float
+    ) -> None:
+        drive = session.drive
+        if drive is None:
+            return  # the session is reading system_mode; the next cmd_vel drives
+        if max(abs(forward), abs(left), abs(turn)) < command.STILL:
+            if session.moving:
+                session.stop()
+            return
+        max_speed = session.host.state.values.get("max_speed")
+        try:
+            fields = command.frame_fields(forward, left, turn, drive, self.si, max_speed)
+        except ValueError as exc:
+            self._say_once("duty", f"cmd_vel not driven: {exc}")
+            return
+        shown = f"cmd_vel {forward:+.2f} m/s, {left:+.2f} m/s, {turn:+.2f} rad/s"
+        session.hold_velocity(shown, **fields)
+
+    def _drive_app(self, session: AppSession, forward: float, left: float, turn: float) -> None:
+        speed, drive = _params(session.host.state)
+        letter = command.letter_for(forward, left, turn, drive, self.si)
+        if letter is None:
+            if session.moving:
+                session.stop()
+            return
+        if session.page_letter != letter.page:
+            session.switch_page(letter.page)
+        busy = session.host.state.query is not None
+        wanted = speed is None or abs(letter.speed - speed) > SPEED_CHANGE * max(speed, 1)
+        if not busy and wanted and session.host.state.layout.speed_index is not None:
+            session.speed_command([str(letter.speed)])
+        session.press(letter.letter)
+
+    # ------------------------------------------------------------ the records
+
+    def _publish_records(self) -> None:
+        state = self.session.telemetry_state()
+        if state is None:
+            self._say_once("no app", "no APP port beside: odom, battery and imu are not sent")
+            return
+        now_ns, now = time.time_ns(), self.session.now()
+        for at, event in self._new(state, "A"):
+            stamp = now_ns - int((now - at) * 1e9)
+            self._raw(event, state, stamp)
+            self._odometry(event, state, at, stamp)
+        for at, event in self._new(state, "B"):
+            stamp = now_ns - int((now - at) * 1e9)
+            self._raw(event, state, stamp)
+            self._attitude(event, state, stamp)
+
+    def _new(self, state: HostState, letter: str) -> list[tuple[float, Any]]:
+        trace = state.velocities if letter == "A" else state.attitudes
+        seen = self._seen[letter]
+        fresh = [(at, event) for at, event in reversed(trace.points) if at > seen]
+        if fresh:
+            self._seen[letter] = fresh[0][0]
+        return fresh[::-1]
+
+    def _fields(self, event: Any, state: HostState, letter: str) -> dict[str, tuple[float, Any]]:
+        """A record's values by field name, each divided by its scale, with its field."""
+        fields = state.layout.a_fields if letter == "A" else state.layout.b_fields
+        values = app.record_fields(event)[1]
+        return {f.name: (v / f.scale, f) for f, v in zip(fields, values, strict=False)}
+
+    def _odometry(self, event: Any, state: HostState, at: float, stamp: int) -> None:
+        fields = self._fields(event, state, "A")
+        if not all(k in fields and fields[k][1].signed for k in ("x", "y", "z")):
+            self._say_once(
+                "odom",
+                f"the {state.layout.profile.name} profile's A record carries no signed x, y "
+                "and z: odom and tf are not sent",
+            )
+            self._battery(fields, stamp)
+            return
+        pose = self.odometry.step(at, fields["x"][0], fields["y"][0], fields["z"][0])
+        options = self.options
+        self._put(
+            "odom",
+            self.messages.odometry(
+                pose, stamp, options.odom_frame, options.base_frame, self.odometry.variance
+            ),
+        )
+        self._put(
+            "/tf", self.messages.transform(pose, stamp, options.odom_frame, options.base_frame)
+        )
+        self._battery(fields, stamp)
+
+    def _attitude(self, event: Any, state: HostState, stamp: int) -> None:
+        fields = self._fields(event, state, "B")
+        if all(k in fields for k in ("pitch", "roll", "yaw")):
+            roll, pitch = math.radians(fields["roll"][0]), math.radians(fields["pitch"][0])
+            yaw = -math.radians(fields["yaw"][0])  # the board's yaw is clockwise
+            self._put("imu", self.messages.imu(roll, pitch, yaw, stamp, self.options.base_frame))
+        self._battery(fields, stamp)
+
+    def _battery(self, fields: dict[str, tuple[float, Any]], stamp: int) -> None:
+        for value, field in fields.values():
+            if field.battery:
+                self._put(
+                    "battery_state", self.messages.battery(value, stamp, self.options.base_frame)
+                )
+
+    def _raw(self, event: Any, state: HostState, stamp: int) -> None:
+        raw = to_json(event, state.layout).get("raw", "")
+        self._put("~/raw", self.messages.text(str(raw)))
+
+    def _put(self, topic: str, payload: bytes) -> None:
+        publisher = self.publishers[topic]
+        publisher.sequence += 1
+        extra = attachment(publisher.sequence, time.time_ns(), publisher.gid)
+        publisher.zenoh.put(payload, attachment=extra)
+
+    def _say_once(self, kind: str, text: str) -> None:
+        if kind not in self._said:
+            self._said.add(kind)
+            self.log(text)
+
+
+def _params(state: HostState) -> tuple[int | None, DriveType]:
+    """The APP port's speed parameter and drive type, as its last C record gave them
+    (no record yet, or no system_mode: an omni car, whose letters every drive takes)."""
+    layout = state.layout
+    if state.params is None:
+        return None, DriveType.OMNI
+    values = app.record_fields(state.params)[1]
+    speed = None if layout.speed_index is None else int(values[layout.speed_index])
+    names = [param.name for param in layout.params]
+    if "system_mode" not in names:
+        return speed, DriveType.OMNI
+    drive = params.drive_type(int(values[names.index("system_mode")]))
+    return speed, drive or DriveType.OMNI

@@ -1,0 +1,53 @@
+"""Dead reckoning from the board's reported velocity, with no I/O: each A record's body
+velocity (x right, y forward, z clockwise, in the profile's velocity unit) turned into
+REP 103's (forward, left, counter-clockwise; m/s, rad/s) and integrated from record to
+record. Its error grows with the distance driven: the pose's variance is stated as
+(DRIFT × distance)² plus a floor, for a consumer that fuses it."""
+
+from __future__ import annotations
+
+import math
+
+from appmode.ros.messages import Pose2D
+
+DRIFT = 0.05
+"""The standard deviation of the pose per metre driven (x, y in metres, yaw in radians):
+a wheeled car's dead reckoning drifts by a few per cent."""
+FLOOR = 1e-4
+GAP = 0.5
+"""Seconds between two records past which the car's motion in between is unknown: the
+next record starts a new step (the pose is not pushed across a gap in the telemetry)."""
+
+
+class Odometry:
+    """The car's pose in `odom`, integrated from the velocities reported."""
+
+    def __init__(self, metres: float, radians: float) -> None:
+        self.metres = metres
+        """Metres a second one velocity unit of x and y is."""
+        self.radians = radians
+        """Radians a second one unit of z is."""
+        self.pose = Pose2D(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        self.distance = 0.0
+        self._at: float | None = None
+
+    def step(self, at: float, x: float, y: float, z: float) -> Pose2D:
+        """A velocity reported at `at` (seconds): the pose after it, moved by the mean of
+        this velocity and the last over the time between them."""
+        forward, left, turn = y * self.metres, -x * self.metres, -z * self.radians
+        last = self.pose
+        dt = 0.0 if self._at is None or not 0 < at - self._at <= GAP else at - self._at
+        self._at = at
+        mean_forward, mean_left = (forward + last.forward) / 2, (left + last.left) / 2
+        mean_turn = (turn + last.turn) / 2
+        heading = last.yaw + mean_turn * dt / 2
+        dx = (mean_forward * math.cos(heading) - mean_left * math.sin(heading)) * dt
+        dy = (mean_forward * math.sin(heading) + mean_left * math.cos(heading)) * dt
+        self.distance += math.hypot(dx, dy)
+        yaw = math.remainder(last.yaw + mean_turn * dt, math.tau)
+        self.pose = Pose2D(last.x + dx, last.y + dy, yaw, forward, left, turn)
+        return self.pose
+
+    @property
+    def variance(self) -> float:
+        return FLOOR + (DRIFT * self.distance) ** 2

@@ -1,0 +1,1 @@
+"""The car as a ROS 2 node (issue 67), checked against rmw_zenoh's design doc."""

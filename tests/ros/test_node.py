@@ -1,0 +1,183 @@
+"""`appmode ros` seen from a ROS 2 side written from rmw_zenoh's design doc (tests/ros/
+peer.py), through a Zenoh router on loopback: the node's tokens, odometry with valid
+attachments, cmd_vel driving the car — judged on the board's own recording — and
+silence and SIGTERM stopping it."""
+
+from __future__ import annotations
+
+import signal
+import socket
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("zenoh", reason="the ros extra (eclipse-zenoh) is not installed")
+pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed")
+
+import zenoh
+
+from appmode.testing.process import BoardProcess
+from tests.ros import peer
+from tests.support.processes import serving, stop_process, timed_sent
+
+ODOMETRY_JAZZY = "RIHS01_3cc97dc7fb7502f8714462c526d369e35b603cfc34d946e3f2eda2766dfec6e0"
+TWIST_JAZZY = "RIHS01_9c45bf16fe0983d80e3cfe750d6835843d265a9a6c46bd2e609fcddde6fb8d2a"
+ZERO = "FF FE 01 00 00 00 00 00 00 00"
+
+
+@dataclass
+class Car:
+    board: BoardProcess
+    record: Path
+    node: object
+    ros: zenoh.Session
+    endpoint: str
+
+    def frames(self) -> list[tuple[float, str]]:
+        """The control port's frames as the board took them (its clock), in hex."""
+        lines = self.record.read_text().splitlines() if self.record.exists() else []
+        return [
+            (float(line.split()[0]), line.split(" 2> ", 1)[1]) for line in lines if " 2> " in line
+        ]
+
+    def board_timed(self) -> list[tuple[float, str]]:
+        """What the board took on its APP port, with its times."""
+        return timed_sent(self.record) if self.record.exists() else []
+
+    def board_sent(self) -> list[str]:
+        return [unit for _, unit in self.board_timed()]
+
+    def entities(self, want: int) -> list[peer.Entity]:
+        end = time.monotonic() + 15
+        while time.monotonic() < end:
+            found = peer.graph(self.ros)
+            if len(found) >= want:
+                return found
+            time.sleep(0.2)
+        raise AssertionError(f"the graph holds {peer.graph(self.ros)}")
+
+
+def free_endpoint() -> str:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
+
+
+@pytest.fixture
+def car(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[Car]:
+    uart2, *extra = getattr(request, "param", (True,))
+    endpoint = free_endpoint()
+    router = peer.router(endpoint)
+    record = tmp_path / "board.transcript"
+    board = BoardProcess("--pty", "--quiet", "--record", str(record))
+    node, line = serving(
+        "ros",
+        board.url,
+        *((board.uart2,) if uart2 else ()),
+        "--connect",
+        endpoint,
+        *extra,
+        data=tmp_path / "data",
+    )
+    ros = peer.session(endpoint)
+    try:
+        assert line.startswith("ros: node /appmode"), f"{line!r}: {stop_process(node)}"
+        yield Car(board, record, node, ros, endpoint)
+    finally:
+        ros.close()
+        stop_process(node)
+        board.stop()
+        router.close()
+
+
+def test_the_node_s_tokens_odometry_and_cmd_vel_as_a_ros_side_sees_them(car: Car) -> None:
+    entities = {(e.kind, e.topic or e.node): e for e in car.entities(7)}
+    assert ("NN", "appmode") in entities
+    odom = entities[("MP", "/odom")]
+    assert odom.type_name == "nav_msgs::msg::dds_::Odometry_" and odom.type_hash == ODOMETRY_JAZZY
+    assert odom.qos == "::,10:,:,:,,"
+    assert entities[("MP", "/battery_state")].type_name == "sensor_msgs::msg::dds_::BatteryState_"
+    cmd_vel = entities[("MS", "/cmd_vel")]
+    assert cmd_vel.type_name == "geometry_msgs::msg::dds_::Twist_"
+    assert cmd_vel.type_hash == TWIST_JAZZY
+    assert len({e.zid for e in entities.values()}) == 1
+
+    odometry = peer.Received()
+    subscriber = car.ros.declare_subscriber(odom.data_key, odometry.on_sample)
+    time.sleep(1.0)
+    assert len(odometry.payloads) >= 5
+    sequences = [a[0] for a in odometry.attachments]
+    assert sequences == sorted(sequences) and len(set(sequences)) == len(sequences)
+    assert all(abs(a[1] - time.time_ns()) < 5e9 and len(a[2]) == 16 for a in odometry.attachments)
+    assert len({a[2] for a in odometry.attachments}) == 1  # one publisher, one GID
+    first = odometry.messages("nav_msgs/msg/Odometry")[-1]
+    assert first.header.frame_id == "odom" and first.child_frame_id == "base_link"
+
+    twist = peer.TwistPublisher(car.ros, cmd_vel)
+    start = time.monotonic()
+    while time.monotonic() - start < 2.0:
+        twist.publish(0.3)
+        time.sleep(0.05)
+    forward = [f for _, f in car.frames() if f.startswith("FF FE 01 00 00 01 2C")]
+    assert forward, f"no velocity frame y=300 (0.3 m/s) on the board: {car.frames()[-4:]}"
+    moving = odometry.messages("nav_msgs/msg/Odometry")[-1]
+    assert 0.2 < moving.twist.twist.linear.x < 0.35, moving.twist.twist
+    assert moving.pose.pose.position.x > 0.05
+    silent = time.monotonic()
+    board_silent = car.board.clock_after  # the board's clock of this moment
+    end = silent + 5
+    while time.monotonic() < end and car.frames()[-1][1] != ZERO:
+        time.sleep(0.02)
+    stopped_at, last = car.frames()[-1]
+    assert last == ZERO, car.frames()[-3:]
+    assert stopped_at + board_silent - silent < 0.8, "the stop came later than 0.8 s"
+    subscriber.undeclare()
+
+    node = car.node
+    node.send_signal(signal.SIGTERM)  # type: ignore[attr-defined]
+    node.communicate(timeout=15)  # type: ignore[attr-defined]
+    assert node.returncode == 0  # type: ignore[attr-defined]
+    time.sleep(0.5)
+    assert peer.graph(car.ros) == [], "the tokens stay after the node ended"
+    assert car.frames()[-1][1] == ZERO
+
+
+@pytest.mark.parametrize("car", [(True, "--distro", "humble")], indirect=True)
+def test_humble_writes_no_type_hash(car: Car) -> None:
+    entities = car.entities(7)
+    assert all(e.type_hash == "TypeHashNotSupported" for e in entities if e.kind != "NN")
+    odom = next(e for e in entities if e.topic == "/odom")
+    assert odom.qos == "1:2:1,10:,:,:,,"
+    odometry = peer.Received()
+    car.ros.declare_subscriber(odom.data_key, odometry.on_sample)
+    time.sleep(1.0)
+    assert odometry.payloads, "nothing on 0/odom/…/TypeHashNotSupported"
+
+
+@pytest.mark.parametrize("car", [(False,)], indirect=True)
+def test_on_the_app_port_cmd_vel_is_the_nearest_direction_and_silence_stops(car: Car) -> None:
+    cmd_vel = next(e for e in car.entities(7) if e.topic == "/cmd_vel")
+    twist = peer.TwistPublisher(car.ros, cmd_vel)
+    junk = car.ros.declare_publisher(cmd_vel.data_key)
+    junk.put(b"\x00\x01\x00\x00not a twist")  # ignored, said once
+    end = time.monotonic() + 3
+    while time.monotonic() < end and "A" not in car.board_sent():
+        twist.publish(0.2)
+        time.sleep(0.05)
+    for _ in range(20):
+        twist.publish(0.2)
+        time.sleep(0.05)
+    sent = car.board_sent()
+    assert "J" in sent and "A" in sent, sent[-8:]
+    assert "{0:200}" in sent, "the speed asked (0.2 m/s = 200 mm/s) as max_speed"
+    silent = time.monotonic()
+    end = silent + 5
+    while time.monotonic() < end and car.board_sent()[-1] != "Z":
+        time.sleep(0.02)
+    stopped = car.board.clock_after + car.board_timed()[-1][0]
+    assert car.board_sent()[-1] == "Z" and stopped - silent < 0.8
+    err = stop_process(car.node)  # type: ignore[arg-type]
+    assert "a cmd_vel that is no Twist was ignored" in err and "Traceback" not in err

@@ -1,0 +1,94 @@
+"""rmw_zenoh's wire format, pinned: the examples of its docs/design.md (topic keys and
+liveliness tokens), the attachment's layout (zenoh-ext's own serializer as the
+reference), XXH3-128's published vector, and the RIHS01 hash of every type the node
+uses — as rosbags computes them, each checked against the hash other implementations
+publish for it (rclpy's `ros2 topic info -v`, ros-z, rmw_zenoh's own example)."""
+
+from __future__ import annotations
+
+import struct
+
+import pytest
+
+pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed")
+zenoh_ext = pytest.importorskip("zenoh.ext", reason="the ros extra (eclipse-zenoh) is missing")
+
+from appmode.ros import messages  # noqa: E402
+from appmode.ros.graph import Node, Qos, namespace  # noqa: E402
+from appmode.ros.wire import attachment, gid, read_attachment  # noqa: E402
+
+STRING_HASH = "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18"
+HASHES = {
+    messages.STRING: STRING_HASH,
+    messages.TWIST: "RIHS01_9c45bf16fe0983d80e3cfe750d6835843d265a9a6c46bd2e609fcddde6fb8d2a",
+    messages.TWIST_STAMPED: (
+        "RIHS01_5f0fcd4f81d5d06ad9b4c4c63e3ea51b82d6ae4d0558f1d475229b1121db6f64"
+    ),
+    messages.ODOMETRY: "RIHS01_3cc97dc7fb7502f8714462c526d369e35b603cfc34d946e3f2eda2766dfec6e0",
+    messages.BATTERY: "RIHS01_4bee5dfce981c98faa6828b868307a0a73f992ed0789f374ee96c8f840e69741",
+    messages.IMU: "RIHS01_7d9a00ff131080897a5ec7e26e315954b8eae3353c3f995c55faf71574000b5b",
+    messages.TF: "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
+}
+
+
+def test_the_type_hashes_of_every_type_used() -> None:
+    jazzy = messages.Messages("jazzy")
+    assert set(HASHES) == set(messages.TYPES)
+    for ros_type, expected in HASHES.items():
+        assert jazzy.type_hash(ros_type) == expected, ros_type
+
+
+def test_the_design_doc_s_topic_keys() -> None:
+    plain = Node(0, "/", "talker", "z")
+    assert plain.topic_key("chatter", messages.STRING, STRING_HASH) == (
+        f"0/chatter/std_msgs::msg::dds_::String_/{STRING_HASH}"
+    )
+    robot = Node(0, namespace("robot1"), "talker", "z")
+    assert robot.topic_key("chatter", messages.STRING, STRING_HASH) == (
+        f"0/robot1/chatter/std_msgs::msg::dds_::String_/{STRING_HASH}"
+    )
+    assert robot.resolve("/tf") == "/tf" and robot.resolve("~/raw") == "/robot1/talker/raw"
+
+
+def test_the_design_doc_s_liveliness_tokens() -> None:
+    listener = Node(2, "/", "listener", "aac3178e146ba6f1fc6e6a4085e77f21")
+    assert (
+        listener.node_token() == "@ros2_lv/2/aac3178e146ba6f1fc6e6a4085e77f21/0/0/NN/%/%/listener"
+    )
+    subscription = listener.entity_token(
+        10, "MS", "chatter", messages.STRING, STRING_HASH, Qos(depth=10)
+    )
+    assert subscription == (
+        "@ros2_lv/2/aac3178e146ba6f1fc6e6a4085e77f21/0/10/MS/%/%/listener/%chatter/"
+        f"std_msgs::msg::dds_::String_/{STRING_HASH}/::,10:,:,:,,"
+    )
+    talker = Node(2, "/", "talker", "8b20917502ee955ac4476e0266340d5c")
+    publisher = talker.entity_token(10, "MP", "chatter", messages.STRING, STRING_HASH, Qos(depth=7))
+    assert publisher == (
+        "@ros2_lv/2/8b20917502ee955ac4476e0266340d5c/0/10/MP/%/%/talker/%chatter/"
+        f"std_msgs::msg::dds_::String_/{STRING_HASH}/::,7:,:,:,,"
+    )
+
+
+def test_humble_writes_no_hash_and_its_qos_kinds_out() -> None:
+    node = Node(0, "/", "appmode", "z", distro="humble")
+    assert node.topic_key("odom", messages.ODOMETRY, "RIHS01_x").endswith(
+        "/nav_msgs::msg::dds_::Odometry_/TypeHashNotSupported"
+    )
+    assert Qos(depth=10).text("humble") == "1:2:1,10:,:,:,,"
+    assert Qos(depth=42).text("jazzy") == "::,:,:,:,,"
+
+
+def test_the_attachment_is_zenoh_ext_s_serialization_of_its_three_fields() -> None:
+    wire = attachment(7, 1_700_000_000_123_456_789, bytes(range(16)))
+    reference = zenoh_ext.z_serialize(
+        (zenoh_ext.Int64(7), zenoh_ext.Int64(1_700_000_000_123_456_789), bytes(range(16)))
+    )
+    assert wire == reference.to_bytes() and len(wire) == 33
+    assert read_attachment(wire) == (7, 1_700_000_000_123_456_789, bytes(range(16)))
+
+
+def test_a_gid_is_xxh3_128_of_the_token_low_half_first() -> None:
+    empty = int("99aa06d3014798d86001c324468d497f", 16)  # XXH3_128(""), the published vector
+    assert gid("") == struct.pack("<QQ", empty & (2**64 - 1), empty >> 64)
+    assert len(gid("@ros2_lv/0/z/0/0/NN/%/%/appmode")) == 16
