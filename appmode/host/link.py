@@ -8,6 +8,7 @@ ControlHost` on UART2) build on it and decode what `_read_once` brings.
 from __future__ import annotations
 
 import contextlib
+import socket
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -15,6 +16,7 @@ from types import TracebackType
 from typing import Any, Generic, TypeVar
 
 import serial
+from serial.urlhandler import protocol_socket
 
 from appmode.errors import AppmodeError
 from appmode.host import signals
@@ -40,6 +42,24 @@ L = TypeVar("L", bound="Link[Any]")
 UNDELIVERED = "the final stop was not delivered: the car may still be moving"
 """Said when a session ends with its link down and the car last told to move: no host
 can stop it now (the firmware has no time-out)."""
+LINGER = 0.5
+"""Seconds a TCP link waits at its end for the other side to take the last bytes."""
+
+
+def _end_tcp(port: serial.SerialBase) -> None:
+    """End a TCP link (pyserial's socket://) gently: say the end, then read what is still
+    coming until the other side closes. Closing with unread bytes resets the
+    connection: a board whose next write then fails may drop it before it has read
+    the final stop."""
+    sock = getattr(port, "_socket", None)
+    if not isinstance(port, protocol_socket.Serial) or not isinstance(sock, socket.socket):
+        return
+    with contextlib.suppress(OSError):
+        sock.shutdown(socket.SHUT_WR)
+        sock.settimeout(LINGER)
+        deadline = time.monotonic() + LINGER
+        while sock.recv(4096) and time.monotonic() < deadline:
+            pass
 
 
 class LinkLost(AppmodeError):
@@ -386,6 +406,7 @@ class Link(Generic[E]):
             if self._port is not None:
                 with contextlib.suppress(serial.SerialException, OSError):
                     self._port.flush()
+                _end_tcp(self._port)
                 self._port.close()
                 self._port = None
             with contextlib.suppress(AppmodeError):  # only its recording failed, as above

@@ -196,6 +196,8 @@ class TcpEndpoint:
         shown = f"[{bound_host}]" if family == socket.AF_INET6 else bound_host
         self.url = f"socket://{shown}:{bound_port}"
         self._client: socket.socket | None = None
+        self._gone = False
+        """A write found the client gone: write no more, read what it sent until the end."""
         self._out = Overrun(log, "the TCP client")
         self._paused = False
         sel.register(self._listener, selectors.EVENT_READ, self)
@@ -228,12 +230,13 @@ class TcpEndpoint:
         conn.setblocking(False)
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._client = conn
+        self._gone = False
         if not self._paused:
             self._sel.register(conn, selectors.EVENT_READ, self)
         self._log(f"client connected from {peer[0]}:{peer[1]}")
 
     def _receive(self, size: int) -> bytes:
-        if self._client is None:  # dropped earlier in this pass (a write to it failed)
+        if self._client is None:
             return b""
         try:
             data = self._client.recv(size)
@@ -247,13 +250,15 @@ class TcpEndpoint:
         return data
 
     def write(self, data: bytes) -> None:
-        if self._client is None:
+        if self._client is None or self._gone:
             return
         client = self._client
         try:
             self._out.write(data, client.send)
-        except OSError as exc:
-            self._drop(f"client connection lost ({exc.strerror})")
+        except OSError:
+            # the client has gone; what it sent before is still to be read (its last
+            # stop, often), so the connection ends when a read finds its end
+            self._gone = True
 
     def _drop(self, why: str) -> None:
         self._out.dropped = 0

@@ -6,12 +6,13 @@ computes it from the type's definition."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
+
+from appmode.protocol.odometry import Pose2D
 
 TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
@@ -24,19 +25,6 @@ TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING)
 STORES = {"jazzy": Stores.ROS2_JAZZY, "humble": Stores.ROS2_HUMBLE}
 UNKNOWN = -1.0
 """A covariance's first element when the quantity is not measured (REP 145)."""
-
-
-@dataclass(frozen=True, slots=True)
-class Pose2D:
-    """Where the car is in `odom` (metres, radians counter-clockwise) and how it moves
-    in `base_link` (m/s forward and left, rad/s counter-clockwise)."""
-
-    x: float
-    y: float
-    yaw: float
-    forward: float
-    left: float
-    turn: float
 
 
 class Messages:

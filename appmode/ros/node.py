@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from appmode.protocol import app, params
+from appmode.protocol.odometry import Odometry
 from appmode.protocol.params import DriveType
 from appmode.protocol.render import to_json
 from appmode.ros import command
@@ -32,7 +33,6 @@ from appmode.ros.messages import (
     TWIST_STAMPED,
     Messages,
 )
-from appmode.ros.odometry import Odometry
 from appmode.ros.wire import attachment, gid
 from appmode.session.app.session import AppSession
 from appmode.session.control.session import ControlSession

@@ -7,10 +7,10 @@ import math
 
 import pytest
 
+from appmode.protocol.odometry import Odometry
 from appmode.protocol.params import DriveType
 from appmode.ros.command import frame_fields, letter_for
 from appmode.ros.graph import BadName, namespace, node_name
-from appmode.ros.odometry import Odometry
 from tests.support.processes import run
 
 SI = (0.001, 0.001)

@@ -7,8 +7,21 @@ record. Its error grows with the distance driven: the pose's variance is stated 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
-from appmode.ros.messages import Pose2D
+
+@dataclass(frozen=True, slots=True)
+class Pose2D:
+    """Where the car is in `odom` (metres, radians counter-clockwise) and how it moves
+    in `base_link` (m/s forward and left, rad/s counter-clockwise)."""
+
+    x: float
+    y: float
+    yaw: float
+    forward: float
+    left: float
+    turn: float
+
 
 DRIFT = 0.05
 """The standard deviation of the pose per metre driven (x, y in metres, yaw in radians):
