@@ -39,6 +39,7 @@ OWN_PORTS = {
     "ble": "appmode.bluetooth.links.protocol_ble",
     "bt": "appmode.bluetooth.links.protocol_bt",
     "zenoh": "appmode.net.protocol_zenoh",
+    "socket": "appmode.ports.protocol_tcp",
 }
 """appmode's own port classes (pyserial's handlers for these schemes): they take the
 Target itself, and say themselves what went wrong and what to do."""
@@ -108,7 +109,7 @@ def is_rfcomm(where: str) -> bool:
 def explain_open_error(where: str, exc: Exception, scheme: str = "") -> str:
     code = getattr(exc, "errno", None)
     text = str(exc)
-    if scheme in OWN_PORTS:  # the port's own message: what, then the fix
+    if scheme in OWN_PORTS and scheme != "socket":  # its own message: what, then the fix
         return text
     if code == errno.ENOENT or "No such file" in text:
         if is_rfcomm(where):
