@@ -15,6 +15,7 @@ import re
 import stat
 import sys
 import time
+from collections.abc import Iterable
 from pathlib import Path
 
 from appmode.errors import AppmodeError
@@ -26,6 +27,13 @@ LEFTOVER = re.compile(r"\.(?P<name>.+)\.[0-9a-f]{8}\.appmode-tmp")
 
 def write_whole(path: str | os.PathLike[str], data: bytes, what: str) -> None:
     """Make `data` the content of `path`; AppmodeError naming `what` and the path if not."""
+    write_streamed(path, [data], what)
+
+
+def write_streamed(path: str | os.PathLike[str], chunks: Iterable[bytes], what: str) -> None:
+    """Make the `chunks`, made as they are written, the content of `path` (a regular file
+    only once all are written); AppmodeError naming `what` and the path if not. An
+    AppmodeError from making them leaves the file as it was."""
     shown = os.fspath(path)
     target = Path(os.path.realpath(path))
     try:
@@ -36,9 +44,9 @@ def write_whole(path: str | os.PathLike[str], data: bytes, what: str) -> None:
         raise AppmodeError(f"cannot write {what} {shown}: {exc.strerror}") from None
     try:
         if existing is not None and not stat.S_ISREG(existing.st_mode):
-            _write_in_place(target, data, what)
+            _write_in_place(target, chunks, what)
         else:
-            _replace(target, data, existing)
+            _replace(target, chunks, existing)
     except OSError as exc:
         folder = target.parent
         if not folder.is_dir():
@@ -118,22 +126,24 @@ def temporary_beside(target: Path) -> Path:
     return target.with_name(f".{target.name}.{os.urandom(4).hex()}.appmode-tmp")
 
 
-def _write_in_place(target: Path, data: bytes, what: str) -> None:
+def _write_in_place(target: Path, chunks: Iterable[bytes], what: str) -> None:
     fd = open_fifo(target, what) if is_fifo(target) else os.open(target, os.O_WRONLY | _CLOEXEC)
     try:
-        _write_all(fd, data)
+        for data in chunks:
+            _write_all(fd, data)
     finally:
         os.close(fd)
 
 
-def _replace(target: Path, data: bytes, existing: os.stat_result | None) -> None:
+def _replace(target: Path, chunks: Iterable[bytes], existing: os.stat_result | None) -> None:
     tmp = temporary_beside(target)
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666)
     try:
         try:
             if existing is not None:
                 os.fchmod(fd, stat.S_IMODE(existing.st_mode))
-            _write_all(fd, data)
+            for data in chunks:
+                _write_all(fd, data)
             os.fsync(fd)
         finally:
             os.close(fd)

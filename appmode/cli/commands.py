@@ -18,6 +18,7 @@ COMMANDS: dict[str, str] = {
     "tap": "sit between an app and a board, recording both directions",
     "dump": "decode a transcript",
     "plot": "draw a transcript's telemetry (needs matplotlib)",
+    "convert": "convert a transcript to MCAP (for Foxglove) and back, losslessly",
     "ports": "list serial ports (USB-UART adapters, Bluetooth rfcomm)",
     "scan": "list nearby Bluetooth modules (BLE and paired classic) and their URLs",
     "doctor": "find the car: check each serial port and say how to drive it or what to fix",
@@ -70,6 +71,10 @@ EXAMPLES: dict[str, tuple[str, ...]] = {
     ),
     "dump": ("appmode dump car.transcript", "appmode dump car.transcript --csv > car.csv"),
     "plot": ("appmode plot car.transcript -o car.png",),
+    "convert": (
+        "appmode convert car.transcript car.mcap",
+        "appmode convert car.mcap car.transcript",
+    ),
     "ports": ("appmode ports",),
     "scan": ("appmode scan", "appmode scan --time 10 --json"),
     "doctor": ("appmode doctor", "appmode doctor /dev/ttyUSB0 --json"),

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import ExitStack, closing
 from typing import TYPE_CHECKING, TextIO, TypeVar
@@ -14,11 +15,13 @@ from appmode.host.app.query import QueryDone
 from appmode.host.control.client import ControlHost
 from appmode.host.events import BoardWarning, LinkStatus
 from appmode.host.outcomes import QueryFailed
+from appmode.line.wire import Tap
 from appmode.ports.recording import open_recorder
 from appmode.protocol.render import describe, line, to_json
 
 if TYPE_CHECKING:
     from appmode.ports.choice import BoardChoice
+    from appmode.protocol.channels import Viewer
 
 H = TypeVar("H", Host, ControlHost)
 E = TypeVar("E")
@@ -30,6 +33,7 @@ def open_host(
     record: str | None,
     stop_on_close: bool = True,
     confirm_stop: bool = False,
+    view: Viewer | None = None,
 ) -> Host:
     """The APP host of the board chosen, then its recording (`with_recording`); with
     `confirm_stop` it checks its stop on the board's A records."""
@@ -39,21 +43,38 @@ def open_host(
         profile=choice.profile,
         confirm_stop=confirm_stop,
     )
-    return with_recording(stack, host, record)
+    return with_recording(stack, host, record, view)
 
 
-def with_recording(stack: ExitStack, host: H, record: str | None) -> H:
+def with_recording(stack: ExitStack, host: H, record: str | None, view: Viewer | None = None) -> H:
     """An opened host, then its recording: a URL that does not open leaves the file
-    untouched. The recording is closed after the host, so it holds the final stop."""
+    untouched. The recording is closed after the host, so it holds the final stop. A
+    live `view` (`--foxglove`) is fed the same bytes."""
     try:
-        recorder = open_recorder(record, 0.0, host.target.directives) if record else None
+        recorder = (
+            open_recorder(record, 0.0, host.target.directives, layout=host.profile.a_layout)
+            if record
+            else None
+        )
     except BaseException:
         host.close()
         raise
     if recorder is not None:
         stack.enter_context(closing(recorder))
-        host.tap = recorder
+    taps: list[Tap] = [t for t in (view, recorder) if t is not None]
+    if view is not None:
+        view.epoch = time.time() - host.now()
+    if taps:
+        host.tap = taps[0] if len(taps) == 1 else _every(taps)
     return stack.enter_context(host)
+
+
+def _every(taps: list[Tap]) -> Tap:
+    def tap(direction: str, at: float, data: bytes) -> None:
+        for one in taps:
+            one(direction, at, data)
+
+    return tap
 
 
 def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:

@@ -1,5 +1,6 @@
 """A recording written to a file the user names (`--record FILE`, a board's own): the
-file opened here, the transcript written by `protocol.recorder.Recorder`."""
+file opened here, the transcript written by `protocol.recorder.Recorder` — as MCAP when
+the name ends in `.mcap` (the suffix chooses the format, as python-can's logger does)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ from functools import partial
 
 from appmode.errors import AppmodeError
 from appmode.files import is_fifo, open_fifo
-from appmode.protocol.recorder import Recorder
+from appmode.protocol.layouts import VELOCITY, Layout
+from appmode.protocol.recorder import Lines, Recorder
 from appmode.writer import BoundedWriter
 
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
@@ -27,16 +29,19 @@ def open_recorder(
     origin: float = 0.0,
     directives: tuple[str, ...] = (),
     background: bool = True,
+    layout: Layout = VELOCITY,
 ) -> Recorder:
     """A recorder of the file `path`, written by a `BoundedWriter`: a full disk, a FIFO
     nobody reads or a stalled reader never holds up the caller (the recording stops, and
     the next call or `close` says why). With `background` False it is written on the
     caller's thread, which its reader may slow down (a simulated board's own recording:
-    nothing waits for it, and a flood is recorded whole)."""
+    nothing waits for it, and a flood is recorded whole). A `.mcap` file is MCAP, its
+    decoded channels in `layout`'s terms (needs the `foxglove` extra's mcap)."""
     shown = os.fspath(path)
+    lines = _format(shown, layout)
     if is_fifo(path) and background:  # its open waits for a reader: in the writer
         opener = partial(open_fifo, path, "transcript", "the session goes on meanwhile")
-        return Recorder(BoundedWriter(opener, shown), origin, directives)
+        return Recorder(BoundedWriter(opener, shown), origin, directives, lines=lines)
     new = not os.path.lexists(path)
     try:
         if is_fifo(path):
@@ -47,15 +52,15 @@ def open_recorder(
         raise AppmodeError(f"cannot write transcript {shown}: {exc.strerror}") from None
     try:
         if not background:
-            out = os.fdopen(fd, "w", encoding="utf-8")
+            out = os.fdopen(fd, "w", encoding="utf-8") if lines is None else os.fdopen(fd, "wb")
             try:
-                return Recorder(out, origin, directives, shown, closes=True)
+                return Recorder(out, origin, directives, shown, closes=True, lines=lines)
             except AppmodeError:  # not even the header fits
                 with contextlib.suppress(OSError):
                     out.close()
                 raise
         writer = BoundedWriter(lambda: fd, shown)
-        recorder = Recorder(writer, origin, directives)
+        recorder = Recorder(writer, origin, directives, lines=lines)
         writer.ran(THREAD_WAIT)
         if not writer.drained(HEADER_WAIT):  # not even the header fits (a full disk)
             why = writer.failure or f"its first line unwritten after {HEADER_WAIT:g} s"
@@ -67,3 +72,16 @@ def open_recorder(
                 os.unlink(path)
         raise
     return recorder
+
+
+def _format(path: str, layout: Layout) -> Lines | None:
+    """MCAP for a `.mcap` name, else None (a transcript)."""
+    if not path.lower().endswith(".mcap"):
+        return None
+    try:
+        from appmode.protocol.mcap_format import McapLines
+    except ImportError:
+        raise AppmodeError(
+            f"cannot write {path}: MCAP needs the mcap package: pip install 'appmode[foxglove]'"
+        ) from None
+    return McapLines(layout)

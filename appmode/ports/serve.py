@@ -26,7 +26,7 @@ from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import Faults, FaultSpec
-from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
+from appmode.line.wire import APP, UART2, UART2_BAUD, Tap, Wire
 from appmode.ports.endpoints import Endpoint, Log, MakeEndpoint
 from appmode.ports.recording import open_recorder
 from appmode.ports.schedule import INPUT_BACKLOG, Served
@@ -62,6 +62,7 @@ class BoardServer:
         directives: tuple[str, ...] = (),
         make_uart2: list[MakeEndpoint] | None = None,
         faults: FaultSpec | None = None,
+        view: Tap | None = None,
     ) -> None:
         self.log = log
         self._faults = faults
@@ -82,7 +83,7 @@ class BoardServer:
         self._sel.register(self._wake_read, selectors.EVENT_READ, None)
         self._origin = time.monotonic()
         try:
-            self._open(make_endpoints, boards, pace, record, directives, make_uart2)
+            self._open(make_endpoints, boards, pace, record, directives, make_uart2, view)
         except BaseException:
             self.close()
             raise
@@ -95,6 +96,7 @@ class BoardServer:
         record: str | None,
         directives: tuple[str, ...],
         make_uart2: list[MakeEndpoint] | None,
+        view: Tap | None,
     ) -> None:
         pairs: list[dict[str, Endpoint]] = []
         for i, make in enumerate(make_endpoints):
@@ -105,7 +107,11 @@ class BoardServer:
                 self._endpoints.append(pair[UART2])
             pairs.append(pair)
         self._recorder = (
-            open_recorder(record, 0.0, directives, background=False) if record else None
+            open_recorder(
+                record, 0.0, directives, background=False, layout=boards[0].profile.a_layout
+            )
+            if record
+            else None
         )
         for pair, board in zip(pairs, boards, strict=True):
             if self._recorder is not None:
@@ -117,7 +123,7 @@ class BoardServer:
             wire = Wire(
                 board,
                 bauds[APP] if pace else None,
-                self._recorder,
+                _every(self._recorder, view),
                 bauds.get(UART2, UART2_BAUD) if pace else None,
             )
             one = Served(
@@ -329,9 +335,22 @@ class ServeOptions:
         return (f"board {' '.join(needs)}",) if needs else ()
 
 
-def run_board(options: ServeOptions) -> int:
+def _every(recorder: Recorder | None, view: Tap | None) -> Tap | None:
+    """The board's tap: its recording and its live view, either, or none."""
+    if recorder is None or view is None:
+        return recorder or view
+
+    def tap(direction: str, at: float, data: bytes) -> None:
+        view(direction, at, data)
+        recorder(direction, at, data)
+
+    return tap
+
+
+def run_board(options: ServeOptions, view: Tap | None = None) -> int:
     """Build the board(s) and serve until interrupted (KeyboardInterrupt); print each
-    port's line (`port: …`, then `uart2: …`) for clients to open."""
+    port's line (`port: …`, then `uart2: …`) for clients to open. A live `view` sees the
+    first board's bytes."""
 
     def log(text: str) -> None:
         if not options.quiet:
@@ -352,6 +371,7 @@ def run_board(options: ServeOptions) -> int:
             record=options.record,
             directives=options.directives,
             make_uart2=[options.uart2] * options.count,
+            view=view,
         )
         try:
             for i in range(options.count):

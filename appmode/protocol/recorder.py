@@ -6,7 +6,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections import deque
-from typing import TextIO
+from typing import Any, BinaryIO, Protocol, TextIO
 
 from appmode.errors import AppmodeError
 from appmode.protocol.escaping import escape
@@ -69,6 +69,38 @@ class _Held:
         return rest
 
 
+class Lines(Protocol):
+    """A recording's format: what its start, each unit and comment, and its end add
+    (text for a transcript, bytes for MCAP: `mcap_format.McapLines`)."""
+
+    def start(self, directives: tuple[str, ...]) -> str | bytes: ...
+
+    def line(
+        self, time: float, raw: bytes, direction: str, text: bool, event: Any = None
+    ) -> str | bytes: ...
+
+    def comment(self, time: float, text: str) -> str | bytes: ...
+
+    def finish(self) -> str | bytes: ...
+
+
+class TextLines:
+    """A transcript, format v1: a line a unit."""
+
+    def start(self, directives: tuple[str, ...]) -> str:
+        return "".join([HEADER + "\n", *(f"@{d}\n" for d in directives)])
+
+    def line(self, time: float, raw: bytes, direction: str, text: bool, event: Any = None) -> str:
+        payload = uart2_payload(raw, text) if direction in UART2_DIRECTIONS else escape(raw)
+        return f"{time:.{TIME_DIGITS}f} {direction} {payload}\n"
+
+    def comment(self, time: float, text: str) -> str:
+        return f"# {text}\n"
+
+    def finish(self) -> str:
+        return ""
+
+
 class Recorder:
     """Writes a session as it happens: each direction split into commands and records.
 
@@ -81,14 +113,16 @@ class Recorder:
 
     def __init__(
         self,
-        out: TextIO | BoundedWriter,
+        out: TextIO | BinaryIO | BoundedWriter,
         origin: float = 0.0,
         directives: tuple[str, ...] = (),
         name: str | None = None,
         closes: bool = False,
+        lines: Lines | None = None,
     ) -> None:
         """`out`: a stream (written at once, and left open unless `closes`), or a bounded
-        writer (written off the caller's thread, closed with the recorder)."""
+        writer (written off the caller's thread, closed with the recorder); `lines`: the
+        format (a transcript's text by default; a binary stream for MCAP's bytes)."""
         self._out = out
         self.name = name or str(getattr(out, "name", "the transcript"))
         self._failed = False
@@ -97,11 +131,13 @@ class Recorder:
         self._origin = origin
         self._reader = PortsReader()
         self._held = {direction: _Held() for direction in DIRECTIONS}
-        self._queue: list[tuple[float, int, bytes, str, bool]] = []
-        """Lines not yet written: time, order, bytes, direction, and whether a UART2 line
-        is APP text (§12) — as decoded, whatever the mode when it is written."""
+        self._lines: Lines = lines or TextLines()
+        self._queue: list[tuple[float, int, bytes, str, bool, Event | None]] = []
+        """Lines not yet written: time, order, bytes, direction, whether a UART2 line is
+        APP text (§12) — as decoded, whatever the mode when it is written — and the
+        event it decoded to (None: a unit written before it ended)."""
         self._order = itertools.count()  # keeps lines of one time in the order they came
-        self._write("".join([HEADER + "\n", *(f"@{d}\n" for d in directives)]))
+        self._write(self._lines.start(directives))
 
     def __call__(self, direction: str, time: float, data: bytes) -> None:
         self._held[direction].add(data, time)
@@ -111,7 +147,8 @@ class Recorder:
     def note(self, text: str, time: float) -> None:
         """A comment line at `time`: what happened that no byte shows (the first comment
         of a transcript is its title)."""
-        self._queue.append((time, next(self._order), " ".join(text.split()).encode(), "#", False))
+        said = " ".join(text.split()).encode()
+        self._queue.append((time, next(self._order), said, "#", False, None))
         self._release(time)
 
     def follow(self, system_mode: int, time: float) -> None:
@@ -124,7 +161,8 @@ class Recorder:
             when, raw = self._held[shown].take(len(event.raw))
             if raw:
                 text = isinstance(event, APP_EVENTS)
-                self._queue.append((when, next(self._order), raw, shown, text))
+                whole = event if raw == event.raw else None
+                self._queue.append((when, next(self._order), raw, shown, text, whole))
 
     def _release(self, now: float) -> None:
         """Write, in time order, the lines that no incomplete unit came before; a unit
@@ -136,30 +174,30 @@ class Recorder:
                 if start <= now - HOLD:
                     when, raw = held.unshown()
                     text = self._reader.app_mode
-                    self._queue.append((when, next(self._order), raw, direction, text))
+                    self._queue.append((when, next(self._order), raw, direction, text, None))
                 else:
                     first = min(first, start)
         self._queue.sort()
         ready = [line for line in self._queue if line[0] < first]
         del self._queue[: len(ready)]
-        for when, _, raw, direction, text in ready:
-            self._line(when, raw, direction, text)
+        for when, _, raw, direction, text, event in ready:
+            at = max(0.0, when - self._origin)
+            if direction == "#":
+                self._write(self._lines.comment(at, raw.decode()))
+            else:
+                self._write(self._lines.line(at, raw, direction, text, event))
 
-    def _line(self, time: float, raw: bytes, direction: str, text: bool) -> None:
-        if direction == "#":
-            self._write(f"# {raw.decode()}\n")
+    def _write(self, text: str | bytes) -> None:
+        if not text:
             return
-        payload = uart2_payload(raw, text) if direction in UART2_DIRECTIONS else escape(raw)
-        self._write(f"{max(0.0, time - self._origin):.{TIME_DIGITS}f} {direction} {payload}\n")
-
-    def _write(self, text: str) -> None:
         if isinstance(self._out, BoundedWriter):
-            if self._failed or not self._out.write(text.encode("utf-8")):
+            data = text.encode("utf-8") if isinstance(text, str) else text
+            if self._failed or not self._out.write(data):
                 self._failed = True
                 raise AppmodeError(f"cannot write transcript {self.name}: {self._out.failure}")
             return
         try:
-            self._out.write(text)
+            self._out.write(text)  # type: ignore[arg-type]  # the stream the format wants
             self._out.flush()
         except OSError as exc:
             self._failed = True
@@ -178,6 +216,7 @@ class Recorder:
             try:
                 self._units(self._reader.flush())
                 self._release(math.inf)
+                self._write(self._lines.finish())
             except AppmodeError as exc:
                 error = exc
         if isinstance(self._out, BoundedWriter):

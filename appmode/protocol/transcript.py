@@ -84,6 +84,18 @@ class Directive:
 
 
 @dataclass(frozen=True, slots=True)
+class Comment:
+    """One `# text` line (the first one after the header is the title)."""
+
+    lineno: int
+    text: str
+
+
+Line = Entry | Directive | Comment
+"""What a transcript's line is, blank lines and the header aside."""
+
+
+@dataclass(frozen=True, slots=True)
 class Transcript:
     path: str
     items: tuple[Entry | Directive, ...]
@@ -137,8 +149,8 @@ def parse_lines(lines: Iterable[tuple[int, bytes, bool]], path: str) -> Transcri
     warnings: list[str] = []
     title = ""
     for item in line_items(lines, path, warnings.append):
-        if isinstance(item, str):
-            title = title or item
+        if isinstance(item, Comment):
+            title = title or item.text
         else:
             items.append(item)
     return Transcript(path, tuple(items), title, tuple(warnings))
@@ -146,8 +158,8 @@ def parse_lines(lines: Iterable[tuple[int, bytes, bool]], path: str) -> Transcri
 
 def line_items(
     lines: Iterable[tuple[int, bytes, bool]], path: str, warn: Callable[[str], None]
-) -> Iterator[Entry | Directive | str]:
-    """Each line's item; a comment as its text (the first one is the title)."""
+) -> Iterator[Line]:
+    """Each line's item (the first comment is the title)."""
     for lineno, raw, ended in lines:
         try:
             item = _item(raw, lineno, path)
@@ -160,7 +172,7 @@ def line_items(
             yield item
 
 
-def _item(raw: bytes, lineno: int, path: str) -> Entry | Directive | str | None:
+def _item(raw: bytes, lineno: int, path: str) -> Line | None:
     where = f"{path}:{lineno}"
     try:
         line = raw.decode("utf-8").removesuffix("\r")
@@ -176,14 +188,34 @@ def _item(raw: bytes, lineno: int, path: str) -> Entry | Directive | str | None:
     if not stripped:
         return None
     if stripped.startswith("#"):
-        return None if stripped == HEADER else stripped.lstrip("# ").strip()
+        return None if stripped == HEADER else Comment(lineno, stripped.lstrip("# ").strip())
     if stripped.startswith("@"):
-        name, *args = stripped[1:].split() or [""]
-        if name not in DIRECTIVES:
-            known = ", ".join(f"@{d}" for d in DIRECTIVES)
-            raise TranscriptError(f"{where}: unknown directive @{_cut(name)} (known: {known})")
-        return Directive(lineno, name, tuple(args))
-    return _entry(line.rstrip("\r\n"), lineno, where)
+        return parse_directive(stripped, lineno, where)
+    return parse_entry(line.rstrip("\r\n"), lineno, where)
+
+
+def parse_directive(text: str, lineno: int, where: str) -> Directive:
+    """One `@name args` line; TranscriptError if no such directive."""
+    name, *args = text.strip()[1:].split() or [""]
+    if name not in DIRECTIVES:
+        known = ", ".join(f"@{d}" for d in DIRECTIVES)
+        raise TranscriptError(f"{where}: unknown directive @{_cut(name)} (known: {known})")
+    return Directive(lineno, name, tuple(args))
+
+
+def time_text(time: float) -> str:
+    """A line's time as the format writes it: to 0.1 ms, or every digit it has beyond."""
+    text = f"{time:.{TIME_DIGITS}f}"
+    return text if float(text) == time else repr(time)
+
+
+def format_line(item: Line) -> str:
+    """The text of one line (no newline), as `_item` reads it back."""
+    if isinstance(item, Entry):
+        return f"{time_text(item.time)} {item.direction} {item.text}"
+    if isinstance(item, Directive):
+        return " ".join(("@" + item.name, *item.args))
+    return f"# {item.text}"
 
 
 def _cut(text: str, limit: int = 60) -> str:
@@ -191,7 +223,8 @@ def _cut(text: str, limit: int = 60) -> str:
     return text if len(text) <= limit else f"{text[:limit]}… ({len(text):,} chars)"
 
 
-def _entry(line: str, lineno: int, where: str) -> Entry:
+def parse_entry(line: str, lineno: int, where: str) -> Entry:
+    """One `TIME DIR PAYLOAD` line; TranscriptError says what is wrong, at `where`."""
     parts = line.split(" ", 2)
     if len(parts) != 3 or not parts[2]:
         raise TranscriptError(

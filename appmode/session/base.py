@@ -7,6 +7,7 @@ port.
 from __future__ import annotations
 
 import shlex
+import time
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
@@ -17,6 +18,7 @@ from appmode.host import signals
 from appmode.host.link import UNDELIVERED, Link
 from appmode.ports.recording import open_recorder
 from appmode.ports.target import Target
+from appmode.protocol.channels import Viewer
 from appmode.protocol.recorder import Recorder
 from appmode.session.authority import LAPSE, StopGuard
 from appmode.session.command_line import (
@@ -70,6 +72,9 @@ class BaseSession(ABC):
         """Commands and queries that failed (`fail`)."""
         self.on_message = on_message
         self.recorder: Recorder | None = None
+        self.viewers: list[Viewer] = []
+        """Live views beside the session's own (`--foxglove`): each a tap that never
+        blocks (`viewers.live.LiveView`)."""
         self.names_files = True
         """The command line may name files (`record FILE`); a page's may not: its
         recordings go to `recordings_folder()` under names appmode makes."""
@@ -266,6 +271,8 @@ class BaseSession(ABC):
 
     def say(self, text: str) -> None:
         self.messages.append(text)
+        for viewer in self.viewers:
+            viewer.note(text)
         if self.on_message is not None:
             self.on_message(text)
 
@@ -298,7 +305,15 @@ class BaseSession(ABC):
             self.close()
             raise
 
+    def add_viewer(self, viewer: Viewer) -> None:
+        """Show the session to `viewer` from now on (its bytes, what it says), on the
+        session's clock from `viewer.epoch`, the wall-clock time of its start."""
+        viewer.epoch = time.time() - self.now()
+        self.viewers.append(viewer)
+
     def _tap(self, direction: str, time: float, data: bytes) -> None:
+        for viewer in self.viewers:
+            viewer(direction, time, data)
         if self.recorder is None:
             return
         try:
@@ -327,7 +342,9 @@ class BaseSession(ABC):
         """Record from now on, times counted from `origin` (default: now)."""
         try:
             start = self.now() if origin is None else origin
-            recorder = open_recorder(path, start, self.target.directives)
+            recorder = open_recorder(
+                path, start, self.target.directives, layout=self.host.profile.a_layout
+            )
         except AppmodeError as exc:
             if self.recorder is None:
                 raise

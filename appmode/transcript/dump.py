@@ -30,7 +30,7 @@ from appmode.transcript.matcher import (
     board_needs,
     parse_pattern,
 )
-from appmode.transcript.reading import iter_transcript, read_transcript
+from appmode.transcript.reading import iter_lines, iter_transcript, read_transcript
 
 Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent
 
@@ -67,11 +67,11 @@ def decoded(
         yield last[direction], direction, event
 
 
-def needs_of(path: str, warn: Callable[[str], None]) -> BoardNeeds:
+def needs_of(path: str, warn: Callable[[str], None], partial: bool = False) -> BoardNeeds:
     """The board a transcript file names (`@board`, the last one), read from its `@`
-    lines alone."""
+    lines alone (`partial`: of an MCAP file cut short too)."""
     needs = BoardNeeds()
-    for item in iter_transcript(path, warn, directives_only=True):
+    for item in iter_lines(path, warn, directives_only=True, partial=partial):
         if isinstance(item, Directive) and item.name == "board":
             needs = board_needs(item.args, f"{path}:{item.lineno}")
     return needs

@@ -1,21 +1,25 @@
 """Transcript files read from disk: whole (`read_transcript`) or a line at a time in
-constant memory (`iter_transcript`). The grammar is `protocol.transcript`'s, which reads
-only what it is given."""
+constant memory (`iter_transcript`), as text (the grammar of `protocol.transcript`) or
+MCAP (`protocol.mcap_format`: told by its first bytes, whatever the file's name)."""
 
 from __future__ import annotations
 
+import io
 import os
 from collections.abc import Callable, Iterator
 
 from appmode.errors import AppmodeError
 from appmode.protocol.transcript import (
+    Comment,
     Directive,
     Entry,
+    Line,
     Transcript,
     line_items,
-    parse_lines,
     stream_lines,
 )
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
 def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
@@ -24,12 +28,16 @@ def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Tr
     MAX_LINE bytes: a file that is no transcript (/dev/zero, a binary) fails at once. A
     last line cut short (a recording stopped by a full disk) is left out, with a warning
     in `warnings`."""
-    name = name or os.fspath(path)
-    try:
-        with open(path, "rb") as handle:
-            return parse_lines(stream_lines(handle, name), name)
-    except OSError as exc:
-        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
+    shown = name or os.fspath(path)
+    items: list[Entry | Directive] = []
+    warnings: list[str] = []
+    title = ""
+    for item in iter_lines(path, warnings.append, shown):
+        if isinstance(item, Comment):
+            title = title or item.text
+        else:
+            items.append(item)
+    return Transcript(shown, tuple(items), title, tuple(warnings))
 
 
 def iter_transcript(
@@ -37,15 +45,62 @@ def iter_transcript(
 ) -> Iterator[Entry | Directive]:
     """The lines of a transcript file one at a time, in constant memory, as
     `read_transcript` reads them; `warn` hears of a last line cut short. With
-    `directives_only`, only the `@` lines are read (a quick first pass)."""
-    name = os.fspath(path)
+    `directives_only`, only the `@` lines are read (a quick first pass over a text)."""
+    for item in iter_lines(path, warn, directives_only=directives_only):
+        if not isinstance(item, Comment):
+            yield item
+
+
+def iter_lines(
+    path: str | os.PathLike[str],
+    warn: Callable[[str], None],
+    name: str | None = None,
+    directives_only: bool = False,
+    partial: bool = False,
+) -> Iterator[Line]:
+    """Every line of a transcript or MCAP file, comments too, in constant memory; an
+    MCAP file cut short is an error unless `partial` (then `warn` hears of it)."""
+    shown = name or os.fspath(path)
     try:
         with open(path, "rb") as handle:
-            lines = stream_lines(handle, name)
-            if directives_only:
-                lines = (line for line in lines if line[1].lstrip().startswith(b"@"))
-            for item in line_items(lines, name, warn):
-                if not isinstance(item, str):
-                    yield item
+            yield from _items(handle, shown, warn, directives_only, partial)
     except OSError as exc:
-        raise AppmodeError(f"cannot read transcript {name}: {exc.strerror}") from None
+        raise AppmodeError(f"cannot read transcript {shown}: {exc.strerror}") from None
+
+
+def _items(
+    handle: io.BufferedReader,
+    name: str,
+    warn: Callable[[str], None],
+    directives_only: bool,
+    partial: bool,
+) -> Iterator[Line]:
+    if handle.peek(len(MCAP_MAGIC))[: len(MCAP_MAGIC)] == MCAP_MAGIC:
+        try:
+            from appmode.protocol.mcap_format import read_items
+        except ImportError:
+            raise AppmodeError(
+                f"{name} is MCAP: reading it needs the mcap package: "
+                "pip install 'appmode[foxglove]'"
+            ) from None
+        for item in read_items(handle, name, warn, _ends_as_mcap(handle), partial):
+            if not directives_only or isinstance(item, Directive):
+                yield item
+        return
+    lines = stream_lines(handle, name)
+    if directives_only:
+        lines = (line for line in lines if line[1].lstrip().startswith(b"@"))
+    yield from line_items(lines, name, warn)
+
+
+def _ends_as_mcap(handle: io.BufferedReader) -> bool | None:
+    """Whether the file ends with MCAP's magic (None: a pipe, which cannot be looked at
+    ahead)."""
+    if not handle.seekable():
+        return None
+    start = handle.tell()
+    size = handle.seek(0, os.SEEK_END)
+    handle.seek(max(0, size - len(MCAP_MAGIC)))
+    ends = handle.read(len(MCAP_MAGIC)) == MCAP_MAGIC and size >= 2 * len(MCAP_MAGIC)
+    handle.seek(start)
+    return ends

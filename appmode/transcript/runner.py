@@ -197,18 +197,19 @@ SUITE = _suite()
 
 
 def collect(paths: list[str]) -> list[Path]:
-    """Transcript files from files and directories (searched recursively, sorted)."""
+    """Transcript files from files and directories (searched recursively, sorted: their
+    transcripts and MCAP recordings)."""
     found: list[Path] = []
     for name in paths:
         path = Path(name)
         if path.is_dir():
-            found += sorted(path.rglob(f"*{SUFFIX}"))
+            found += sorted(p for p in path.rglob("*") if p.suffix in (SUFFIX, ".mcap"))
         elif path.exists():
             found.append(path)
         else:
             raise AppmodeError(f"no such transcript or directory: {name}")
     if not found:
-        raise AppmodeError(f"no {SUFFIX} files in {', '.join(paths)}")
+        raise AppmodeError(f"no {SUFFIX} or .mcap files in {', '.join(paths)}")
     return found
 
 

@@ -1,0 +1,190 @@
+"""What a viewer (Foxglove, an MCAP file) shows of a session, with no I/O: each decoded
+unit as a JSON message on a channel named for what it is — the records by kind, with
+the profile's field names and units (`/app/A`, `/app/B`, `/app/C`), what the host sent
+(`/app/commands`, `/uart2/commands`), what UART2 answered (`/uart2/replies`) — and the
+car's dead-reckoned pose (`/pose` and `/tf`, in foxglove's PoseInFrame and
+FrameTransform shapes, labelled as dead reckoning). One table of the channels; every
+schema a JSON schema, so a plot panel lists the fields by name, with their units."""
+
+from __future__ import annotations
+
+import math
+import threading
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from appmode.protocol import app, control
+from appmode.protocol.control_view import view
+from appmode.protocol.layouts import Layout
+from appmode.protocol.odometry import Odometry, Pose2D
+from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2
+
+POSE_FRAME = "odom"
+"""The frame the dead-reckoned pose is in (its origin: where the session began)."""
+BASE_FRAME = "base_link"
+OBJECT: dict[str, Any] = {"type": "object"}
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelSpec:
+    topic: str
+    schema_name: str
+    schema: dict[str, Any]
+    description: str
+
+
+def _number_fields(fields: list[tuple[str, str]]) -> dict[str, Any]:
+    properties = {name: {"type": "number", "description": unit} for name, unit in fields}
+    return {"type": "object", "properties": {**properties, "raw": {"type": "string"}}}
+
+
+_TIME = {
+    "type": "object",
+    "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}},
+}
+_VECTOR = {"type": "object", "properties": {k: {"type": "number"} for k in "xyz"}}
+_QUATERNION = {"type": "object", "properties": {k: {"type": "number"} for k in "xyzw"}}
+POSE_SCHEMA = {
+    "title": "foxglove.PoseInFrame",
+    "type": "object",
+    "properties": {
+        "timestamp": _TIME,
+        "frame_id": {"type": "string"},
+        "pose": {
+            "type": "object",
+            "properties": {"position": _VECTOR, "orientation": _QUATERNION},
+        },
+    },
+}
+TRANSFORM_SCHEMA = {
+    "title": "foxglove.FrameTransform",
+    "type": "object",
+    "properties": {
+        "timestamp": _TIME,
+        "parent_frame_id": {"type": "string"},
+        "child_frame_id": {"type": "string"},
+        "translation": _VECTOR,
+        "rotation": _QUATERNION,
+    },
+}
+
+
+_WHEELS = {"type": "array", "items": {"type": "integer"}}
+ENCODERS = {
+    "type": "object",
+    "properties": {
+        "targets": {**_WHEELS, "description": "each wheel's target (encoder counts)"},
+        "actuals": {**_WHEELS, "description": "each wheel's measured speed (encoder counts)"},
+        "raw": {"type": "string"},
+    },
+}
+
+
+def channels(layout: Layout) -> dict[str, ChannelSpec]:
+    """Every channel, by topic, with `layout`'s record fields."""
+    a = [(f.name, f.unit) for f in layout.a_fields]
+    b = [(f.name, f.unit) for f in layout.b_fields]
+    c = [(p.name, p.label) for p in layout.params]
+    specs = [
+        ChannelSpec("/app/A", "appmode.A", _number_fields(a), "A records: motion"),
+        ChannelSpec("/app/B", "appmode.B", _number_fields(b), "B records: attitude, battery"),
+        ChannelSpec("/app/C", "appmode.C", _number_fields(c), "C records: the parameters"),
+        ChannelSpec("/app/other", "appmode.event", OBJECT, "other bytes from the board"),
+        ChannelSpec("/app/commands", "appmode.event", OBJECT, "letters and frames sent"),
+        ChannelSpec("/uart2/commands", "appmode.event", OBJECT, "control-port frames sent"),
+        ChannelSpec("/uart2/replies", "appmode.event", OBJECT, "control-port replies"),
+        ChannelSpec("/uart2/encoders", "appmode.encoders", ENCODERS, "encoder reports"),
+        ChannelSpec("/pose", "foxglove.PoseInFrame", POSE_SCHEMA, "dead reckoning"),
+        ChannelSpec("/tf", "foxglove.FrameTransform", TRANSFORM_SCHEMA, "dead reckoning"),
+    ]
+    return {spec.topic: spec for spec in specs}
+
+
+class Decoded:
+    """Decoded units, in `layout`'s terms, as (topic, JSON message) pairs."""
+
+    def __init__(self, layout: Layout) -> None:
+        self.layout = layout
+        self.odometry = Odometry(*layout.profile.velocity_si)
+        motion = {f.name: f for f in layout.a_fields}
+        self._dead_reckons = all(k in motion and motion[k].signed for k in ("x", "y", "z"))
+
+    def unit(self, time: float, direction: str, event: Any) -> list[tuple[str, dict[str, Any]]]:
+        """The messages one decoded unit makes (`time`: seconds, the session's)."""
+        body = view(event, self.layout)[0]
+        if direction == SENT:
+            return [("/app/commands", body)]
+        if direction == SENT2:
+            return [("/uart2/commands", body)]
+        if direction == RECEIVED2:
+            encoders = isinstance(event, control.EncoderReport)
+            return [("/uart2/encoders" if encoders else "/uart2/replies", body)]
+        if direction != RECEIVED or not isinstance(event, app.RECORDS):
+            return [("/app/other", body)]
+        letter, values = app.record_fields(event)
+        if letter not in "ABC":
+            return [("/app/other", body)]
+        found = [(f"/app/{letter}", self._scaled(letter, values, event.raw))]
+        if letter == "A" and self._dead_reckons:
+            pose = self._pose(time, values)
+            found += [("/pose", pose_message(pose, time)), ("/tf", transform(pose, time))]
+        return found
+
+    def _scaled(self, letter: str, values: tuple[int, ...], raw: bytes) -> dict[str, Any]:
+        """A record's values in the user's units (each field's value over its scale)."""
+        layout = self.layout
+        if letter == "C":
+            scales = [(p.name, p.scale) for p in layout.params]
+        else:
+            fields = layout.a_fields if letter == "A" else layout.b_fields
+            scales = [(f.name, f.scale) for f in fields]
+        body: dict[str, Any] = {
+            name: value if scale == 1 else value / scale
+            for (name, scale), value in zip(scales, values, strict=False)
+        }
+        body["raw"] = raw.decode("latin-1")
+        return body
+
+    def _pose(self, time: float, values: tuple[int, ...]) -> Pose2D:
+        by_name = {f.name: v / f.scale for f, v in zip(self.layout.a_fields, values, strict=False)}
+        return self.odometry.step(time, by_name["x"], by_name["y"], by_name["z"])
+
+
+def _stamp(time: float) -> dict[str, int]:
+    ns = round(time * 1e9)
+    return {"sec": ns // 10**9, "nsec": ns % 10**9}
+
+
+def _yaw(yaw: float) -> dict[str, float]:
+    return {"x": 0.0, "y": 0.0, "z": math.sin(yaw / 2), "w": math.cos(yaw / 2)}
+
+
+def pose_message(pose: Pose2D, time: float) -> dict[str, Any]:
+    return {
+        "timestamp": _stamp(time),
+        "frame_id": POSE_FRAME,
+        "pose": {"position": {"x": pose.x, "y": pose.y, "z": 0.0}, "orientation": _yaw(pose.yaw)},
+    }
+
+
+def transform(pose: Pose2D, time: float) -> dict[str, Any]:
+    return {
+        "timestamp": _stamp(time),
+        "parent_frame_id": POSE_FRAME,
+        "child_frame_id": BASE_FRAME,
+        "translation": {"x": pose.x, "y": pose.y, "z": 0.0},
+        "rotation": _yaw(pose.yaw),
+    }
+
+
+class Viewer(Protocol):
+    """A live view of a session: fed its bytes as a tap and what it says, never waiting
+    (it queues, bounded, and drops what does not fit)."""
+
+    epoch: float
+    watched: threading.Event
+    """Set once someone watches (a replay to a viewer alone waits for it)."""
+
+    def __call__(self, direction: str, time: float, data: bytes) -> None: ...
+
+    def note(self, text: str) -> None: ...

@@ -1,0 +1,179 @@
+"""MCAP recordings (issue 68.2, 68.3, 68.5): `.mcap` chooses the format of every
+recording; dump, replay, conform and plot read it as a transcript; `appmode convert` is
+lossless both ways over the shipped suite; a corrupt, cut or foreign file is one line
+and a non-zero exit."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("mcap", reason="the foxglove extra (mcap) is not installed")
+
+from mcap.reader import make_reader
+from mcap.writer import CompressionType, Writer
+
+from appmode.protocol.transcript import TranscriptError
+from appmode.transcript.convert import run_convert
+from appmode.transcript.dump import run_dump
+from appmode.transcript.reading import iter_lines, read_transcript
+from appmode.transcript.runner import SUITE
+from tests.support.processes import run
+
+SUITE_FILES = sorted(SUITE.rglob("*.transcript"))
+EXAMPLES = sorted((SUITE.parent / "examples").rglob("*.transcript"))
+
+
+def dumped(path: Path) -> str:
+    out = io.StringIO()
+    run_dump(str(path), "json", out)
+    return out.getvalue()
+
+
+def lines_of(path: Path) -> list[object]:
+    return list(iter_lines(path, lambda text: None))
+
+
+@pytest.mark.parametrize("source", SUITE_FILES + EXAMPLES, ids=lambda p: p.name)
+def test_convert_is_lossless_both_ways(source: Path, tmp_path: Path) -> None:
+    mcap, back, again = tmp_path / "a.mcap", tmp_path / "b.transcript", tmp_path / "c.mcap"
+    run_convert(str(source), str(mcap), None, False)
+    run_convert(str(mcap), str(back), None, False)
+    run_convert(str(back), str(again), None, False)
+    assert dumped(mcap) == dumped(source) == dumped(back)
+    # every line comes back as it was, at its line number: comments and directives too
+    assert lines_of(mcap) == lines_of(source) == lines_of(back)
+    assert again.read_bytes() == mcap.read_bytes()
+
+
+def test_a_recording_named_mcap_is_mcap_with_decoded_channels(tmp_path: Path) -> None:
+    path = tmp_path / "drive.mcap"
+    done = run("drive", "sim://", "--record", str(path), stdin=b"drive A\nwait 0.6\nstop\n")
+    assert done.returncode == 0, done.stderr
+    with path.open("rb") as handle:
+        reader = make_reader(handle)
+        summary = reader.get_summary()
+        assert summary is not None and reader.get_header().profile == "appmode"
+        topics = {c.topic for c in summary.channels.values()}
+        assert {"/raw/app/sent", "/raw/app/received", "/app/A", "/pose", "/tf"} <= topics
+        schema = next(json.loads(s.data) for s in summary.schemas.values() if s.name == "appmode.A")
+        assert {"x", "y", "z"} <= set(schema["properties"])
+        sent = [m.data for _, c, m in reader.iter_messages(topics=["/raw/app/sent"])]
+        poses = [json.loads(m.data) for _, _, m in reader.iter_messages(topics=["/pose"])]
+    assert b"A" in sent and sent[-1] == b"Z"
+    assert poses[-1]["frame_id"] == "odom" and poses[-1]["pose"]["position"]["x"] > 0.1
+    # the raw channels are the transcript: dump reads them as it reads text
+    text = read_transcript(path)
+    assert [e.data for e in text.entries if e.direction == ">"] == sent
+
+
+def test_record_and_replay_read_mcap(tmp_path: Path) -> None:
+    path = tmp_path / "rec.mcap"
+    done = run("record", "sim://", str(path), "--count", "5")
+    assert done.returncode == 0, done.stderr
+    assert len(read_transcript(path).entries) >= 5
+    shown = run("dump", str(path))
+    assert shown.returncode == 0 and "velocity" in shown.stdout
+
+
+def test_conform_runs_an_mcap_file(tmp_path: Path) -> None:
+    source = SUITE / "s2_1_unrecognised_bytes_stop.transcript"
+    mcap = tmp_path / f"{source.stem}.mcap"
+    run_convert(str(source), str(mcap), None, False)
+    done = run("conform", str(mcap))
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1 passed" in done.stdout + done.stderr
+
+
+@pytest.fixture
+def recording(tmp_path: Path) -> Path:
+    path = tmp_path / "whole.mcap"
+    run_convert(str(SUITE / "s5_set_each_param.transcript"), str(path), None, False)
+    return path
+
+
+def one_line_error(*args: str) -> str:
+    done = run(*args)
+    assert done.returncode != 0
+    assert "Traceback" not in done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    return line
+
+
+def test_a_corrupt_mcap_is_one_line(recording: Path, tmp_path: Path) -> None:
+    data = bytearray(recording.read_bytes())
+    bad = tmp_path / "bad.mcap"
+    for offset in (9, 40, len(data) // 2, len(data) - 30):
+        flipped = bytearray(data)
+        flipped[offset] ^= 0xFF
+        bad.write_bytes(bytes(flipped))
+        line = one_line_error("dump", str(bad))
+        assert line.startswith(f"appmode: error: {bad}"), line
+
+
+def test_a_cut_mcap_says_so_and_partial_keeps_what_it_holds(
+    recording: Path, tmp_path: Path
+) -> None:
+    cut = tmp_path / "cut.mcap"
+    whole = recording.read_bytes()
+    cut.write_bytes(whole[: len(whole) * 2 // 3])
+    line = one_line_error("dump", str(cut))
+    assert "cut short" in line and "--partial" in line
+    out = tmp_path / "kept.transcript"
+    done = run("convert", "--partial", str(cut), str(out))
+    assert done.returncode == 0, done.stderr
+    assert "cut short" in done.stderr
+    kept = read_transcript(out).entries
+    assert 0 < len(kept) < len(read_transcript(recording).entries)
+
+
+def test_a_foreign_mcap_is_named_as_such(tmp_path: Path) -> None:
+    path = tmp_path / "ros.mcap"
+    with path.open("wb") as handle:
+        writer = Writer(handle)
+        writer.start(profile="ros2", library="test")
+        writer.finish()
+    line = one_line_error("dump", str(path))
+    assert "profile 'ros2'" in line and "not an appmode recording" in line
+
+
+def test_chunks_from_other_writers_are_read_and_bounded(tmp_path: Path) -> None:
+    """A file another MCAP writer made from ours (chunked, compressed) reads the same; a
+    record that claims more than the reader's bound is refused, not allocated."""
+    source = SUITE_FILES[0]
+    ours = tmp_path / "ours.mcap"
+    run_convert(str(source), str(ours), None, False)
+    chunked = tmp_path / "chunked.mcap"
+    with ours.open("rb") as handle, chunked.open("wb") as out:
+        reader = make_reader(handle)
+        writer = Writer(out, compression=CompressionType.ZSTD, chunk_size=512)
+        writer.start(profile="appmode", library="rewritten")
+        ids: dict[int, int] = {}
+        for _, channel, message in reader.iter_messages(log_time_order=False):
+            if channel.id not in ids:
+                ids[channel.id] = writer.register_channel(
+                    channel.topic, channel.message_encoding, 0, channel.metadata
+                )
+            writer.add_message(
+                ids[channel.id],
+                message.log_time,
+                message.data,
+                message.publish_time,
+                message.sequence,
+            )
+        writer.finish()
+    assert lines_of(chunked) == lines_of(source)
+    huge = tmp_path / "huge.mcap"
+    huge.write_bytes(b"\x89MCAP0\r\n" + b"\x01" + (2**40).to_bytes(8, "little") + b"x" * 64)
+    with pytest.raises(TranscriptError, match="not a readable MCAP file"):
+        list(iter_lines(huge, lambda text: None))
+
+
+def test_convert_refuses_to_write_over_its_input(recording: Path) -> None:
+    before = recording.read_bytes()
+    line = one_line_error("convert", str(recording), str(recording))
+    assert "is the file being read" in line
+    assert recording.read_bytes() == before
