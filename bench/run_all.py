@@ -33,6 +33,7 @@ from bench import (
     replay_timing,
     ros,
     startup,
+    viewers,
 )
 from bench.board_load import (
     bench_board_cpu,
@@ -251,6 +252,7 @@ def main() -> None:
         ("bluetooth", lambda: ble_link.rows(quick)),
         ("network", lambda: network.bench_network(quick)),
         ("ros", lambda: ros.rows(quick)),
+        ("viewers", lambda: viewers.rows(quick)),
     ]
     if args.only:
         unknown = set(args.only) - {name for name, _ in plan}

@@ -19,6 +19,7 @@ LAYERS = (
     "net",
     "transcript",
     "session",
+    "viewers",
     "ros",
     "console",
     "web",

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import time
 from functools import partial
 from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
+from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import Subparsers, add_profile, add_record, file_name, number_type
 from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES
@@ -67,6 +69,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "port, 115200 on UART2)",
     )
     add_record(board)
+    add_foxglove(board, "the board's own view (what both its ports carry)")
     board.add_argument(
         "--quiet", "-q", action="store_true", help="do not log what the board receives"
     )
@@ -148,12 +151,13 @@ def run(args: argparse.Namespace) -> int:
         args.record,
         args.listen2,
         args.port2,
+        args.foxglove,
     )
     if args.count > 1 and any(option is not None for option in alone):
         raise AppmodeError(
             "--count serves several boards on ptys: it cannot be combined "
             "with --listen, --port, --bluetooth, --advertise, --listen2, --port2, --link, "
-            "--flash or --record"
+            "--flash, --record or --foxglove"
         )
     if args.nus and args.advertise is None:
         raise AppmodeError("--nus is an option of --advertise: add --advertise [NAME]")
@@ -169,7 +173,10 @@ def run(args: argparse.Namespace) -> int:
         quiet=args.quiet,
         baud=args.baud,
     )
-    return run_board(options)
+    with live_view(args.foxglove, options.profile.a_layout) as view:
+        if view is not None:
+            view.epoch = time.time()  # the board's clock starts now
+        return run_board(options, view)
 
 
 def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:

@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
+from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -104,6 +105,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
         default=None,
     )
     add_record(parser)
+    add_foxglove(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -117,9 +119,12 @@ def run(args: argparse.Namespace) -> int:
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
     on_message = None if interactive else _print_message
-    session = open_session(choice, driving, on_message, args.record)
-    script = command_lines(sys.stdin, MAX_COMMAND)
-    return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
+    with live_view(args.foxglove, choice.profile.a_layout) as view:
+        session = open_session(choice, driving, on_message, args.record)
+        if view is not None:
+            session.add_viewer(view)
+        script = command_lines(sys.stdin, MAX_COMMAND)
+        return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
 
 
 def _print_message(text: str) -> None:

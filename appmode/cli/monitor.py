@@ -8,6 +8,7 @@ from contextlib import ExitStack
 from typing import TYPE_CHECKING, TextIO
 
 from appmode.cli.commands import COMMANDS
+from appmode.cli.live_view import add_foxglove
 from appmode.cli.options import (
     DAY,
     ON_A_BOARD,
@@ -47,6 +48,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     add_uart2(mon, "print the replies and encoder reports of the board's control port")
     add_record(mon)
+    add_foxglove(mon, "the records")
     return mon
 
 
@@ -87,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
             record=args.record,
             out=sys.stdout,
             stop_on_exit=args.stop_on_exit,
+            foxglove=args.foxglove,
         )
     return run_monitor(
         choice,
@@ -97,6 +100,7 @@ def run(args: argparse.Namespace) -> int:
         stop_on_exit=args.stop_on_exit,
         kinds=args.filter,
         out=sys.stdout,
+        foxglove=args.foxglove,
     )
 
 
@@ -111,14 +115,17 @@ def run_monitor(
     stop_on_exit: bool = False,
     kinds: frozenset[str] | None = None,
     name: str = "monitor",
+    foxglove: str | None = None,
 ) -> int:
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none
     (`appmode record`)."""
     from appmode.cli.hostio import open_host, show, until_count
+    from appmode.cli.live_view import live_view
 
     with ExitStack() as stack:
-        host = open_host(stack, choice, record, stop_on_close=stop_on_exit)
+        view = stack.enter_context(live_view(foxglove, choice.profile.a_layout))
+        host = open_host(stack, choice, record, stop_on_close=stop_on_exit, view=view)
         url = choice.target
         doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"
         sys.stderr.write(f"{doing} (Ctrl-C to stop)\n")  # one write: the FIFO's note is another

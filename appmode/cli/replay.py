@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from appmode.cli.commands import COMMANDS
+from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import DAY, Subparsers, file_name, number_type
 from appmode.errors import AppmodeError
 
@@ -15,12 +16,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help=COMMANDS["replay"],
         description="Play the host's lines ('>', driving a board) or the board's lines ('<', "
         "feeding an app) to a port, each at its time from the start. As the host the replay "
-        "ends with Z.",
+        "ends with Z. With --foxglove and no --to, both sides are played to the viewer.",
     )
     replay.add_argument("file", type=file_name, metavar="FILE", help="the transcript")
     replay.add_argument(
         "--to",
-        required=True,
         metavar="URL",
         help="where to play it; with --side board, 'pty' makes a new pseudo-terminal for an "
         "app to open (its path is printed; the replay starts when the app sends something)",
@@ -61,10 +61,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     replay.add_argument(
         "-v", "--verbose", action="store_true", help="print each line as it is played"
     )
+    add_foxglove(replay, "the transcript")
     return replay
 
 
 def run(args: argparse.Namespace) -> int:
+    from appmode.transcript.dump import needs_of
     from appmode.transcript.replay import run_replay
 
     if args.side == "host" and args.to == "pty":
@@ -72,13 +74,18 @@ def run(args: argparse.Namespace) -> int:
             "replay --to pty plays the board's side to an app: add --side board (to drive "
             "a board on a pty, serve it with appmode board and replay to its port)"
         )
-    return run_replay(
-        args.file,
-        args.to,
-        args.side,
-        args.speed,
-        args.loop,
-        gap=args.gap,
-        skip=args.skip,
-        verbose=args.verbose,
-    )
+    if args.to is None and args.foxglove is None:
+        raise AppmodeError("replay needs --to URL (a port to play to), --foxglove PORT, or both")
+    layout = needs_of(args.file, lambda text: None).profile.a_layout
+    with live_view(args.foxglove, layout) as view:
+        return run_replay(
+            args.file,
+            args.to,
+            args.side,
+            args.speed,
+            args.loop,
+            gap=args.gap,
+            skip=args.skip,
+            verbose=args.verbose,
+            view=view,
+        )

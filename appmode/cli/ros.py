@@ -7,9 +7,11 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from contextlib import ExitStack
 from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
+from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import HOLDS, Subparsers, add_profile, add_uart2, target
 from appmode.errors import AppmodeError
 
@@ -83,6 +85,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="stop the car after this long without a cmd_vel (default 0.5)",
     )
     add_profile(ros, f"the car's profile, {HOLDS}", default=None)
+    add_foxglove(ros, "the car")
     return ros
 
 
@@ -125,6 +128,7 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
     config_file = os.environ.get("ZENOH_SESSION_CONFIG_URI") or None
     router = open_session("router", None, listen=connect) if args.router else None
     zenoh = None
+    stack = ExitStack()  # the live view, stopped after the car's stop
     try:
         zenoh = open_session("peer", None, (LISTEN,), connect, config_file=config_file)
         if not list(zenoh.info.routers_zid()):
@@ -135,8 +139,11 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
         url, url2 = _ports(args)
         choice = choose(url, url2, uart2=args.uart2 and url2 is None, profile=args.profile)
         timeout = args.cmd_vel_timeout
+        view = stack.enter_context(live_view(args.foxglove, choice.profile.a_layout))
         session = open_car(choice, HoldToDrive(first_timeout=timeout, repeat_timeout=timeout))
         session.lease, session.lease_source = timeout, "cmd_vel"
+        if view is not None:
+            session.add_viewer(view)
         graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
         ros = RosNode(session, zenoh, graph, Options(args.stamped, timeout), _log)
         ended = [False]
@@ -156,6 +163,7 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
                 print(f"appmode: {session.undelivered}", file=sys.stderr)
         return 1 if session.left_moving else 0
     finally:
+        stack.close()
         if zenoh is not None:
             close_session(zenoh)
         if router is not None:

@@ -10,6 +10,7 @@ from contextlib import ExitStack
 from typing import TYPE_CHECKING, TextIO
 
 from appmode.cli.hostio import until_count, with_recording
+from appmode.cli.live_view import live_view
 from appmode.host.control.client import ControlHost, Event
 from appmode.host.control.state import PortMode
 from appmode.host.control.tokens import Step, parse_setting, parse_token, perform
@@ -22,6 +23,7 @@ from appmode.text import counted, wrapped
 
 if TYPE_CHECKING:
     from appmode.ports.choice import BoardChoice
+    from appmode.protocol.channels import Viewer
 
 QUIET_UART2 = (
     "a board sends replies only to reads, and encoder reports only while system_mode "
@@ -36,14 +38,18 @@ TAKEOVER = (
 
 
 def open_control_host(
-    stack: ExitStack, choice: BoardChoice, record: str | None, stop_on_close: bool = True
+    stack: ExitStack,
+    choice: BoardChoice,
+    record: str | None,
+    stop_on_close: bool = True,
+    view: Viewer | None = None,
 ) -> ControlHost:
     """The control-port host of the board chosen, then its recording
     (hostio.with_recording)."""
     host = ControlHost(
         choice.target, stop_on_close=stop_on_close, profile=choice.profile, drive=choice.drive
     )
-    return with_recording(stack, host, record)
+    return with_recording(stack, host, record, view)
 
 
 def show(
@@ -176,11 +182,14 @@ def run_monitor(
     record: str | None,
     out: TextIO,
     stop_on_exit: bool = False,
+    foxglove: str | None = None,
 ) -> int:
-    """Print replies and encoder reports as they arrive; passive unless `stop_on_exit`."""
+    """Print replies and encoder reports as they arrive; passive unless `stop_on_exit`;
+    live to Foxglove on `foxglove` ([HOST:]PORT)."""
     seen = errors = bursts = 0
     with ExitStack() as stack:
-        host = open_control_host(stack, choice, record, stop_on_exit)
+        view = stack.enter_context(live_view(foxglove, choice.profile.a_layout))
+        host = open_control_host(stack, choice, record, stop_on_exit, view)
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         host.watch = lambda direction, event: show(host, direction, event, out, as_json)
         try:

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
+from appmode.cli.live_view import live_view
 from appmode.cli.options import Subparsers, target
 from appmode.errors import AppmodeError
 
@@ -92,8 +93,12 @@ def run(args: argparse.Namespace) -> int:
         return _serve_fleet(args, host, port, tls, tuple(addresses), fingerprint)
     if args.connect or args.fleet_key is not None:
         raise AppmodeError("--connect and --fleet-key go with --fleet")
-    session = open_session(board_choice(args), driving(), record=args.record)
-    return serve_web(session, host, port, tls, tuple(addresses), fingerprint)
+    choice = board_choice(args)
+    with live_view(args.foxglove, choice.profile.a_layout) as view:
+        session = open_session(choice, driving(), record=args.record)
+        if view is not None:
+            session.add_viewer(view)
+        return serve_web(session, host, port, tls, tuple(addresses), fingerprint)
 
 
 def _serve_fleet(

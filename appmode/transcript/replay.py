@@ -14,6 +14,7 @@ like every host session.
 
 from __future__ import annotations
 
+import itertools
 import os
 import sys
 import time
@@ -32,6 +33,7 @@ from appmode.transcript.reading import read_transcript
 
 if TYPE_CHECKING:
     from appmode.ports.newpty import PtyPort
+    from appmode.protocol.channels import Viewer
 
 Item = tuple[float, bytes]
 EARLY = 0.0005
@@ -98,7 +100,7 @@ def play(
 
 def run_replay(
     path: str,
-    url: str,
+    url: str | None,
     side: str,
     speed: float,
     loops: int,
@@ -106,13 +108,19 @@ def run_replay(
     gap: float = 0.0,
     skip: float | None = None,
     verbose: bool = False,
+    view: Viewer | None = None,
 ) -> int:
     """Play one side (`host` or `board`) of the transcript at `path` to `url` (`pty`: a new
-    pseudo-terminal, for an app to open), `loops` times at `speed`× its pace."""
+    pseudo-terminal, for an app to open), `loops` times at `speed`× its pace; with a live
+    `view`, what is played is shown there too (both sides when `url` is None)."""
     transcript = read_transcript(path)
     for warning in transcript.warnings:
         print(f"appmode: WARNING: {warning}", file=sys.stderr)
     entries = [(e.time, e.direction, e.data) for e in transcript.entries]
+    if url is None:
+        if view is None:
+            raise AppmodeError("replay: nowhere to play to: give --to URL or --foxglove PORT")
+        return _to_view(path, entries, view, speed, loops, gap, skip)
     items = retime(plan(entries, side), gap, skip)
     mark = ">" if side == "host" else "<"
     if not items:
@@ -121,7 +129,10 @@ def run_replay(
     started = time.monotonic()
 
     def shown(write: Callable[[bytes], object]) -> Callable[[bytes], object]:
-        """`write`, printing each unit as it goes (-v)."""
+        """`write`, printing each unit as it goes (-v), and showing it in the live view."""
+        if view is not None:
+            view.epoch = time.time()
+            write = _also_shown(write, view, mark, started)
         if not verbose:
             return write
         decoder = HostDecoder() if side == "host" else BoardDecoder()
@@ -164,6 +175,56 @@ def run_replay(
     print(
         f"replayed {len(late)} {'commands' if side == 'host' else 'records'} from {path} "
         f"as the {side} to {url}; latest send {worst:.2f} ms after its time",
+        file=sys.stderr,
+    )
+    return 0
+
+
+def _also_shown(
+    write: Callable[[bytes], object], view: Viewer, direction: str, started: float
+) -> Callable[[bytes], object]:
+    def write_and_show(data: bytes) -> None:
+        write(data)
+        view(direction, time.monotonic() - started, data)
+
+    return write_and_show
+
+
+def _to_view(
+    path: str,
+    entries: list[tuple[float, str, bytes]],
+    view: Viewer,
+    speed: float,
+    loops: int,
+    gap: float,
+    skip: float | None,
+) -> int:
+    """Both sides of a transcript played to a live view in real time."""
+    ordered = sorted(entries, key=lambda e: e[0])
+    items = retime([(t, data) for t, _, data in ordered], gap, skip)
+    if not items:
+        raise AppmodeError(f"{path} has no lines to play")
+    directions = itertools.cycle([d for _, d, _ in ordered])
+    show = _progress(path) if sys.stderr.isatty() else None
+    print(
+        "replay: waiting for a viewer to subscribe (Ctrl-C gives up)", file=sys.stderr, flush=True
+    )
+    while not view.watched.wait(0.2):  # a short wait: Ctrl-C ends it
+        pass
+    view.epoch = time.time()
+    started = time.monotonic()
+    late = play(
+        items,
+        lambda data: view(next(directions), time.monotonic() - started, data),
+        speed=speed,
+        loops=loops,
+        progress=show,
+    )
+    if show is not None:
+        print(file=sys.stderr)
+    print(
+        f"replayed {len(late)} lines from {path} to the live view; latest "
+        f"{max(late) * 1000:.2f} ms after its time",
         file=sys.stderr,
     )
     return 0

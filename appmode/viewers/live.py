@@ -1,0 +1,217 @@
+"""A live Foxglove server for a session, a board or a replay (`--foxglove [HOST:]PORT`),
+through the official foxglove-sdk (the `foxglove` extra).
+
+Nothing here may slow the car's stop: the caller only appends to a bounded queue
+(`QUEUE` items; what does not fit is dropped and counted), and a worker thread decodes
+the bytes (`PortsReader`) into the channels of `protocol.channels` and logs them. The
+SDK keeps each viewer's backlog bounded too (`BACKLOG` messages; the oldest dropped for
+a viewer that does not read), so a viewer that connects and never reads costs nothing
+but its own messages."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import queue
+import threading
+import time
+from typing import Any
+
+from appmode.errors import AppmodeError
+from appmode.protocol.channels import channels
+from appmode.protocol.escaping import escape
+from appmode.protocol.layouts import VELOCITY, Layout
+from appmode.protocol.reader import PortsReader
+from appmode.protocol.render import describe
+
+QUEUE = 4096
+"""Units and notes waiting for the worker at most (seconds of a flood: they are small)."""
+BACKLOG = 1024
+"""Messages the SDK keeps for each viewer at most (the oldest are dropped)."""
+RAW = {
+    ">": "/raw/app/sent",
+    "<": "/raw/app/received",
+    "2>": "/raw/uart2/sent",
+    "2<": "/raw/uart2/received",
+}
+BYTES_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "text": {"type": "string", "description": "the bytes as transcripts show them"},
+        "hex": {"type": "string"},
+        "length": {"type": "integer"},
+    },
+}
+IN_FORCE = "/session/in_force"
+LOG = "/log"
+IN_FORCE_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "command": {"type": "string", "description": "the letter or frame in force"},
+        "text": {"type": "string"},
+        "moving": {"type": "boolean"},
+    },
+}
+
+
+class LiveView:
+    """A Foxglove WebSocket server on `host`:`port` (0: a free port), fed as a tap:
+    `view(direction, time, data)` with a session's times (seconds from its start),
+    `view.note(text)` for what the session says."""
+
+    def __init__(
+        self, host: str, port: int, layout: Layout = VELOCITY, name: str = "appmode"
+    ) -> None:
+        try:
+            import foxglove
+        except ImportError:
+            raise AppmodeError(
+                "--foxglove needs the foxglove SDK: pip install 'appmode[foxglove]'"
+            ) from None
+        self._foxglove = foxglove
+        self._context = foxglove.Context()
+        self.watched = threading.Event()
+        """Set when a viewer first subscribes to a channel."""
+        try:
+            self._server = foxglove.start_server(
+                name=name,
+                host=host,
+                port=port,
+                context=self._context,
+                message_backlog_size=BACKLOG,
+                server_listener=_listener(self.watched),
+            )
+        except Exception as exc:  # the SDK raises its own errors: a port in use, say
+            raise AppmodeError(
+                f"--foxglove {host}:{port}: cannot serve there ({exc}): pick another port "
+                "(0 picks a free one)"
+            ) from None
+        self.host = host
+        self.port = int(self._server.port)
+        self.epoch = time.time()
+        """The wall-clock time of the session's time 0 (set by whoever feeds it)."""
+        self.dropped = 0
+        """Units and notes the queue had no room for."""
+        self._channels: dict[str, Any] = {}
+        for spec in channels(layout).values():
+            self._channel(spec.topic, spec.schema_name, spec.schema)
+        for topic in RAW.values():
+            self._channel(topic, "appmode.bytes", BYTES_SCHEMA)
+        self._channel(IN_FORCE, "appmode.in_force", IN_FORCE_SCHEMA)
+        self._log = foxglove.channels.LogChannel(LOG, context=self._context)
+        self._layout = layout
+        self._queue: queue.Queue[tuple[Any, ...] | None] = queue.Queue(QUEUE)
+        self._thread = threading.Thread(target=self._run, name="foxglove", daemon=True)
+        self._thread.start()
+
+    @property
+    def url(self) -> str:
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"ws://{host}:{self.port}"
+
+    def _channel(self, topic: str, schema_name: str, schema: dict[str, Any]) -> None:
+        fox = self._foxglove
+        described = fox.Schema(
+            name=schema_name, encoding="jsonschema", data=json.dumps(schema).encode()
+        )
+        self._channels[topic] = fox.Channel(
+            topic, schema=described, message_encoding="json", context=self._context
+        )
+
+    # ------------------------------------------------------------ the caller's side
+
+    def __call__(self, direction: str, time: float, data: bytes) -> None:
+        self._put(("bytes", direction, time, data))
+
+    def note(self, text: str) -> None:
+        self._put(("note", time.time(), text))
+
+    def _put(self, item: tuple[Any, ...]) -> None:
+        try:
+            self._queue.put_nowait(item)
+        except queue.Full:
+            self.dropped += 1
+
+    def close(self, wait: float = 1.0) -> None:
+        """Log what is queued (at most `wait` seconds), then stop the server."""
+        with contextlib.suppress(queue.Full):
+            self._queue.put(None, timeout=wait)
+        self._thread.join(wait)
+        self._server.stop()
+
+    # ------------------------------------------------------------ the worker's side
+
+    def _run(self) -> None:
+        from appmode.protocol.channels import Decoded
+
+        reader = PortsReader(layout=self._layout)
+        decoded = Decoded(self._layout)
+        while (item := self._queue.get()) is not None:
+            if item[0] == "note":
+                self._note(item[1], item[2])
+                continue
+            _, direction, at, data = item
+            for shown, event in reader.feed(direction, data):
+                self._unit(self.epoch + at, shown, event)
+                for topic, body in decoded.unit(self.epoch + at, shown, event):
+                    self._channels[topic].log(body, log_time=_ns(self.epoch + at))
+
+    def _unit(self, when: float, direction: str, event: Any) -> None:
+        """A unit's bytes, its line in the log; a command that sets motion or stops it
+        on /session/in_force."""
+        ns, raw = _ns(when), event.raw
+        self._channels[RAW[direction]].log(
+            {"text": escape(raw), "hex": raw.hex(" "), "length": len(raw)}, log_time=ns
+        )
+        text = describe(event, self._layout)
+        self._note(when, f"{direction} {escape(raw)}  {text}", level="Debug")
+        moves = _moves(event) if direction in (">", "2>") else None
+        if moves is not None:
+            self._channels[IN_FORCE].log(
+                {"command": escape(raw), "text": text, "moving": moves}, log_time=ns
+            )
+
+    def _note(self, when: float, text: str, level: str = "Info") -> None:
+        fox = self._foxglove
+        ns = _ns(when)
+        self._log.log(
+            fox.messages.Log(
+                timestamp=fox.messages.Timestamp(sec=ns // 10**9, nsec=ns % 10**9),
+                level=getattr(fox.messages.LogLevel, level),
+                message=text,
+                name="appmode",
+                file="",
+                line=0,
+            ),
+            log_time=ns,
+        )
+
+
+def _listener(watched: threading.Event) -> Any:
+    """The server's listener: sets `watched` when a viewer subscribes."""
+    from foxglove.websocket import ServerListener
+
+    class Watched(ServerListener):
+        def on_subscribe(self, client: Any, channel: Any) -> None:
+            watched.set()
+
+    return Watched()
+
+
+def _ns(when: float) -> int:
+    return round(when * 1e9)
+
+
+def _moves(event: Any) -> bool | None:
+    """Whether a command sets the car moving (True), stops it (False), or neither."""
+    from appmode.protocol import app, control
+
+    if isinstance(event, app.Move):
+        return event.direction != 0
+    if isinstance(event, app.Stop):
+        return False
+    if isinstance(event, control.VelocityFrame | control.MotorFrame):
+        return any(event.values) and not (isinstance(event, control.VelocityFrame) and event.angle)
+    if isinstance(event, control.PositionFrame):
+        return any((event.x, event.y, event.z))
+    return None
