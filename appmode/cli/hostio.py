@@ -15,7 +15,7 @@ from appmode.host.app.query import QueryDone
 from appmode.host.control.client import ControlHost
 from appmode.host.events import BoardWarning, LinkStatus
 from appmode.host.outcomes import QueryFailed
-from appmode.line.wire import Tap
+from appmode.line.wire import every
 from appmode.ports.recording import open_recorder
 from appmode.protocol.render import describe, line, to_json
 
@@ -61,20 +61,12 @@ def with_recording(stack: ExitStack, host: H, record: str | None, view: Viewer |
         raise
     if recorder is not None:
         stack.enter_context(closing(recorder))
-    taps: list[Tap] = [t for t in (view, recorder) if t is not None]
     if view is not None:
         view.epoch = time.time() - host.now()
-    if taps:
-        host.tap = taps[0] if len(taps) == 1 else _every(taps)
+    tap = every(view, recorder)
+    if tap is not None:
+        host.tap = tap
     return stack.enter_context(host)
-
-
-def _every(taps: list[Tap]) -> Tap:
-    def tap(direction: str, at: float, data: bytes) -> None:
-        for one in taps:
-            one(direction, at, data)
-
-    return tap
 
 
 def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:

@@ -21,6 +21,21 @@ if TYPE_CHECKING:  # a host that names the ports imports no board
     from appmode.board.firmware import Board
 
 Tap = Callable[[str, float, bytes], None]
+
+
+def every(*taps: Tap | None) -> Tap | None:
+    """One tap that feeds each of `taps` in turn (those not None); None if none is."""
+    given = [tap for tap in taps if tap is not None]
+    if len(given) <= 1:
+        return given[0] if given else None
+
+    def tap(direction: str, at: float, data: bytes) -> None:
+        for one in given:
+            one(direction, at, data)
+
+    return tap
+
+
 APP, UART2 = "app", "uart2"
 PORTS = (APP, UART2)
 APP_BAUD = 9600

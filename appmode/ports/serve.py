@@ -26,7 +26,7 @@ from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import Faults, FaultSpec
-from appmode.line.wire import APP, UART2, UART2_BAUD, Tap, Wire
+from appmode.line.wire import APP, UART2, UART2_BAUD, Tap, Wire, every
 from appmode.ports.endpoints import Endpoint, Log, MakeEndpoint
 from appmode.ports.recording import open_recorder
 from appmode.ports.schedule import INPUT_BACKLOG, Served
@@ -123,7 +123,7 @@ class BoardServer:
             wire = Wire(
                 board,
                 bauds[APP] if pace else None,
-                _every(self._recorder, view),
+                every(view, self._recorder),
                 bauds.get(UART2, UART2_BAUD) if pace else None,
             )
             one = Served(
@@ -333,18 +333,6 @@ class ServeOptions:
         needs = [f"profile={self.profile.name}"] if self.profile is not SHEET else []
         needs += [f"drive={self.drive.cli_name}"] if self.drive else []
         return (f"board {' '.join(needs)}",) if needs else ()
-
-
-def _every(recorder: Recorder | None, view: Tap | None) -> Tap | None:
-    """The board's tap: its recording and its live view, either, or none."""
-    if recorder is None or view is None:
-        return recorder or view
-
-    def tap(direction: str, at: float, data: bytes) -> None:
-        view(direction, at, data)
-        recorder(direction, at, data)
-
-    return tap
 
 
 def run_board(options: ServeOptions, view: Tap | None = None) -> int:

@@ -23,6 +23,13 @@ POSE_FRAME = "odom"
 """The frame the dead-reckoned pose is in (its origin: where the session began)."""
 BASE_FRAME = "base_link"
 OBJECT: dict[str, Any] = {"type": "object"}
+RAW = {
+    ">": "/raw/app/sent",
+    "<": "/raw/app/received",
+    "2>": "/raw/uart2/sent",
+    "2<": "/raw/uart2/received",
+}
+"""Each direction's raw channel: a message a unit, its bytes as they went."""
 
 
 @dataclass(frozen=True, slots=True)

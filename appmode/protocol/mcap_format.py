@@ -25,7 +25,7 @@ from mcap.records import Channel, Chunk, DataEnd, Footer, Header, Message
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
-from appmode.protocol.channels import Decoded, channels
+from appmode.protocol.channels import RAW, Decoded, channels
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.transcript import (
@@ -45,12 +45,6 @@ from appmode.protocol.transcript import (
 SUFFIX = ".mcap"
 PROFILE = "appmode"
 """The MCAP header's profile: a file of appmode's (a transcript and its views)."""
-RAW = {
-    ">": "/raw/app/sent",
-    "<": "/raw/app/received",
-    "2>": "/raw/uart2/sent",
-    "2<": "/raw/uart2/received",
-}
 AS_TEXT = "/as_text"
 PATTERN = "/pattern"
 COMMENTS = "/transcript/comments"

@@ -18,7 +18,7 @@ import time
 from typing import Any
 
 from appmode.errors import AppmodeError
-from appmode.protocol.channels import channels
+from appmode.protocol.channels import RAW, channels
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.reader import PortsReader
@@ -28,12 +28,6 @@ QUEUE = 4096
 """Units and notes waiting for the worker at most (seconds of a flood: they are small)."""
 BACKLOG = 1024
 """Messages the SDK keeps for each viewer at most (the oldest are dropped)."""
-RAW = {
-    ">": "/raw/app/sent",
-    "<": "/raw/app/received",
-    "2>": "/raw/uart2/sent",
-    "2<": "/raw/uart2/received",
-}
 BYTES_SCHEMA = {
     "type": "object",
     "properties": {
