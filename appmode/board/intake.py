@@ -105,12 +105,15 @@ class FirmwareIntake:
 
 
 class ControlIntake:
-    """UART2 as the reference loop reads it (§13.1): `FF FE` looked for only between
-    frames, then the next 8 bytes are a frame whatever they hold. `feed` returns the
-    frames completed, header included; `receiving` says whether one is under way."""
+    """UART2 as the reference loop reads it (§13.1, §13.3): every byte received, a
+    frame's own included, goes through the header detector; when no frame is being
+    collected, the byte after the last two received `FF FE` starts one, and it and the
+    next 7 are the frame whatever they hold. `feed` returns the frames completed, header
+    included; `receiving` says whether one is under way (its first byte came)."""
 
     def __init__(self) -> None:
         self._frame = bytearray()
+        self._last = (-1, -1)  # the last two bytes received, in order
 
     @property
     def receiving(self) -> bool:
@@ -118,15 +121,15 @@ class ControlIntake:
 
     def feed(self, data: bytes) -> list[bytes]:
         out: list[bytes] = []
-        frame = self._frame
+        frame, size = self._frame, control.FRAME - len(control.HEADER)
+        first, second = control.HEADER
+        before, last = self._last
         for byte in data:
-            if len(frame) >= len(control.HEADER) or byte == control.HEADER[len(frame)]:
+            if frame or (before == first and last == second):
                 frame.append(byte)
-            elif frame:  # a header broken off: this byte may start one
-                frame.clear()
-                if byte == control.HEADER[0]:
-                    frame.append(byte)
-            if len(frame) == control.FRAME:
-                out.append(bytes(frame))
-                frame.clear()
+                if len(frame) == size:
+                    out.append(control.HEADER + frame)
+                    frame.clear()
+            before, last = last, byte
+        self._last = (before, last)
         return out

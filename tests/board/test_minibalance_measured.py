@@ -125,11 +125,72 @@ def test_the_8_bytes_after_a_header_are_a_frame_whatever_they_hold() -> None:
 def test_a_frame_is_taken_only_when_the_line_pauses() -> None:
     first = bytes.fromhex("FF FE 01 00 00 00 64 00 00 00")
     second = bytes.fromhex("FF FE 01 00 00 00 32 00 00 00")
-    script = [(ON, UART2, bytes(11)), (ON + 0.1, UART2, first + second[:2])]
+    script = [(ON, UART2, bytes(11)), (ON + 0.1, UART2, first + second[:3])]
     board, _, _ = play(script, ON + 0.5)
     assert board.vehicle.vy == 0, "a frame under way: the first is not taken"
-    board, _, _ = play([*script, (ON + 0.5, UART2, second[2:])], ON + 0.6)
+    board, _, _ = play([*script, (ON + 0.5, UART2, second[3:])], ON + 0.6)
     assert board.vehicle.vy == 50, "the last frame, once the line pauses"
+
+
+def test_a_header_alone_is_no_frame_under_way() -> None:
+    """Usart_Flag is set by the byte after `FF FE`: a tick between the header and that
+    byte takes the frame before it (meca_base usartx.c)."""
+    first = bytes.fromhex("FF FE 01 00 00 00 64 00 00 00")
+    script = [(ON, UART2, bytes(11)), (ON + 0.1, UART2, first + b"\xff\xfe")]
+    board, _, _ = play(script, ON + 0.3)
+    assert board.vehicle.vy == 100
+
+
+def y_by_tick(data: bytes, ticks: int) -> list[float]:
+    """The board model's commanded y at each 10 ms control tick after `data` came on
+    UART2 (back to back, no pause), once the board runs."""
+    board = Board(profile=MINIBALANCE)
+    board.advance(ON)
+    board.receive_uart2(data, ON)
+    ys: list[float] = []
+    for tick in range(1, ticks + 1):
+        board.advance(ON + tick * 0.01)
+        ys.append(board.vehicle.vy)
+    return ys
+
+
+def test_the_header_is_the_last_two_bytes_a_frames_own_included() -> None:
+    """§13.3's minimal case: the first frame's data ends in `FF FE`, so the byte after it
+    starts the second, the zero frame, and only the last frame counts: y 0 throughout."""
+    data = bytes.fromhex("FF FE 01 00 20 74 60 AE FF FE 01 00 00 00 00 00 00 00")
+    assert y_by_tick(data, 100) == [0] * 100
+    board = Board(profile=MINIBALANCE)
+    board.advance(ON)
+    board.receive_uart2(data, ON)
+    board.advance(ON + 1.0)
+    assert (board.vehicle.vx, board.vehicle.vy, board.vehicle.vz) == (0, 0, 0)
+    assert board.vehicle.heading == 0, "no turn either"
+
+
+def test_a_motor_frame_after_the_same_prefix_moves_nothing() -> None:
+    data = bytes.fromhex("FF FE 01 00 20 74 60 AE FF FE 02 D9 82 26 00 00 00 07")
+    board = Board(profile=MINIBALANCE)
+    board.advance(ON)
+    board.receive_uart2(data, ON)
+    board.advance(ON + 1.0)
+    assert board.vehicle.vx == 0 and board.vehicle.vy == 0
+
+
+def test_of_two_frames_in_one_tick_only_the_last_counts() -> None:
+    go = bytes.fromhex("FF FE 01 00 00 00 64 00 00 00")
+    assert y_by_tick(bytes(11) + go + bytes.fromhex("FF FE 01 00 00 00 32 00 00 00"), 5) == [50] * 5
+    assert y_by_tick(bytes(11) + go, 5) == [100] * 5
+
+
+def test_with_bytes_between_the_two_frames_both_are_frames() -> None:
+    """§13.3: `… 60 AE 00 00 00 00 FF FE 01 …`: the second frame is found by its own
+    header, and it is the last one."""
+    data = bytes.fromhex("FF FE 01 00 20 74 60 AE 00 00 00 00 FF FE 01 00 00 00 14 00 00 00")
+    board = Board(profile=MINIBALANCE)
+    board.advance(ON)
+    board.receive_uart2(data, ON)
+    board.advance(ON + 0.5)
+    assert board.vehicle.vy == 20
 
 
 def test_a_frame_before_the_take_over_counts_only_if_it_is_the_last() -> None:
@@ -144,3 +205,25 @@ def test_a_frame_before_the_take_over_counts_only_if_it_is_the_last() -> None:
 def test_uart2_carries_a_burst_after_each_app_record() -> None:
     _, records, uart2 = play([], ON)
     assert uart2 == b"\xff\xfe\x00" * len(records), "FF FE and the gyro's low byte, at rest"
+
+
+def test_a_negative_speed_setting_commands_every_axis_each_tick_whatever_is_held() -> None:
+    """§13.3's open note, compared on the commanded z tick by tick: `{0:-596}` sets
+    −2404 (the `-` is −3 · 1000), and each tick's clamp (`v < −max`, then `v > max`)
+    leaves every axis at −2404 while rotating with `G` and after `H`: the yaw a peer
+    reports at that rate aliases (±180° wraps between records), the command does not."""
+    board = Board(profile=MINIBALANCE)
+    board.advance(ON)
+    board.receive(b"KG", ON)
+    board.advance(ON + 0.3)
+    assert board.vehicle.vz < 0
+    board.receive(b"{0:-596}", ON + 0.3)
+    held: set[tuple[float, float, float]] = set()
+    for tick in range(1, 60):
+        if tick == 30:
+            board.receive(b"H", ON + 0.3 + tick * 0.01)
+        board.advance(ON + 0.3 + tick * 0.01 + 0.001)
+        if tick > 1:
+            held.add((board.vehicle.vx, board.vehicle.vy, board.vehicle.vz))
+    assert board.params[0] == -2404
+    assert held == {(-2404, -2404, -2404)}
