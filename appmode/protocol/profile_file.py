@@ -32,6 +32,11 @@ A_FIELDS = 4
 """Fields of an A record: `{A f0:f1:f2:f3}$` for every firmware of the family."""
 MAX_FIELDS = 9
 """At most nine fields in a B record, nine parameters (`{n:v}`: n is one digit, 0–8)."""
+SCALES = (1e-6, 1e6)
+"""The smallest and largest scale a field or a parameter may have: beyond them a value
+is no longer a number a frame or a record can carry (inf, 1e-320)."""
+MAX_TEXT = 200
+"""The longest text (a description, a label, a unit, a page's name), in characters."""
 
 
 class ProfileError(ValueError):
@@ -120,6 +125,8 @@ def parse(text: str, where: str) -> ProfileFile:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ProfileError(where, [f"not TOML: {exc}"]) from None
+    except RecursionError:
+        raise ProfileError(where, ["nested too deeply: a profile's values are flat"]) from None
     problems: list[str] = []
     base: ProfileFile | None = None
     like = data.get("like")
@@ -173,11 +180,11 @@ def _build(
         elif not isinstance(flags[key], bool):
             problem(f"{key} = {flags[key]!r}: true or false")
     replies = data.get("replies", list(base.replies) if base else [])
-    if not (isinstance(replies, list) and all(isinstance(r, str) and r for r in replies)):
+    if not (isinstance(replies, list) and all(_plain(r) and r for r in replies)):
         problem(f'replies = {replies!r}: a list of texts, such as ["##$"]')
         replies = []
     boot = data.get("boot", base.boot if base else "")
-    if not isinstance(boot, str) or len(boot) > 200:
+    if not _plain(boot):
         problem(f'boot = {boot!r}: a text its start-up output holds, such as "mpu_set_sensor"')
         boot = ""
     pages = _letters(data, "pages", str, problem, base.pages if base else None)
@@ -190,10 +197,12 @@ def _build(
     b = _fields(records, "B", problem, base.b if base else None)
     if a is not None and len(a) != A_FIELDS:
         problem(f"records.A has {len(a)} fields: an A record has {A_FIELDS}")
+    elif a is not None and not any(field.motion for field in a):
+        problem("records.A: no field says motion = true: mark those that show the motion")
     params = _params(data, problem, base.params if base else None)
     speed_param = data.get("speed_param", base.speed_param if base else None) or None  # "": none
     names = [p.name for p in params or ()]
-    if speed_param is not None and speed_param not in names:
+    if speed_param is not None and params is not None and speed_param not in names:
         problem(f"speed_param = {speed_param!r}: name one of the parameters ({', '.join(names)})")
     velocity_si = _velocity_si(data, base, problem)
     if not isinstance(name, str) or a is None or b is None or params is None:
@@ -256,6 +265,22 @@ def _number(value: object) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+SCALE_TEXT = f"a number from {SCALES[0]:g} to {SCALES[1]:g}"
+
+
+def _scale(value: object) -> bool:
+    return _number(value) and SCALES[0] <= value <= SCALES[1]  # type: ignore[operator]
+
+
+def _plain(value: object) -> bool:
+    """A text a view can show as it is: no control characters, not too long."""
+    return (
+        isinstance(value, str)
+        and len(value) <= MAX_TEXT
+        and all(ch.isprintable() or ch == " " for ch in value)
+    )
+
+
 def _text(
     data: Mapping[str, Any],
     key: str,
@@ -269,6 +294,9 @@ def _text(
         return None
     if not isinstance(value, str) or not value.strip():
         problem(f'{key} = {value!r}: a text, {key} = "…"')
+        return None
+    if not _plain(value):
+        problem(f"{key} = {value!r}: a line of at most {MAX_TEXT} characters, no control ones")
         return None
     if pattern and not (value[0].isalpha() and set(value) <= NAME_CHARACTERS):
         problem(f"{key} = {value!r}: lower-case letters, digits and _, a letter first")
@@ -289,7 +317,7 @@ def _letters(
         isinstance(k, str)
         and len(k) == 1
         and "A" <= k <= "Z"
-        and (isinstance(v, str) if kind is str else _whole(v))
+        and (_plain(v) and bool(v.strip()) if kind is str else _whole(v) and abs(v) <= 2**31)
         for k, v in table.items()
     )
     if not good:
@@ -322,21 +350,21 @@ def _fields(
             problem(f"{at}: unknown key {key!r}: a field has {', '.join(sorted(FIELD_KEYS))}")
         name = _text(entry, "name", _under(at, problem), pattern=True)
         scale = entry.get("scale", 1.0)
-        if not _number(scale) or scale <= 0:
-            problem(f"{at}: scale = {scale!r}: a number above 0 (field = scale × value)")
+        if not _scale(scale):
+            problem(f"{at}: scale = {scale!r}: {SCALE_TEXT} (field = scale × value)")
         wrap = entry.get("wrap")
-        if wrap is not None and (not _whole(wrap) or wrap < 2):
+        if wrap is not None and (not _whole(wrap) or not 2 <= wrap <= 2**32):
             problem(f"{at}: wrap = {wrap!r}: where the field wraps, such as 256")
         flags = {k: entry.get(k, k == "signed") for k in ("signed", "motion", "battery")}
         for key, value in flags.items():
             if not isinstance(value, bool):
                 problem(f"{at}: {key} = {value!r}: true or false")
         unit, label = entry.get("unit", ""), entry.get("label", name)
-        if not isinstance(unit, str) or not isinstance(label, str):
-            problem(f"{at}: label and unit are texts")
+        if not _plain(unit) or not _plain(label):
+            problem(f"{at}: label and unit are texts of a line, no control characters")
         if name is not None:
             fields.append(
-                Field(name, str(label), str(unit), float(scale) if _number(scale) else 1.0,
+                Field(name, str(label), str(unit), float(scale) if _scale(scale) else 1.0,
                       flags["signed"] is True, wrap if _whole(wrap) else None,
                       flags["motion"] is True, flags["battery"] is True)
             )  # fmt: skip
@@ -415,10 +443,13 @@ def _param(entry: object, at: str, problem: Callable[[str], None]) -> ParamSpec 
     if not isinstance(default, int) or isinstance(default, bool) or not low <= default <= high:
         problem(f"{at}: default = {default!r}: a whole number in {low}–{high}")
         return None
-    if not _number(scale) or scale <= 0:
-        problem(f"{at}: scale = {scale!r}: above 0 (the frame's integer = scale × value)")
+    if not _scale(scale):
+        problem(f"{at}: scale = {scale!r}: {SCALE_TEXT} (the frame's integer = scale × value)")
         return None
     label = entry.get("label", name)
-    if name is None or not isinstance(label, str):
+    if not _plain(label):
+        problem(f"{at}: label = {label!r}: a text of a line, no control characters")
+        return None
+    if name is None:
         return None
     return ParamSpec(name, label, low, high, default, float(scale))

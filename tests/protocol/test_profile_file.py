@@ -86,6 +86,39 @@ def test_a_user_s_file_is_checked_and_read_like_a_shipped_one(tmp_path: Path):
             "params[0]: default = 11: a whole number in 0–10",
         ),
         ('name = "x"\nlike = "sheet"\ncolour = "red"\n', "unknown key 'colour'"),
+        (
+            'name = "x"\nlike = "sheet"\n[records]\nA = [{ name = "a" }, { name = "b" },'
+            ' { name = "c", battery = true }, { name = "d" }]\n',
+            "records.A: no field says motion = true",
+        ),
+        ('name = "x"\nboot = ' + "[" * 20_000 + "]" * 20_000 + "\n", "nested too deeply"),
+        ('name = "x"\nboot = ' + "{a=" * 5_000 + "1" + "}" * 5_000 + "\n", "nested too deeply"),
+        (
+            'name = "x"\nlike = "sheet"\n[[params]]\nname = "max_speed"\nmaximum = 9\n'
+            "scale = inf\n",
+            "params[0]: scale = inf: a number from 1e-06 to 1e+06",
+        ),
+        (
+            'name = "x"\nlike = "sheet"\n[[params]]\nname = "max_speed"\nmaximum = 9\n'
+            "scale = 1e-320\n",
+            "params[0]: scale = 1e-320: a number from",
+        ),
+        (
+            'name = "x"\nlike = "sheet"\n[records]\nB = [{ name = "a", scale = nan }]\n',
+            "records.B[0]: scale = nan",
+        ),
+        (
+            'name = "x"\nlike = "sheet"\ndescription = "\\u001b]52;c;aGk=\\u0007\\u001b[2J"\n',
+            "description = '\\x1b]52;c;aGk=\\x07\\x1b[2J': a line of at most 200",
+        ),
+        (
+            'name = "x"\nlike = "sheet"\n[pages]\nK = "\\u001b[8mhidden"\n',
+            "[pages]: a capital letter = a page's name",
+        ),
+        (
+            'name = "x"\nlike = "sheet"\n[records]\nB = [{ name = "a", label = "\\u009b2J" }]\n',
+            "records.B[0]: label and unit are texts of a line",
+        ),
     ],
 )
 def test_a_broken_profile_is_one_line_a_mistake(tmp_path: Path, text: str, said: str):
