@@ -446,10 +446,10 @@ def _param(entry: object, at: str, problem: Callable[[str], None]) -> ParamSpec 
     if not _scale(scale):
         problem(f"{at}: scale = {scale!r}: {SCALE_TEXT} (the frame's integer = scale × value)")
         return None
-    label = entry.get("label", name)
-    if not _plain(label):
-        problem(f"{at}: label = {label!r}: a text of a line, no control characters")
-        return None
     if name is None:
+        return None
+    label = entry.get("label", name)
+    if not isinstance(label, str) or not _plain(label):
+        problem(f"{at}: label = {label!r}: a text of a line, no control characters")
         return None
     return ParamSpec(name, label, low, high, default, float(scale))
