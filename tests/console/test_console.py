@@ -96,6 +96,12 @@ def run_console(
     return session, record, typed_at
 
 
+def said(text: str) -> Seen:
+    """The console's session has said `text` (a set verified: on a loaded machine that
+    can take past a fixed pause)."""
+    return lambda console: text in console.session.messages
+
+
 @pytest.fixture
 def quit_key() -> Iterator[tuple[str, float]]:
     yield (CTRL_C, 0.0)
@@ -181,7 +187,8 @@ def test_grid_keys_follow_the_page(tmp_path: Path, quit_key: tuple[str, float]) 
 def test_command_line_set_is_verified_and_typing_does_not_drive(
     tmp_path: Path, quit_key: tuple[str, float]
 ) -> None:
-    keys = [(":", 0.1), ("set max_speed 800\r", 0.8), quit_key]
+    verified = said("max_speed = 800 (verified)")
+    keys = [(":", 0.1, None), ("set max_speed 800\r", 0.1, verified), (*quit_key, None)]
     session, record, _ = run_console(tmp_path, keys)
     payloads = [p for _, p in sent(record)]
     assert "{0:800}" in payloads
@@ -241,8 +248,22 @@ def test_up_recalls_the_previous_command_not_a_completion(tmp_path: Path, typed:
 
     keys: list[tuple[str, float, Seen | None]] = [(":", 0.1, None)]
     keys += [(c, 0.02, None) for c in typed]
-    keys += [("\r", 0.6, None), (":", 0.1, None), (TAB, 0.2, menu), (UP, 0.2, recalled)]
-    keys += [("\r", 0.6, None), (CTRL_C, 0.0, None)]
+    said_when_done = {
+        "params": "parameters read",
+        "set max_speed 800": "max_speed = 800 (verified)",
+    }
+
+    def done(n: int) -> tuple[float, Seen | None]:
+        """The pause after Enter and what to see first: the command's message said `n`
+        times in all (a page is sent at once: a pause)."""
+        if typed not in said_when_done:
+            return 0.6, None
+        text = said_when_done[typed]
+        return 0.1, lambda console: list(console.session.messages).count(text) >= n
+
+    first = 1 + (typed == "params")  # the console read them once at the start
+    keys += [("\r", *done(first)), (":", 0.1, None), (TAB, 0.2, menu), (UP, 0.2, recalled)]
+    keys += [("\r", *done(first + 1)), (CTRL_C, 0.0, None)]
     session, record, _ = run_console(tmp_path, keys)
     assert not session.host.connected
     lines = [p for _, p in sent(record)]
@@ -255,9 +276,11 @@ def test_up_recalls_the_previous_command_not_a_completion(tmp_path: Path, typed:
 
 
 def test_quit_with_unsaved_parameters_asks_once(tmp_path: Path) -> None:
-    keys = [(":", 0.1), ("set max_speed 800\r", 0.8), (":", 0.1), ("quit\r", 0.3)]
-    keys += [("w", 0.3)]  # still driving (w: A, forward): the first quit only warned
-    keys += [(":", 0.1), ("quit\r", 0.0)]
+    verified = said("max_speed = 800 (verified)")
+    keys = [(":", 0.1, None), ("set max_speed 800\r", 0.1, verified), (":", 0.1, None)]
+    keys += [("quit\r", 0.3, None)]
+    keys += [("w", 0.3, None)]  # still driving (w: A, forward): the first quit only warned
+    keys += [(":", 0.1, None), ("quit\r", 0.0, None)]
     session, record, _ = run_console(tmp_path, keys)
     warning = "not saved: max_speed 500 → 800 — :save keeps it; quit again to leave"
     assert any(m.startswith(warning) for m in session.messages), session.messages
