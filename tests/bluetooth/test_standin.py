@@ -132,6 +132,11 @@ def test_sigterm_mid_drive_leaves_z_last(appmode_ble_board: ServedBoard) -> None
 
 def _drop(bus: str) -> None:
     """Ask the stand-in to drop its connections (the car out of range)."""
+    _ask(bus, "Drop")
+
+
+def _ask(bus: str, member: str) -> None:
+    """Call one of the stand-in's own methods (what no radio API has)."""
     from dbus_fast import Message, MessageType
     from dbus_fast.aio import MessageBus
 
@@ -142,13 +147,35 @@ def _drop(bus: str) -> None:
                 destination="org.bluez",
                 path="/org/appmode/standin",
                 interface="org.appmode.StandIn1",
-                member="Drop",
+                member=member,
             )
         )
         link.disconnect()
         assert reply is not None and reply.message_type == MessageType.METHOD_RETURN
 
     asyncio.run(call())
+
+
+def test_a_module_s_name_opens_it_and_two_of_one_name_are_refused(
+    appmode_ble_board: ServedBoard,
+) -> None:
+    """Issue 64.6: with two `HC-08` nearby, `ble://HC-08` opened the first one heard."""
+    board = appmode_ble_board
+    assert board.bus is not None
+    done = run("params", "ble://HC-08")
+    assert done.returncode == 0 and "max_speed" in done.stdout, done.stderr
+    _ask(board.bus, "Twin")
+    before = len(sent(board))
+    done = run("params", "ble://HC-08")
+    assert done.returncode != 0
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert "2 BLE devices nearby are called 'HC-08'" in lines[0]
+    assert "02:CA:40:00:00:08" in lines[0] and "02:CA:40:00:01:00" in lines[0]
+    assert "ble://02:CA:40:00:00:08" in lines[0]
+    assert len(sent(board)) == before, "nothing was sent to either"
+    done = run("params", board.ble)
+    assert done.returncode == 0, "by its address it opens"
 
 
 def test_a_dropped_link_is_lost_then_retried_and_z_goes_first(

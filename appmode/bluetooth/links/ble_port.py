@@ -34,9 +34,14 @@ from appmode.ports.urls import port_target
 if TYPE_CHECKING:
     from bleak import BleakClient
     from bleak.backends.characteristic import BleakGATTCharacteristic
+    from bleak.backends.device import BLEDevice
+    from bleak.backends.scanner import AdvertisementData
 
 SCAN = 6.0
 """Seconds to look for the module before saying it is not nearby."""
+NAME_WINDOW = 1.5
+"""Seconds to go on listening once a module of the asked name is heard: a second module
+of that name (two cars of one kit) makes the name ambiguous."""
 CONNECT = 10.0
 WRITE_BUFFER = 4096
 """Bytes `write` may queue ahead of the radio; past them it waits (its write_timeout)."""
@@ -95,7 +100,7 @@ class BleSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
             device = await BleakScanner.find_device_by_address(target.address, timeout=SCAN)
         else:
             assert target.name is not None
-            device = await BleakScanner.find_device_by_name(target.name, timeout=SCAN)
+            device = await _named(target.name)
         if device is None:
             raise SerialException(
                 f"no BLE device {target.shown} nearby (looked for {SCAN:g} s): switch the "
@@ -225,3 +230,31 @@ def _uart(client: BleakClient) -> UartService:
             f"with ?service=…&write=…&notify=… (its services: {found})"
         )
     return service
+
+
+async def _named(name: str) -> BLEDevice | None:
+    """The one module heard advertising `name`, None if none is heard within SCAN;
+    SerialException naming their addresses when more than one is."""
+    from bleak import BleakScanner
+
+    found: dict[str, BLEDevice] = {}
+    heard = asyncio.Event()
+
+    def advertised(device: BLEDevice, adv: AdvertisementData) -> None:
+        if (adv.local_name or device.name) == name:
+            found[device.address] = device
+            heard.set()
+
+    async with BleakScanner(detection_callback=advertised):
+        try:
+            await asyncio.wait_for(heard.wait(), SCAN)
+        except asyncio.TimeoutError:
+            return None
+        await asyncio.sleep(NAME_WINDOW)
+    if len(found) > 1:
+        addresses = sorted(found)
+        raise SerialException(
+            f"{len(found)} BLE devices nearby are called {name!r} ({', '.join(addresses)}): "
+            f"choose one by its address, such as ble://{addresses[0]}"
+        )
+    return next(iter(found.values()))

@@ -53,6 +53,11 @@ class Control(ServiceInterface):
     def Drop(self) -> Nothing:
         self._standin.drop("dropped by request")
 
+    @dbus_method()
+    def Twin(self) -> Nothing:
+        """Another module nearby with the car's module's name (a second HC-08)."""
+        self._standin.twin()
+
 
 class StandIn:
     """Serves BlueZ's API on `bus_address` for the board behind `board` (a connected
@@ -68,6 +73,7 @@ class StandIn:
         service = UART_SERVICES[0]
         self.ble = Device(self, BLE_ADDRESS, BLE_NAME, [service.service], le=True)
         self.spp = Device(self, SPP_ADDRESS, SPP_NAME, [SPP], le=False)
+        self.twins: list[Device] = []
         base = f"{self.ble.path}/service0010"
         self._gatt: list[tuple[str, ServiceInterface]] = [
             (base, GattService(service.service, self.ble.path, 0x10)),
@@ -138,9 +144,17 @@ class StandIn:
 
     async def _advertise(self) -> None:
         while self.adapter.discovering:
-            for device in [self.ble, *self.peers.heard()]:
+            for device in [self.ble, *self.twins, *self.peers.heard()]:
                 device.advertise(-58 + random.randint(-4, 4))
             await asyncio.sleep(ADVERTISING)
+
+    def twin(self) -> None:
+        """A second module advertising the car's module's name, at its own address."""
+        address = f"02:CA:40:00:01:{len(self.twins):02X}"
+        device = Device(self, address, BLE_NAME, list(self.ble.uuids), le=True)
+        self.twins.append(device)
+        if self._bus is not None:
+            self._bus.export(device.path, device)
 
     # ------------------------------------------------------------ connections
 
