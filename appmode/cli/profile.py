@@ -11,6 +11,7 @@ from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers
 from appmode.protocol import param_values
 from appmode.protocol.profile_file import SHIPPED, Field, ProfileError, ProfileFile
+from appmode.text import escaped
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -86,7 +87,7 @@ def shown(profile: ProfileFile) -> str:
         )
         span, default = param_values.range_text(p), param_values.to_user(p, p.default)
         lines.append(f"  {i:2d}  {p.name:<18}  {span:<24}  {default:>10}  {scale}")
-    return "\n".join(lines) + "\n"
+    return "".join(escaped(line) + "\n" for line in lines)  # a file's texts, as they are
 
 
 def _speed(profile: ProfileFile) -> str:

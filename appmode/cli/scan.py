@@ -9,6 +9,7 @@ import sys
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, number_type
 from appmode.errors import AppmodeError
+from appmode.text import escaped
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -84,15 +85,18 @@ def run(args: argparse.Namespace) -> int:
         return 1
     head = ("kind", "name", "address", "signal", "service", "url")
     rows = [head + (("firmware",) if args.probe else ())] + [
-        (
-            f.kind,
-            f.name or "?",
-            f.address,
-            f"{f.rssi} dBm" if f.rssi is not None else "paired",
-            f.service or "-",
-            f.url,
+        tuple(
+            escaped(cell)  # a name is what a stranger's device says it is
+            for cell in (
+                f.kind,
+                f.name or "?",
+                f.address,
+                f"{f.rssi} dBm" if f.rssi is not None else "paired",
+                f.service or "-",
+                f.url,
+            )
+            + ((firmware.get(f.url) or "-",) if args.probe else ())
         )
-        + ((firmware.get(f.url) or "-",) if args.probe else ())
         for f in listed
     ]
     widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
@@ -116,7 +120,7 @@ def _probe(urls: list[str], shown: bool) -> dict[str, str | None]:
 
         def say(text: str, url: str = url) -> None:
             if shown:
-                sys.stderr.write(f"\r\033[Kprobing {url}: {text}")
+                sys.stderr.write(f"\r\033[Kprobing {escaped(url)}: {escaped(text)}")
                 sys.stderr.flush()
 
         finding = probe(parse_target(url), stop, say)

@@ -28,7 +28,7 @@ from appmode.ports.urls import open_link
 from appmode.protocol import app, app_decoders, param_values, params
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import SUFFIX, Transcript
-from appmode.text import wrapped
+from appmode.text import escaped, wrapped
 from appmode.transcript.matcher import Check
 from appmode.transcript.reading import read_transcript
 
@@ -342,12 +342,13 @@ def _run_all(
             timing = f"{result.seconds:.2f} s of virtual time in {result.wall:.3f} s"
         else:
             timing = f"{result.wall:.2f} s"
+        path = escaped(str(result.path))  # a suite's file names come from outside
         if result.skipped is not None:
-            out.write(f"{verdict}  {result.path}  ({result.skipped})\n")
+            out.write(f"{verdict}  {path}  ({escaped(result.skipped)})\n")
         else:
-            out.write(f"{verdict}  {result.path}  ({timing})\n")
+            out.write(f"{verdict}  {path}  ({timing})\n")
         if result.failure is not None:
-            out.write(f"      {result.failure}\n")
+            out.write(f"      {escaped(result.failure)}\n")
         failed = between() if between is not None and not result.skipped else None
         if failed is not None:
             out.write(f"      {failed}\n")

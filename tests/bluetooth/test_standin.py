@@ -5,6 +5,7 @@ judged on the board's own recording."""
 from __future__ import annotations
 
 import asyncio
+import json
 import os
 import signal
 import subprocess
@@ -135,7 +136,7 @@ def _drop(bus: str) -> None:
     _ask(bus, "Drop")
 
 
-def _ask(bus: str, member: str) -> None:
+def _ask(bus: str, member: str, *args: str) -> None:
     """Call one of the stand-in's own methods (what no radio API has)."""
     from dbus_fast import Message, MessageType
     from dbus_fast.aio import MessageBus
@@ -148,6 +149,8 @@ def _ask(bus: str, member: str) -> None:
                 path="/org/appmode/standin",
                 interface="org.appmode.StandIn1",
                 member=member,
+                signature="s" * len(args),
+                body=list(args),
             )
         )
         link.disconnect()
@@ -164,7 +167,7 @@ def test_a_module_s_name_opens_it_and_two_of_one_name_are_refused(
     assert board.bus is not None
     done = run("params", "ble://HC-08")
     assert done.returncode == 0 and "max_speed" in done.stdout, done.stderr
-    _ask(board.bus, "Twin")
+    _ask(board.bus, "Nearby", "")
     before = len(sent(board))
     done = run("params", "ble://HC-08")
     assert done.returncode != 0
@@ -308,3 +311,23 @@ def test_a_link_lost_for_good_is_never_shown_as_a_stop(appmode_ble_board: Served
     assert "Traceback" not in err
     assert "NOT STOPPED" in out and "Z stop" not in out, out
     assert board.state.moving and sent(board).endswith(b"A"), "the board's own record"
+
+
+HOSTILE = "\x1b]52;c;aGk=\x07\x1b[2K\rHC-08\x1b[8m"
+"""A nearby device's name that writes the clipboard, erases the line and hides the rest
+(issue 64.5), when a terminal is given it as it is."""
+
+
+def test_scan_shows_a_hostile_device_name_escaped(appmode_ble_board: ServedBoard) -> None:
+    assert appmode_ble_board.bus is not None
+    _ask(appmode_ble_board.bus, "Nearby", HOSTILE)
+    done = run("scan", "--time", "2")
+    assert done.returncode == 0, done.stderr
+    out = done.stdout + done.stderr
+    assert not set(out) & {"\x1b", "\x07", "\r"}, repr(out)
+    row = next(line for line in done.stdout.splitlines() if "02:CA:40:00:01:00" in line)
+    assert "\\x1b]52;c;aGk=\\x07\\x1b[2K\\x0dHC-08\\x1b[8m" in row
+    assert "ble://02:CA:40:00:01:00" in row, "the address and URL are shown"
+    listed = run("scan", "--time", "2", "--json")
+    names = [json.loads(line)["name"] for line in listed.stdout.splitlines()]
+    assert HOSTILE in names and "\x1b" not in listed.stdout

@@ -78,3 +78,17 @@ def runaway_board(y: int = 300) -> Iterator[str]:
 
     with _pty_board(step, 0.05) as path:
         yield path
+
+
+@contextmanager
+def chatty_board(text: bytes) -> Iterator[str]:
+    """Sends `text` and a resting A record every 50 ms (a board's start-up text, or a
+    hostile one's)."""
+
+    def step(master: int) -> None:
+        os.write(master, text + b"{A0:0:0:0}$")
+        if select.select([master], [], [], 0)[0]:
+            os.read(master, 1024)
+
+    with _pty_board(step, 0.05) as path:
+        yield path

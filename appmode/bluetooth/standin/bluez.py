@@ -19,6 +19,7 @@ from collections.abc import Callable, Coroutine
 
 from dbus_fast import DBusError, Message, MessageType, Variant
 from dbus_fast.aio import MessageBus
+from dbus_fast.annotations import DBusStr
 from dbus_fast.service import ServiceInterface, dbus_method
 
 from appmode.bluetooth.gatt import Cccd, GattService, UartCharacteristic
@@ -54,9 +55,10 @@ class Control(ServiceInterface):
         self._standin.drop("dropped by request")
 
     @dbus_method()
-    def Twin(self) -> Nothing:
-        """Another module nearby with the car's module's name (a second HC-08)."""
-        self._standin.twin()
+    def Nearby(self, name: DBusStr) -> Nothing:
+        """Another BLE module nearby, advertising `name` ("": the car's module's name, a
+        second HC-08), at an address of its own; it takes no connection."""
+        self._standin.nearby(name or BLE_NAME)
 
 
 class StandIn:
@@ -73,7 +75,7 @@ class StandIn:
         service = UART_SERVICES[0]
         self.ble = Device(self, BLE_ADDRESS, BLE_NAME, [service.service], le=True)
         self.spp = Device(self, SPP_ADDRESS, SPP_NAME, [SPP], le=False)
-        self.twins: list[Device] = []
+        self.others: list[Device] = []
         base = f"{self.ble.path}/service0010"
         self._gatt: list[tuple[str, ServiceInterface]] = [
             (base, GattService(service.service, self.ble.path, 0x10)),
@@ -144,21 +146,23 @@ class StandIn:
 
     async def _advertise(self) -> None:
         while self.adapter.discovering:
-            for device in [self.ble, *self.twins, *self.peers.heard()]:
+            for device in [self.ble, *self.others, *self.peers.heard()]:
                 device.advertise(-58 + random.randint(-4, 4))
             await asyncio.sleep(ADVERTISING)
 
-    def twin(self) -> None:
-        """A second module advertising the car's module's name, at its own address."""
-        address = f"02:CA:40:00:01:{len(self.twins):02X}"
-        device = Device(self, address, BLE_NAME, list(self.ble.uuids), le=True)
-        self.twins.append(device)
+    def nearby(self, name: str) -> None:
+        """Another module advertising `name` (its UART service too), at its own address."""
+        address = f"02:CA:40:00:01:{len(self.others):02X}"
+        device = Device(self, address, name, list(self.ble.uuids), le=True)
+        self.others.append(device)
         if self._bus is not None:
             self._bus.export(device.path, device)
 
     # ------------------------------------------------------------ connections
 
     async def connect(self, device: Device, uuid: str | None) -> None:
+        if device in self.others:
+            raise DBusError(FAILED, f"{device.label} is not the car's module")
         peer = self.peers.owner(device)
         if peer is not None and device.le:
             self.peers.connect_ble(peer, device)
