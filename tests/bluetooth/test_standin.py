@@ -268,17 +268,59 @@ def test_ctrl_c_ends_a_scan_cleanly(appmode_ble_board: ServedBoard) -> None:
 def kill_bus(bus: str) -> None:
     """Kill the stand-in's dbus-daemon: the module is gone for good (its link never
     comes back)."""
-    folder = bus.split("path=", 1)[1].split(",", 1)[0].rsplit("/", 1)[0]
+    daemons = bus_processes(bus, watcher=False)
+    assert daemons, f"no dbus-daemon serves {bus}"
+    os.kill(daemons[0], signal.SIGKILL)
+
+
+def bus_processes(bus: str, watcher: bool = True) -> list[int]:
+    """The processes serving `bus`: its dbus-daemon, and (`watcher`) the shell that
+    stops it once appmode is gone."""
+    folder = bus_folder(bus)
     wanted = f"--config-file={folder}/bus.conf".encode()
+    found = []
     for entry in Path("/proc").iterdir():
         try:
             words = (entry / "cmdline").read_bytes().split(b"\0")
         except OSError:
             continue
-        if wanted in words:
-            os.kill(int(entry.name), signal.SIGKILL)
-            return
-    raise AssertionError(f"no dbus-daemon serves {bus}")
+        if wanted in words and (watcher or words[0].endswith(b"dbus-daemon")):
+            found.append(int(entry.name))
+    return found
+
+
+def bus_folder(bus: str) -> Path:
+    return Path(bus.split("path=", 1)[1].split(",", 1)[0]).parent
+
+
+def test_board_bluetooth_killed_leaves_no_daemon_and_its_folder_goes_next_time() -> None:
+    """Issue 64.10: SIGKILL of `board --bluetooth` left its dbus-daemon running and its
+    folder behind."""
+    from appmode.bluetooth.standin.bus import PrivateBus
+
+    proc = subprocess.Popen(
+        appmode_cmd("board", "--bluetooth"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert proc.stdout is not None
+        bus = ""
+        for line in proc.stdout:
+            if line.startswith("bus: "):
+                bus = line.split(": ", 1)[1].strip()
+                break
+        assert bus, "board --bluetooth said its bus"
+        assert bus_processes(bus, watcher=False)
+    finally:
+        proc.kill()
+        proc.wait(10)
+    wait_for(lambda: not bus_processes(bus), 5)
+    assert bus_folder(bus).exists(), "left behind by a killed owner"
+    with PrivateBus():
+        assert not bus_folder(bus).exists(), "removed by the next bus started"
 
 
 def test_a_link_lost_for_good_is_never_shown_as_a_stop(appmode_ble_board: ServedBoard) -> None:

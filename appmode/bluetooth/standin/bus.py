@@ -1,9 +1,15 @@
 """A private D-Bus bus: Debian's `dbus-daemon` with a configuration of our own, listening
 on a socket in a new folder, so the BlueZ stand-in never touches the machine's system bus.
-Programs reach it with DBUS_SYSTEM_BUS_ADDRESS set to `address`."""
+Programs reach it with DBUS_SYSTEM_BUS_ADDRESS set to `address`.
+
+The daemon dies with us, however we end (SIGKILL too): it runs under a watcher shell
+that waits for the end of a pipe only we hold, then stops it. A folder left by a bus
+whose owner is gone (a machine's power cut) is removed by the next bus started."""
 
 from __future__ import annotations
 
+import contextlib
+import os
 import shutil
 import subprocess
 import tempfile
@@ -30,6 +36,17 @@ CONFIG = """<!DOCTYPE busconfig PUBLIC "-//freedesktop//DTD D-Bus Bus Configurat
 """
 """Anyone on this machine who can reach the socket (a folder only its owner may enter)
 may own a name and call anything: the bus carries one stand-in and its clients."""
+WATCHER = """
+"$0" "$@" & daemon=$!
+read -r _
+kill "$daemon" 2>/dev/null
+wait "$daemon"
+"""
+"""Runs the daemon (its stdin /dev/null) and stops it once our end of its stdin pipe is
+closed: by `close`, or by the kernel when we die."""
+PREFIX = "appmode-bus-"
+OWNER = "owner"
+"""The file in a bus's folder that holds the process id of the program that made it."""
 START = 5.0
 """Seconds the daemon may take to say its address."""
 NO_DAEMON = (
@@ -45,12 +62,15 @@ class PrivateBus:
         daemon = shutil.which("dbus-daemon")
         if daemon is None:
             raise AppmodeError(NO_DAEMON)
-        self._folder = Path(tempfile.mkdtemp(prefix="appmode-bus-"))
+        _remove_stale()
+        self._folder = Path(tempfile.mkdtemp(prefix=PREFIX))
+        (self._folder / OWNER).write_text(str(os.getpid()), encoding="ascii")
         config = self._folder / "bus.conf"
         config.write_text(CONFIG.format(socket=self._folder / "bus"), encoding="utf-8")
+        arguments = [f"--config-file={config}", "--nofork", "--nopidfile", "--print-address"]
         self._process = subprocess.Popen(
-            [daemon, f"--config-file={config}", "--nofork", "--nopidfile", "--print-address"],
-            stdin=subprocess.DEVNULL,
+            ["/bin/sh", "-c", WATCHER, daemon, *arguments],
+            stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
@@ -72,13 +92,14 @@ class PrivateBus:
         return line.strip()
 
     def close(self) -> None:
-        if self._process.poll() is None:
-            self._process.terminate()
-            try:
-                self._process.wait(2)
-            except subprocess.TimeoutExpired:
-                self._process.kill()
-                self._process.wait()
+        if self._process.stdin is not None:
+            with contextlib.suppress(OSError):
+                self._process.stdin.close()  # the watcher stops the daemon
+        try:
+            self._process.wait(2)
+        except subprocess.TimeoutExpired:
+            self._process.kill()
+            self._process.wait()
         for stream in (self._process.stdout, self._process.stderr):
             if stream is not None:
                 stream.close()
@@ -108,3 +129,26 @@ def _first_line(process: subprocess.Popen[str], timeout: float) -> str:
     if reader.is_alive():
         raise subprocess.TimeoutExpired("dbus-daemon", timeout)
     return got[0] if got else ""
+
+
+def _remove_stale() -> None:
+    """Remove the bus folders of ours whose owner is no longer running."""
+    for folder in Path(tempfile.gettempdir()).glob(f"{PREFIX}*"):
+        try:
+            if folder.lstat().st_uid != os.getuid() or not folder.is_dir():
+                continue
+            owner = int((folder / OWNER).read_text(encoding="ascii"))
+        except (OSError, ValueError):
+            continue  # not ours, or being made right now
+        if not _running(owner):
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
