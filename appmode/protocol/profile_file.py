@@ -15,6 +15,17 @@ from functools import cache
 from importlib import resources
 from typing import Any, NamedTuple
 
+from appmode.protocol.profile_checks import (
+    SCALE_TEXT,
+    in_scales,
+    letters,
+    number,
+    plain,
+    text_value,
+    under,
+    whole,
+)
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
@@ -23,20 +34,12 @@ else:  # pragma: no cover - Python 3.10
 SHIPPED = ("sheet", "minibalance", "balance")
 """The profiles appmode ships, in the order `profile list` shows them (the command line's
 options.SHIPPED_PROFILES names them too: a test keeps the two equal)."""
-NAME_CHARACTERS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
-"""A profile's, a field's and a parameter's name: these, a letter first (a JSON key and
-a command word)."""
 MAX_SIZE = 256_000
 """The largest profile file read, in bytes."""
 A_FIELDS = 4
 """Fields of an A record: `{A f0:f1:f2:f3}$` for every firmware of the family."""
 MAX_FIELDS = 9
 """At most nine fields in a B record, nine parameters (`{n:v}`: n is one digit, 0–8)."""
-SCALES = (1e-6, 1e6)
-"""The smallest and largest scale a field or a parameter may have: beyond them a value
-is no longer a number a frame or a record can carry (inf, 1e-320)."""
-MAX_TEXT = 200
-"""The longest text (a description, a label, a unit, a page's name), in characters."""
 
 
 class ProfileError(ValueError):
@@ -157,17 +160,17 @@ def _build(
 ) -> ProfileFile | None:
     for key in sorted(set(data) - TOP):
         problem(f"unknown key {key!r}: the keys are {', '.join(sorted(TOP))}")
-    name = _text(data, "name", problem, pattern=True)
-    description = _text(data, "description", problem, base.description if base else None)
-    source = _text(data, "source", problem, base.source if base else None)
+    name = text_value(data, "name", problem, pattern=True)
+    description = text_value(data, "description", problem, base.description if base else None)
+    source = text_value(data, "source", problem, base.source if base else None)
     baud = data.get("baud", base.baud if base else 9600)
-    if not _whole(baud) or baud <= 0:
+    if not whole(baud) or baud <= 0:
         problem(f"baud = {baud!r}: a rate in bits a second, such as 9600")
     period = data.get("period_ms", list(base.period_ms) if base else None)
     if not (
         isinstance(period, list)
         and len(period) == 2
-        and all(_whole(p) for p in period)
+        and all(whole(p) for p in period)
         and 0 < period[0] <= period[1] <= 60_000
     ):
         problem(f"period_ms = {period!r}: [shortest, longest] in ms, such as [50, 50]")
@@ -180,15 +183,15 @@ def _build(
         elif not isinstance(flags[key], bool):
             problem(f"{key} = {flags[key]!r}: true or false")
     replies = data.get("replies", list(base.replies) if base else [])
-    if not (isinstance(replies, list) and all(_plain(r) and r for r in replies)):
+    if not (isinstance(replies, list) and all(plain(r) and r for r in replies)):
         problem(f'replies = {replies!r}: a list of texts, such as ["##$"]')
         replies = []
     boot = data.get("boot", base.boot if base else "")
-    if not _plain(boot):
+    if not plain(boot):
         problem(f'boot = {boot!r}: a text its start-up output holds, such as "mpu_set_sensor"')
         boot = ""
-    pages = _letters(data, "pages", str, problem, base.pages if base else None)
-    speed_keys = _letters(data, "speed_keys", int, problem, base.speed_keys if base else None)
+    pages = letters(data, "pages", str, problem, base.pages if base else None)
+    speed_keys = letters(data, "speed_keys", int, problem, base.speed_keys if base else None)
     records = data.get("records", {})
     if not isinstance(records, dict) or set(records) - {"A", "B"}:
         problem("[records] holds A and B, each a list of fields")
@@ -211,7 +214,7 @@ def _build(
         name,
         str(description),
         str(source),
-        int(baud) if _whole(baud) else 0,
+        int(baud) if whole(baud) else 0,
         (int(period[0]), int(period[1])),
         bool(flags["control_port"]),
         bool(flags["saves"]),
@@ -238,7 +241,7 @@ def _velocity_si(
     if not (
         isinstance(given, list)
         and len(given) == 2
-        and all(_number(v) and 1e-9 <= v <= 1e3 for v in given)
+        and all(number(v) and 1e-9 <= v <= 1e3 for v in given)
     ):
         problem(
             f"velocity_si = {given!r}: [metres a second, radians a second] one velocity "
@@ -246,84 +249,6 @@ def _velocity_si(
         )
         return SI_DEFAULT
     return float(given[0]), float(given[1])
-
-
-def _under(at: str, problem: Callable[[str], None]) -> Callable[[str], None]:
-    """Problems said of a part of the file (`records.A[2]: …`)."""
-
-    def said(text: str) -> None:
-        problem(f"{at}: {text}")
-
-    return said
-
-
-def _whole(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-def _number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-SCALE_TEXT = f"a number from {SCALES[0]:g} to {SCALES[1]:g}"
-
-
-def _scale(value: object) -> bool:
-    return _number(value) and SCALES[0] <= value <= SCALES[1]  # type: ignore[operator]
-
-
-def _plain(value: object) -> bool:
-    """A text a view can show as it is: no control characters, not too long."""
-    return (
-        isinstance(value, str)
-        and len(value) <= MAX_TEXT
-        and all(ch.isprintable() or ch == " " for ch in value)
-    )
-
-
-def _text(
-    data: Mapping[str, Any],
-    key: str,
-    problem: Callable[[str], None],
-    inherited: str | None = None,
-    pattern: bool = False,
-) -> str | None:
-    value = data.get(key, inherited)
-    if value is None:
-        problem(f'{key} is missing: {key} = "…"')
-        return None
-    if not isinstance(value, str) or not value.strip():
-        problem(f'{key} = {value!r}: a text, {key} = "…"')
-        return None
-    if not _plain(value):
-        problem(f"{key} = {value!r}: a line of at most {MAX_TEXT} characters, no control ones")
-        return None
-    if pattern and not (value[0].isalpha() and set(value) <= NAME_CHARACTERS):
-        problem(f"{key} = {value!r}: lower-case letters, digits and _, a letter first")
-        return None
-    return value
-
-
-def _letters(
-    data: Mapping[str, Any],
-    key: str,
-    kind: type,
-    problem: Callable[[str], None],
-    inherited: Mapping[str, Any] | None,
-) -> dict[str, Any]:
-    table = data.get(key, dict(inherited) if inherited is not None else {})
-    what = "a page's name" if kind is str else "a speed change"
-    good = isinstance(table, dict) and all(
-        isinstance(k, str)
-        and len(k) == 1
-        and "A" <= k <= "Z"
-        and (_plain(v) and bool(v.strip()) if kind is str else _whole(v) and abs(v) <= 2**31)
-        for k, v in table.items()
-    )
-    if not good:
-        problem(f"[{key}]: a capital letter = {what}, one a line, such as K = …")
-        return {}
-    return dict(table)
 
 
 def _fields(
@@ -348,24 +273,24 @@ def _fields(
             continue
         for key in sorted(set(entry) - FIELD_KEYS):
             problem(f"{at}: unknown key {key!r}: a field has {', '.join(sorted(FIELD_KEYS))}")
-        name = _text(entry, "name", _under(at, problem), pattern=True)
+        name = text_value(entry, "name", under(at, problem), pattern=True)
         scale = entry.get("scale", 1.0)
-        if not _scale(scale):
+        if not in_scales(scale):
             problem(f"{at}: scale = {scale!r}: {SCALE_TEXT} (field = scale × value)")
         wrap = entry.get("wrap")
-        if wrap is not None and (not _whole(wrap) or not 2 <= wrap <= 2**32):
+        if wrap is not None and (not whole(wrap) or not 2 <= wrap <= 2**32):
             problem(f"{at}: wrap = {wrap!r}: where the field wraps, such as 256")
         flags = {k: entry.get(k, k == "signed") for k in ("signed", "motion", "battery")}
         for key, value in flags.items():
             if not isinstance(value, bool):
                 problem(f"{at}: {key} = {value!r}: true or false")
         unit, label = entry.get("unit", ""), entry.get("label", name)
-        if not _plain(unit) or not _plain(label):
+        if not plain(unit) or not plain(label):
             problem(f"{at}: label and unit are texts of a line, no control characters")
         if name is not None:
             fields.append(
-                Field(name, str(label), str(unit), float(scale) if _scale(scale) else 1.0,
-                      flags["signed"] is True, wrap if _whole(wrap) else None,
+                Field(name, str(label), str(unit), float(scale) if in_scales(scale) else 1.0,
+                      flags["signed"] is True, wrap if whole(wrap) else None,
                       flags["motion"] is True, flags["battery"] is True)
             )  # fmt: skip
     names = [f.name for f in fields]
@@ -404,7 +329,7 @@ def _params(
             isinstance(defaults, list)
             and len(defaults) == len(specs)
             and all(
-                _whole(d) and s.minimum <= d <= s.maximum
+                whole(d) and s.minimum <= d <= s.maximum
                 for d, s in zip(defaults, specs, strict=True)
             )
         ):
@@ -426,7 +351,7 @@ def _param(entry: object, at: str, problem: Callable[[str], None]) -> ParamSpec 
         return None
     for key in sorted(set(entry) - PARAM_KEYS):
         problem(f"{at}: unknown key {key!r}: a parameter has {', '.join(sorted(PARAM_KEYS))}")
-    name = _text(entry, "name", _under(at, problem), pattern=True)
+    name = text_value(entry, "name", under(at, problem), pattern=True)
     low, high = entry.get("minimum", 0), entry.get("maximum")
     default, scale = entry.get("default", low), entry.get("scale", 1.0)
     if (
@@ -443,13 +368,13 @@ def _param(entry: object, at: str, problem: Callable[[str], None]) -> ParamSpec 
     if not isinstance(default, int) or isinstance(default, bool) or not low <= default <= high:
         problem(f"{at}: default = {default!r}: a whole number in {low}–{high}")
         return None
-    if not _scale(scale):
+    if not in_scales(scale):
         problem(f"{at}: scale = {scale!r}: {SCALE_TEXT} (the frame's integer = scale × value)")
         return None
     if name is None:
         return None
     label = entry.get("label", name)
-    if not isinstance(label, str) or not _plain(label):
+    if not isinstance(label, str) or not plain(label):
         problem(f"{at}: label = {label!r}: a text of a line, no control characters")
         return None
     return ParamSpec(name, label, low, high, default, float(scale))
