@@ -24,6 +24,17 @@ def _escape(found: re.Match[str]) -> str:
     return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
 
 
+LONGEST_WORD = 120
+"""The longest run of characters without a space an error message shows whole."""
+_LONG_WORD = re.compile(rf"\S{{{LONGEST_WORD + 1},}}")
+
+
+def shortened(text: str) -> str:
+    """`text` with every word longer than LONGEST_WORD cut to its start and its length:
+    a 10 kB URL is named in an error, not echoed."""
+    return _LONG_WORD.sub(lambda m: f"{m[0][:60]}…({len(m[0]):,} characters)", text)
+
+
 def counted(count: int, noun: str, plural: str | None = None) -> str:
     """`1 error`, `2 errors` (`plural` for nouns that do not take an s)."""
     return f"{count} {noun if count == 1 else plural or noun + 's'}"

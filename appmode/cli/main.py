@@ -21,6 +21,7 @@ from appmode.cli.commands import COMMANDS, EXAMPLES
 from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
 from appmode.host import signals
+from appmode.text import shortened
 
 OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
@@ -158,7 +159,7 @@ def _run(parser: argparse.ArgumentParser, words: Sequence[str]) -> int:
         sys.stdout.flush()  # here, where a full disk or a closed pipe can be reported
         return status
     except AppmodeError as exc:
-        print(f"appmode: error: {exc}", file=sys.stderr)
+        print(f"appmode: error: {shortened(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130

@@ -6,7 +6,7 @@ import argparse
 import math
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import TYPE_CHECKING, Any, NoReturn, TypeAlias
 
 if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
     from _typeshed import SupportsWrite
@@ -138,6 +138,12 @@ class Parser(argparse.ArgumentParser):
         """argparse's help, then the examples as they are typed."""
         shown = "".join(f"  $ {example}\n" for example in self.examples)
         return super().format_help() + (f"\nexamples:\n{shown}" if shown else "")
+
+    def error(self, message: str) -> NoReturn:
+        """argparse's, with a long word of the message (a 10 kB URL) cut short."""
+        from appmode.text import shortened
+
+        super().error(shortened(message))
 
     def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
         """As argparse's, but a write that fails (a full disk, a closed pipe) is not passed

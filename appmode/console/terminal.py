@@ -9,6 +9,7 @@ command line — merged as prompt_toolkit's own full-screen examples do.
 from __future__ import annotations
 
 import asyncio
+import os
 import time
 from contextlib import suppress
 
@@ -190,11 +191,14 @@ class Console:
         @keys.add("enter", filter=typing)
         def _run(event: KeyPressEvent) -> None:
             text = command.text
-            if not is_quit(text):  # never one ↑ and Enter away
-                command.append_to_history()
             command.reset()
             event.app.layout.focus(self.status)
+            failures = self.session.failures
             self.run_line(text)
+            # kept if the session took it: never a refused line (a paste of 100 kB), never
+            # quit (one ↑ and Enter away)
+            if self.session.failures == failures and text.strip() and not is_quit(text):
+                command.history.append_string(text)
 
         return keys
 
@@ -323,7 +327,8 @@ def command_history() -> History:
     try:
         folder.mkdir(parents=True, exist_ok=True)
         path = folder / "history"
-        path.touch()
+        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600))
+        os.chmod(path, 0o600)  # what was typed is the user's own (older copies: 0644)
     except OSError:
         return InMemoryHistory()
     return FileHistory(str(path))

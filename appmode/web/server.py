@@ -193,7 +193,7 @@ class WebServer:
         if request.path == "/" and "token" in request.query:
             if not token_matches(self.token, request.query.get("token")):
                 return _refused("wrong token: open the address appmode web printed")
-            found = web.HTTPSeeOther("/")  # the token leaves the address bar
+            found = web.HTTPSeeOther("/", headers=HEADERS)  # the token leaves the address bar
             found.set_cookie(
                 COOKIE,
                 self.token,

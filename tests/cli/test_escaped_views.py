@@ -79,3 +79,14 @@ def test_conform_shows_a_suite_s_file_names_escaped(tmp_path: Path) -> None:
     assert done.returncode == 1, done.stderr
     assert clean(done.stdout + done.stderr), repr(done.stdout)
     assert "FAIL" in done.stdout and "ok\\x1b]0;owned\\x07\\x1b[2K.transcript" in done.stdout
+
+
+@pytest.mark.parametrize(
+    "url", ["/dev/{long}", "zenoh://{long}", "socket://{long}:1", "sim://?{long}=1", "{long}"]
+)
+def test_a_10_kb_url_is_named_in_an_error_not_echoed(url: str) -> None:
+    """Issue 64.12: an error repeated a 10 kB URL in full, twice."""
+    done = run("params", url.replace("{long}", "a" * 10_000), timeout=20)
+    assert done.returncode == 2
+    assert len(done.stderr) < 600 and done.stderr.count("\n") == 1, done.stderr[:300]
+    assert "(10," in done.stderr, "its length is said"

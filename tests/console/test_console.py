@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -292,6 +293,23 @@ def test_caps_lock_q_drives_front_left_and_does_not_quit(tmp_path: Path) -> None
     _, record, _ = run_console(tmp_path, [("Q", 0.3), (" ", 0.3), (CTRL_C, 0.0)])
     payloads = [p for _, p in sent(record)]
     assert payloads.count("H") == 1 and payloads[-1] == "Z"
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX file modes")
+def test_history_keeps_no_refused_line_and_is_the_user_s_own(
+    tmp_path: Path, private_data_folder: Path
+) -> None:
+    """Issue 64.12: a refused 100 KB line was saved (mode 0644) and recalled next time."""
+    pasted = "set max_speed " + "9" * 100_000
+    keys = [(":", 0.1), ("fly away\r", 0.3), (":", 0.1), (pasted + "\r", 0.5)]
+    keys += [(":", 0.1), ("latch on\r", 0.3), (CTRL_C, 0.0)]
+    session, _, _ = run_console(tmp_path, keys)
+    assert session.failures == 2, session.messages
+    path = private_data_folder / "appmode" / "history"
+    history = path.read_text()
+    assert "+latch on" in history
+    assert "fly" not in history and "9999" not in history
+    assert path.stat().st_mode & 0o777 == 0o600
 
 
 def test_history_is_kept_across_sessions_without_quit(

@@ -103,6 +103,8 @@ def test_every_route_needs_the_token_and_the_server_s_own_host(tmp_path: Path) -
         set_cookie = headers["Set-Cookie"]
         assert f"appmode_token={web.token}" in set_cookie
         assert "HttpOnly" in set_cookie and "SameSite=Strict" in set_cookie
+        assert headers["Cache-Control"] == "no-store", "the token's answer is never kept"
+        assert headers["Referrer-Policy"] == "no-referrer"
         code, headers, body = get(web.origin + "/", cookie(web))
         assert code == 200 and 'aria-label="forward"' in body
         assert "default-src 'self'" in headers["Content-Security-Policy"]
