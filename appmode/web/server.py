@@ -43,8 +43,10 @@ HEADER_TIMEOUT = 10.0
 """Seconds a connection may take to send a whole request (aiohttp's keep-alive timeout
 also closes a connection whose first request never completes)."""
 MAX_CONNECTIONS = 64
-"""Connections served at once: more are closed as they come (a flood of half-sent
-requests would otherwise use up the server's open files and lock its owner out)."""
+"""Connections served at once. Past them the oldest connection that has not yet made a
+request with the token is closed (the newcomer, if every other one has): a flood of
+half-sent requests churns, and can neither use up the server's open files nor lock its
+owner out."""
 REFRESH = 0.02
 """Seconds between reads of the link (and checks of the heartbeat)."""
 SEND = 0.1
@@ -116,6 +118,8 @@ class WebServer:
         self.port = port
         self.token = token or new_token()
         self._sockets: set[web.WebSocketResponse] = set()
+        self._owners: set[object] = set()
+        """The connections (aiohttp's handlers) that made a request with the token."""
         self._runner: web.AppRunner | None = None
         self.app = web.Application(middlewares=[self._guard], client_max_size=MAX_MESSAGE)
         self.fleet = None if fleet is None else FleetRoutes(self, fleet)
@@ -137,7 +141,11 @@ class WebServer:
     async def start(self) -> None:
         """Listen (port 0 picks a free one: `port` then says which)."""
         self._runner = _CappedRunner(
-            self.app, access_log=None, handle_signals=False, keepalive_timeout=HEADER_TIMEOUT
+            self._owners,
+            self.app,
+            access_log=None,
+            handle_signals=False,
+            keepalive_timeout=HEADER_TIMEOUT,
         )
         await self._runner.setup()
         site = web.TCPSite(
@@ -206,6 +214,7 @@ class WebServer:
             return found
         if not token_matches(self.token, request.cookies.get(COOKIE)):
             return _refused("no token: open the address appmode web printed, with its token")
+        self._owners.add(request.protocol)
         response = await handler(request)
         response.headers.update(HEADERS)
         return response
@@ -292,16 +301,28 @@ class WebServer:
 
 
 class _CappedRunner(web.AppRunner):
-    """An AppRunner whose server closes connections past MAX_CONNECTIONS at once."""
+    """An AppRunner whose server, past MAX_CONNECTIONS, closes the oldest connection not
+    in `owners` (those that made a request with the token)."""
+
+    def __init__(self, owners: set[object], *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._owners = owners
 
     async def _make_server(self) -> web.Server:
         server = await super()._make_server()
-        made = server.connection_made
+        made, owners = server.connection_made, self._owners
 
         def connection_made(handler: Any, transport: asyncio.Transport) -> None:
             made(handler, transport)
-            if len(server.connections) > MAX_CONNECTIONS:
-                transport.close()
+            connections = server.connections  # oldest first
+            if len(connections) <= MAX_CONNECTIONS:
+                return
+            owners.intersection_update(connections)  # forget those that ended
+            for stranger in connections:  # at worst the newcomer, `handler`
+                ending = stranger.transport is None or stranger.transport.is_closing()
+                if stranger not in owners and not ending:
+                    stranger.transport.close()
+                    return
 
         server.connection_made = connection_made  # type: ignore[method-assign]
         return server

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import socket
+import threading
 import time
 from pathlib import Path
 
@@ -19,7 +20,7 @@ import pytest
 from appmode.web.server import HEADER_TIMEOUT, MAX_CONNECTIONS
 from tests.support.web import WebProcess, web_process
 from tests.web.test_https import insecure, local
-from tests.web.test_server import get
+from tests.web.test_server import cookie, get
 
 
 def port_of(web: WebProcess) -> int:
@@ -106,6 +107,45 @@ def test_connections_past_the_cap_are_closed_and_half_sent_requests_time_out(
                 assert survivor.recv(4096) == b""  # closed by the server
             assert time.monotonic() - started < HEADER_TIMEOUT + 5
         finally:
+            for conn in held:
+                conn.close()
+
+
+@pytest.mark.slow
+def test_the_owner_gets_in_beside_300_slow_clients(tmp_path: Path) -> None:
+    """Issue 64.11: at the cap the newcomer was refused, so 300 half-sent requests locked
+    the owner out; now the oldest connection without the token goes, and the slow ones
+    churn while the owner's page loads."""
+    with web_process(tmp_path) as web:
+        held: list[socket.socket] = []
+        stop = threading.Event()
+
+        def slow_client() -> None:
+            conn = socket.create_connection(("127.0.0.1", port_of(web)), timeout=5)
+            conn.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never ends
+            held.append(conn)
+
+        def churn() -> None:
+            while not stop.wait(0.01):
+                with contextlib.suppress(OSError):
+                    slow_client()
+
+        try:
+            for _ in range(300):
+                slow_client()
+            churning = threading.Thread(target=churn, daemon=True)
+            churning.start()
+            started = time.monotonic()
+            code, _, body = get(web.origin + "/", cookie(web))
+            took = time.monotonic() - started
+            assert code == 200 and 'aria-label="forward"' in body
+            assert took < 5, took
+            stop.set()
+            churning.join(5)
+            time.sleep(0.3)
+            assert sum(not is_closed(conn) for conn in held) <= MAX_CONNECTIONS
+        finally:
+            stop.set()
             for conn in held:
                 conn.close()
 
