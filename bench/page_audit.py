@@ -18,14 +18,42 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 TARGETS = {"performance": 95, "accessibility": 100, "best-practices": 100, "seo": 100}
 CHROMIUM = "/usr/bin/chromium"
 TABS = ("drive", "tilt", "params", "waves")
 
 
+RUNS = 3
+"""Lighthouse runs; each category's median counts, as Lighthouse's docs advise for a
+score that varies from run to run with the machine's load."""
+
+
 def lighthouse(tool: str, url: str) -> list[str]:
-    """Lighthouse's scores, printed; what misses its target."""
+    """Lighthouse's scores (the median of RUNS runs), printed; what misses its target."""
+    results = sorted(
+        (_lighthouse_once(tool, url) for _ in range(RUNS)),
+        key=lambda result: result["categories"]["performance"]["score"],
+    )
+    audits = results[RUNS // 2]["audits"]  # the run of the median performance
+    metrics = ("first-contentful-paint", "largest-contentful-paint", "total-blocking-time")
+    shown = [
+        f"{audits[m]['title']} {audits[m]['displayValue']}"
+        for m in (*metrics, "cumulative-layout-shift", "speed-index")
+    ]
+    print("lighthouse metrics (the median run): " + ", ".join(shown))
+    missed = []
+    for name, target in TARGETS.items():
+        scores = sorted(round(r["categories"][name]["score"] * 100) for r in results)
+        score = scores[RUNS // 2]
+        print(f"lighthouse {name}: {score} (target {target}; runs {scores})")
+        if score < target:
+            missed.append(f"lighthouse {name} {score} < {target}")
+    return missed
+
+
+def _lighthouse_once(tool: str, url: str) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as folder:
         report = Path(folder) / "report.json"
         subprocess.run(
@@ -42,21 +70,8 @@ def lighthouse(tool: str, url: str) -> list[str]:
             check=True,
             timeout=300,
         )
-        result = json.loads(report.read_text())
-    categories, audits = result["categories"], result["audits"]
-    metrics = ("first-contentful-paint", "largest-contentful-paint", "total-blocking-time")
-    shown = [
-        f"{audits[m]['title']} {audits[m]['displayValue']}"
-        for m in (*metrics, "cumulative-layout-shift", "speed-index")
-    ]
-    print("lighthouse metrics: " + ", ".join(shown))
-    missed = []
-    for name, target in TARGETS.items():
-        score = round(categories[name]["score"] * 100)
-        print(f"lighthouse {name}: {score} (target {target})")
-        if score < target:
-            missed.append(f"lighthouse {name} {score} < {target}")
-    return missed
+        result: dict[str, Any] = json.loads(report.read_text())
+    return result
 
 
 def axe(script: str, url: str, port: str) -> list[str]:

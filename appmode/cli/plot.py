@@ -25,7 +25,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.transcript.dump import run_plot
+    from appmode.transcript.plot import run_plot
 
     run_plot(args.file, args.output, args.profile)
     print(f"wrote {args.output}", file=sys.stderr)

@@ -360,7 +360,7 @@ def test_replay_to_a_new_pty_feeds_the_app_that_opens_it(tmp_path: Path) -> None
 
 
 def test_command_labels_close_in_time_share_one_label() -> None:
-    from appmode.transcript.dump import command_labels
+    from appmode.transcript.plot import command_labels
 
     commands = [(0.0, "J"), (0.004, "{Q:P}"), (0.5, "B"), (0.502, "C"), (0.503, "D"), (1.0, "Z")]
     assert command_labels(commands, 0.01) == [(0.0, "J {Q:P}"), (0.5, "B C D"), (1.0, "Z")]
@@ -379,10 +379,10 @@ def test_plot_draws_a_uart2_transcript_s_encoder_reports(tmp_path: Path) -> None
 
 
 def test_plot_s_title_is_whole_and_its_labels_stand_apart() -> None:
-    from appmode.transcript.dump import _title
+    from appmode.transcript.plot import _title
     from appmode.transcript.reading import read_transcript
 
     path = ROOT / "transcripts" / "suite" / "s4_letters_omni.transcript"
-    title = _title(str(path), read_transcript(path))
+    title = _title(str(path), read_transcript(path).title)
     assert all(len(line) <= 110 for line in title.splitlines())
     assert not title.endswith(","), "a title cut at a comma reads as clipped"
