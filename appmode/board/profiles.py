@@ -7,6 +7,7 @@ reference firmware as measured (§13). A third board is a third row.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -287,25 +288,70 @@ def from_file(file: ProfileFile) -> Profile:
     )
 
 
-def shipped_profile(name: str) -> Profile:
-    """A profile appmode ships, by name (what a transcript may name: never a file)."""
-    if name not in profile_file.SHIPPED:
-        raise AppmodeError(
-            f"unknown board profile {name!r}: choose one of {', '.join(profile_file.SHIPPED)}"
-        )
-    return profile_named(name)
+_USERS: dict[str, Profile] = {}
+"""The users' profile files read in this run, by their name: a recording that names one
+(with its digest) reads back with it."""
 
 
 @cache
 def profile_named(name: str) -> Profile:
-    """The profile called `name` (a modelled one, a shipped profile file's, or a file at
-    that path); AppmodeError says what is wrong, one line."""
+    """The profile called `name` (a modelled one, a shipped profile file's, a user's file
+    read before under that name, or a file at that path); AppmodeError says what is
+    wrong, one line."""
     if name in PROFILES:
         return PROFILES[name]
+    if name in _USERS:
+        return _USERS[name]
     try:
-        return from_file(load(name))
+        profile = from_file(load(name))
     except ProfileError as exc:
         raise AppmodeError(str(exc).replace("\n", "; ")) from None
+    if profile.name not in profile_file.SHIPPED:
+        _USERS[profile.name] = profile
+    return profile
+
+
+def digest(profile: Profile) -> str | None:
+    """A user's profile file's digest (the first 16 hex digits of its text's SHA-256),
+    which a recording keeps beside its name; None for what appmode ships."""
+    if profile.file is None or profile.name in profile_file.SHIPPED:
+        return None
+    return hashlib.sha256(profile.file.text.encode()).hexdigest()[:16]
+
+
+def board_line(profile: Profile, drive: str | None = None) -> tuple[str, ...]:
+    """A recording's `@board` directive: the profile by name (a user's file by its digest
+    too) and the drive type, as a replay needs them; none for the sheet's defaults."""
+    words = [] if profile is SHEET else [f"profile={profile.name}"]
+    made = digest(profile)
+    words += [f"digest={made}"] if made else []
+    words += [f"drive={drive}"] if drive else []
+    return (f"board {' '.join(words)}",) if words else ()
+
+
+def recorded_profile(name: str, recorded: str | None) -> Profile:
+    """The profile a recording's `@board profile=NAME digest=…` names: a shipped one, or
+    the user's file of that name and digest given in this run (--profile FILE)."""
+    if recorded is None and name in profile_file.SHIPPED:
+        return profile_named(name)
+    user = _USERS.get(name)
+    if user is None and recorded is None:
+        raise AppmodeError(
+            f"unknown board profile {name!r}: choose one of "
+            f"{', '.join(profile_file.SHIPPED)}, or give its profile file with --profile FILE"
+        )
+    if user is None:
+        raise AppmodeError(
+            f"profile={name} is a profile file's (digest {recorded}): give that file with "
+            "--profile FILE"
+        )
+    if recorded is not None and digest(user) != recorded:
+        raise AppmodeError(
+            f"profile={name} was recorded with a file of digest {recorded}, and the "
+            f"{name} given has {digest(user)}: give the file it was recorded with (or "
+            "change the digest in the @board line)"
+        )
+    return user
 
 
 @cache

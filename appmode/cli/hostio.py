@@ -10,6 +10,7 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import ExitStack, closing
 from typing import TYPE_CHECKING, TextIO, TypeVar
 
+from appmode.board.profiles import board_line
 from appmode.host.app.client import Event, Host
 from appmode.host.app.query import QueryDone
 from appmode.host.control.client import ControlHost
@@ -52,7 +53,12 @@ def with_recording(stack: ExitStack, host: H, record: str | None, view: Viewer |
     live `view` (`--foxglove`) is fed the same bytes."""
     try:
         recorder = (
-            open_recorder(record, 0.0, host.target.directives, layout=host.profile.a_layout)
+            open_recorder(
+                record,
+                0.0,
+                board_line(host.profile, host.target.sim_drive),
+                layout=host.profile.a_layout,
+            )
             if record
             else None
         )

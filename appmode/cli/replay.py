@@ -6,7 +6,7 @@ import argparse
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.live_view import add_foxglove, live_view
-from appmode.cli.options import DAY, Subparsers, file_name, number_type
+from appmode.cli.options import DAY, Subparsers, add_profile, file_name, number_type
 from appmode.errors import AppmodeError
 
 
@@ -61,11 +61,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     replay.add_argument(
         "-v", "--verbose", action="store_true", help="print each line as it is played"
     )
+    add_profile(replay, default=None, unset="the transcript's @board profile=…, else sheet")
     add_foxglove(replay, "the transcript")
     return replay
 
 
 def run(args: argparse.Namespace) -> int:
+    from appmode.board.profiles import profile_named
     from appmode.transcript.dump import needs_of
     from appmode.transcript.replay import run_replay
 
@@ -76,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.to is None and args.foxglove is None:
         raise AppmodeError("replay needs --to URL (a port to play to), --foxglove PORT, or both")
-    layout = needs_of(args.file, lambda text: None).profile.a_layout
+    given = profile_named(args.profile) if args.profile else None  # a file @board may name
+    layout = (given or needs_of(args.file, lambda text: None).profile).a_layout
     with live_view(args.foxglove, layout) as view:
         return run_replay(
             args.file,

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import TypeVar
 
 from appmode.board.firmware import Board
-from appmode.board.profiles import SHEET, Profile
+from appmode.board.profiles import SHEET, Profile, board_line
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import Faults, FaultSpec
@@ -330,9 +330,7 @@ class ServeOptions:
     @property
     def directives(self) -> tuple[str, ...]:
         """The recording's `@board` line: what a replay needs of the board."""
-        needs = [f"profile={self.profile.name}"] if self.profile is not SHEET else []
-        needs += [f"drive={self.drive.cli_name}"] if self.drive else []
-        return (f"board {' '.join(needs)}",) if needs else ()
+        return board_line(self.profile, self.drive.cli_name if self.drive else None)
 
 
 def run_board(options: ServeOptions, view: Tap | None = None) -> int:

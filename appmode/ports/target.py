@@ -111,12 +111,9 @@ class Target:
         return self.sim.get("profile")
 
     @property
-    def directives(self) -> tuple[str, ...]:
-        """Transcript directives that describe a sim:// board, to replay its sessions."""
-        needs = " ".join(
-            f"{key}={self.sim[key]}" for key in ("profile", "drive") if key in self.sim
-        )
-        return (f"board {needs}",) if needs else ()
+    def sim_drive(self) -> str | None:
+        """The drive type a sim:// URL names (as the command line spells it)."""
+        return self.sim.get("drive")
 
     def with_sim(self, **options: str | None) -> Target:
         """A sim:// target with `options` where it sets none (a command's `--profile` and

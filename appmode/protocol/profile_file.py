@@ -120,10 +120,12 @@ def shipped(name: str) -> ProfileFile:
     if name not in SHIPPED:
         raise ProfileError(name, [f"no shipped profile: choose one of {', '.join(SHIPPED)}"])
     text = resources.files(__package__).joinpath("profiles", f"{name}.toml").read_text("utf-8")
-    return parse(text, f"{name} (shipped)")
+    return parse(text, f"{name} (shipped)", ours=True)
 
 
-def parse(text: str, where: str) -> ProfileFile:
+def parse(text: str, where: str, ours: bool = False) -> ProfileFile:
+    """A profile file's text checked and read (`ours`: one appmode ships, whose name
+    is one of SHIPPED; a user's may not take those names)."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -139,6 +141,11 @@ def parse(text: str, where: str) -> ProfileFile:
         else:
             base = shipped(like)
     profile = _build(data, base, where, problems.append)
+    if profile is not None and profile.name in SHIPPED and not ours:
+        problems.append(
+            f"name = {profile.name!r}: a shipped profile's name (a recording would name that "
+            "firmware): call yours something else"
+        )
     if problems or profile is None:
         raise ProfileError(where, problems)
     return profile._replace(text=text)

@@ -55,8 +55,8 @@ def uart2_bytes(payload: str) -> tuple[bytes, bytes] | None:
 # ---------------------------------------------------------------- reading
 
 DIRECTIVES = {
-    "board": "the board under test: @board profile=sheet|minibalance "
-    "drive=omni|mecanum|diff|diff-gyro start=power-up",
+    "board": "the board under test: @board profile=sheet|minibalance|balance|NAME "
+    "digest=… drive=omni|mecanum|diff|diff-gyro start=power-up",
     "tolerance": "how early or late a '<' line may be matched, in seconds: @tolerance 0.3",
     "strict": "@strict on: every record must match the next '<' line (none ignored)",
     "align": "@align: time the '<' lines after the next one from when it is matched",

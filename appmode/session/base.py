@@ -13,6 +13,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from appmode.board.profiles import board_line
 from appmode.errors import AppmodeError
 from appmode.host import signals
 from appmode.host.link import UNDELIVERED, Link
@@ -343,7 +344,10 @@ class BaseSession(ABC):
         try:
             start = self.now() if origin is None else origin
             recorder = open_recorder(
-                path, start, self.target.directives, layout=self.host.profile.a_layout
+                path,
+                start,
+                board_line(self.host.profile, self.target.sim_drive),
+                layout=self.host.profile.a_layout,
             )
         except AppmodeError as exc:
             if self.recorder is None:

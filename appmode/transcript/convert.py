@@ -34,8 +34,9 @@ def run_convert(source: str, output: str, profile: str | None, partial: bool) ->
     def warn(text: str) -> None:
         print(f"appmode: WARNING: {text}", file=sys.stderr)
 
+    given = profile_named(profile) if profile else None  # a file the @board line may name
     needs = needs_of(source, lambda text: None, partial=partial)
-    layout = (profile_named(profile) if profile else needs.profile).a_layout
+    layout = (given or needs.profile).a_layout
     items = iter_lines(source, warn, partial=partial)
     to_mcap = output.lower().endswith(".mcap")
     counted: list[int] = []

@@ -92,8 +92,9 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
     """Print every event; A records named as `profile` lays them out (default: the
     transcript's `@board profile=…`, else the sheet's)."""
     say_if_fifo(path)
+    given = profile_named(profile) if profile else None  # a file the @board line may name
     needs = needs_of(path, lambda text: None)  # the second pass warns
-    layout = (profile_named(profile) if profile else needs.profile).a_layout
+    layout = (given or needs.profile).a_layout
     if fmt == "csv":
         fields = ("t", "dir", *json_keys(layout))
         writer = csv.DictWriter(out, fieldnames=fields, extrasaction="ignore")

@@ -24,7 +24,7 @@ import bisect
 import re
 from dataclasses import dataclass, field
 
-from appmode.board.profiles import SHEET, Profile, shipped_profile
+from appmode.board.profiles import SHEET, Profile, recorded_profile
 from appmode.errors import AppmodeError, InvalidValue
 from appmode.line.wire import APP as APP_PORT
 from appmode.line.wire import UART2 as UART2_PORT
@@ -322,18 +322,19 @@ def _expected(entry: Entry, path: str) -> Pattern | BytesPattern | None:
 
 
 def board_needs(args: tuple[str, ...], where: str) -> BoardNeeds:
-    """`@board profile=minibalance drive=omni start=power-up` (each part optional)."""
+    """`@board profile=minibalance drive=omni start=power-up` (each part optional; a
+    user's profile file is named with its `digest=`)."""
     found: dict[str, str] = {}
     for arg in args:
         key, _, value = arg.partition("=")
-        if key not in ("profile", "drive", "start") or key in found:
+        if key not in ("profile", "digest", "drive", "start") or key in found:
             raise AppmodeError(
-                f"{where}: @board takes profile=…, drive=… and start=power-up, once each, "
-                f"not {arg!r}"
+                f"{where}: @board takes profile=…, digest=…, drive=… and start=power-up, "
+                f"once each, not {arg!r}"
             )
         found[key] = value
     try:
-        profile = shipped_profile(found.get("profile", "sheet"))
+        profile = recorded_profile(found.get("profile", "sheet"), found.get("digest"))
         drive = DriveType.from_cli_name(found["drive"]) if "drive" in found else None
         profile.check(drive=drive is not None, flash=False)
     except (AppmodeError, ValueError) as exc:

@@ -102,8 +102,9 @@ def run_plot(path: str, output: str, profile: str | None = None) -> int:
             "appmode plot needs matplotlib: pip install matplotlib (or, in a checkout of "
             "appmode, pip install '.[plot]')"
         ) from None
+    given = profile_named(profile) if profile else None  # a file the @board line may name
     needs = needs_of(path, lambda text: None)  # the second pass warns
-    layout = (profile_named(profile) if profile else needs.profile).a_layout
+    layout = (given or needs.profile).a_layout
     read, seen, wheels = _Read(path), _Telemetry(layout), _Wheels()
     for t, direction, event in decoded(read.items(), needs.drive, path, layout):
         if isinstance(event, (app.Velocity, app.Attitude, app.OtherRecord)):

@@ -17,7 +17,7 @@ def test_each_kind_of_url_is_told_apart() -> None:
     assert parse_target("ble://HC-08").radio and parse_target("bt://02:CA:40:00:00:05").radio
     sim = parse_target("sim://?profile=minibalance&drive=diff&port=uart2")
     assert sim.simulated and sim.profile == "minibalance" and sim.sim_port == "uart2"
-    assert sim.directives == ("board profile=minibalance drive=diff",)
+    assert sim.sim_drive == "diff"
     assert str(sim) == sim.url
 
 

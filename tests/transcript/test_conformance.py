@@ -135,7 +135,7 @@ def test_ranges_match_from_low_to_high() -> None:
     [
         ("@tolerance soon", "@tolerance takes seconds"),
         ("@strict maybe", "@strict takes on"),
-        ("@board wheels=3", "@board takes profile=…, drive=…"),
+        ("@board wheels=3", "@board takes profile=…, digest=…, drive=…"),
         ("@board profile=tiny", "unknown board profile 'tiny'"),
         ("@board profile=minibalance drive=omni", "has no drive types"),
         ("@board drive=tank", "unknown drive type"),
