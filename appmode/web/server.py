@@ -319,9 +319,9 @@ class _CappedRunner(web.AppRunner):
                 return
             owners.intersection_update(connections)  # forget those that ended
             for stranger in connections:  # at worst the newcomer, `handler`
-                ending = stranger.transport is None or stranger.transport.is_closing()
-                if stranger not in owners and not ending:
-                    stranger.transport.close()
+                link = stranger.transport
+                if stranger not in owners and link is not None and not link.is_closing():
+                    link.close()
                     return
 
         server.connection_made = connection_made  # type: ignore[method-assign]
