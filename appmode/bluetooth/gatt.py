@@ -73,9 +73,12 @@ class Characteristic(ServiceInterface):
         service: str,
         received: Callable[[bytes, str], None],
         subscribed: Callable[[bool], None] = lambda on: None,
+        secured: list[str] | None = None,
     ) -> None:
         super().__init__("org.bluez.GattCharacteristic1")
         self._uuid, self._service = uuid, service
+        self._flags = FLAGS + (secured or [])
+        """FLAGS, and what makes BlueZ require pairing (`secured`)."""
         self._received, self._subscribed = received, subscribed
         self._value = b""
         self.notifying = False
@@ -98,7 +101,7 @@ class Characteristic(ServiceInterface):
 
     @dbus_property(access=PropertyAccess.READ)
     def Flags(self) -> DBusStrings:
-        return FLAGS
+        return self._flags
 
     @dbus_method()
     def ReadValue(self, options: DBusDict) -> DBusBytes:

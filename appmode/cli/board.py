@@ -9,7 +9,14 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.live_view import add_foxglove, live_view
-from appmode.cli.options import Subparsers, add_profile, add_record, file_name, number_type
+from appmode.cli.options import (
+    Subparsers,
+    add_admission,
+    add_profile,
+    add_record,
+    file_name,
+    number_type,
+)
 from appmode.errors import AppmodeError
 from appmode.protocol.params import DRIVE_NAMES
 
@@ -126,6 +133,7 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         action="store_true",
         help="with --advertise: offer the Nordic UART service instead of FFE0/FFE1",
     )
+    add_admission(board)
     board.add_argument(
         "--baud",
         type=number_type(300, 4_000_000, whole=True),
@@ -159,8 +167,10 @@ def run(args: argparse.Namespace) -> int:
             "with --listen, --port, --bluetooth, --advertise, --listen2, --port2, --link, "
             "--flash, --record or --foxglove"
         )
-    if args.nus and args.advertise is None:
-        raise AppmodeError("--nus is an option of --advertise: add --advertise [NAME]")
+    if (args.nus or args.allow or args.secure) and args.advertise is None:
+        raise AppmodeError(
+            "--nus, --allow and --secure are options of --advertise: add --advertise [NAME]"
+        )
     options = ServeOptions(
         app=_app_endpoint(args),
         uart2=_uart2_endpoint(args),
@@ -191,11 +201,15 @@ def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
     if args.bluetooth:
         return partial(_bluetooth("--bluetooth").BluetoothEndpoint, baud=args.baud)
     if args.advertise is not None:
+        from appmode.bluetooth.advertise.admission import Admission
         from appmode.bluetooth.uuids import UART_SERVICES
 
         endpoint = _bluetooth("--advertise").AdvertisedEndpoint
         service = UART_SERVICES[1 if args.nus else 0]
-        return partial(endpoint, name=args.advertise, service=service, baud=args.baud)
+        admission = Admission(frozenset(args.allow or ()), args.secure)
+        return partial(
+            endpoint, name=args.advertise, service=service, baud=args.baud, admission=admission
+        )
     return partial(endpoints.PtyEndpoint, link=args.link, baud=args.baud)
 
 

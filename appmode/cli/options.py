@@ -74,6 +74,33 @@ ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {
 FROM_URL = "a sim:// URL's profile, else sheet"
 
 
+def add_admission(parser: argparse.ArgumentParser) -> None:
+    """`--allow ADDRESS` and `--secure`: which phones an advertised module takes."""
+
+    def address(text: str) -> str:
+        from appmode.bluetooth.advertise.admission import addresses
+
+        try:
+            return addresses(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parser.add_argument(
+        "--allow",
+        action="append",
+        type=address,
+        metavar="ADDRESS",
+        help="with an advertised module: take only this phone (its Bluetooth address; "
+        "again for more); any other's writes and links are refused",
+    )
+    parser.add_argument(
+        "--secure",
+        action="store_true",
+        help="with an advertised module: take only phones paired (bonded) with this "
+        "machine; BlueZ asks the phone to pair before its first write",
+    )
+
+
 def add_profile(
     parser: argparse.ArgumentParser,
     what: str = A_RECORD,

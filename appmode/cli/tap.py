@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, file_name
+from appmode.cli.options import Subparsers, add_admission, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -32,6 +32,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="with advertise: offer the Nordic UART service instead of FFE0/FFE1",
     )
+    add_admission(tap)
     tap.add_argument("--quiet", "-q", action="store_true", help="no status lines")
     return tap
 
@@ -39,4 +40,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from appmode.transcript.tap import run_tap
 
-    return run_tap(args.app, args.board, args.record, args.quiet, args.nus)
+    admission = None
+    if args.allow or args.secure:
+        from appmode.bluetooth.advertise.admission import Admission
+
+        admission = Admission(frozenset(args.allow or ()), args.secure)
+    return run_tap(args.app, args.board, args.record, args.quiet, args.nus, admission)

@@ -17,6 +17,7 @@ from typing import Protocol
 
 import serial
 
+from appmode.bluetooth.advertise.admission import ANY_PHONE, Admission
 from appmode.errors import AppmodeError
 from appmode.line.pacing import Ahead
 from appmode.ports.recording import open_recorder
@@ -53,7 +54,7 @@ ADVERTISE = "advertise"
 ADVERTISED_NAME = "HC-08"
 
 
-def _app_side(app_url: str, nus: bool, quiet: bool) -> Stream:
+def _app_side(app_url: str, nus: bool, quiet: bool, admission: Admission | None) -> Stream:
     """The app's side, open; its address printed as `port: …` when tap made it."""
     if app_url == "pty":
         pty_port = new_pty()
@@ -81,16 +82,29 @@ def _app_side(app_url: str, nus: bool, quiet: bool) -> Stream:
         if not quiet:
             print(f"tap: {text}", file=sys.stderr, flush=True)
 
-    port = AdvertisedPort(name, UART_SERVICES[1 if nus else 0], log, READ_TIMEOUT)
+    admitted = admission or ANY_PHONE
+    port = AdvertisedPort(name, UART_SERVICES[1 if nus else 0], log, READ_TIMEOUT, admitted)
+    if (warning := admitted.warning(name)) is not None:  # said once it is on the air
+        print(f"tap: {warning}", file=sys.stderr, flush=True)
     print(f"port: ble://{name}", flush=True)
     return port
 
 
-def run_tap(app_url: str, board_url: str, record: str, quiet: bool, nus: bool = False) -> int:
-    """Forward until interrupted or a side leaves, recording both directions."""
-    if nus and not app_url.startswith(ADVERTISE):
-        raise AppmodeError("--nus is for an advertised app side: tap advertise[:NAME] …")
-    app = _app_side(app_url, nus, quiet)
+def run_tap(
+    app_url: str,
+    board_url: str,
+    record: str,
+    quiet: bool,
+    nus: bool = False,
+    admission: Admission | None = None,
+) -> int:
+    """Forward until interrupted or a side leaves, recording both directions; an
+    advertised app side takes the phones `admission` admits (default: any)."""
+    if (nus or admission) and not app_url.startswith(ADVERTISE):
+        raise AppmodeError(
+            "--nus, --allow and --secure are for an advertised app side: tap advertise[:NAME] …"
+        )
+    app = _app_side(app_url, nus, quiet, admission)
     try:
         board = open_link(board_url, timeout=READ_TIMEOUT)
     except BaseException:

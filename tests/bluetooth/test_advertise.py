@@ -51,6 +51,8 @@ PHONE = textwrap.dedent(
         got = bytearray()
         client = BleakClient(device)
         await client.connect()
+        if how == "pair":
+            await client.pair()
         await client.start_notify(UART, lambda _, data: got.extend(data))
         send = lambda data: client.write_gatt_char(UART, data, response=False)
         await send(b"{Q:P}")
@@ -136,6 +138,49 @@ def test_a_bleak_program_finds_the_advertised_car_reads_sets_and_drives_it(
     assert sent_lines(record) == ["{Q:P}", "{1:1234}", "{Q:P}", "A", "Z"]
     assert "a phone subscribed" in err and "the phone unsubscribed or left" in err
     assert car_heard(appmode_ble_board) == []  # the other car heard nothing
+    assert f"WARNING: the module {NAME} takes any phone in range" in err
+
+
+@pytest.mark.parametrize(
+    ("admission", "how", "taken"),
+    [
+        (("--allow", "11:22:33:44:55:66"), "drive", False),
+        (("--allow", "02:ca:40:00:00:01", "--allow", "11:22:33:44:55:66"), "drive", True),
+        (("--secure",), "drive", False),
+        (("--secure",), "pair", True),
+    ],
+    ids=["a stranger", "an allowed phone", "unpaired", "paired"],
+)
+def test_an_advertised_module_takes_only_the_phones_it_is_told_to(
+    appmode_ble_board: ServedBoard,
+    phone: Path,
+    tmp_path: Path,
+    admission: tuple[str, ...],
+    how: str,
+    taken: bool,
+) -> None:
+    """Issue 64.4: any phone in range could drive the car. The stand-in's central is
+    02:CA:40:00:00:01; it pairs when the phone calls Pair."""
+    record = tmp_path / "advertised.transcript"
+    with board_process("--advertise", NAME, *admission, "--record", str(record)) as board:
+        done = run_phone(phone, how)
+        err = board.stop(signal.SIGINT)
+    assert "WARNING" not in err
+    if taken:
+        assert done.returncode == 0, done.stderr
+        assert sent_lines(record) == ["{Q:P}", "{1:1234}", "{Q:P}", "A", "Z"]
+    else:
+        assert done.returncode != 0 and "not heard in time" in done.stderr
+        assert sent_lines(record) == [], "the board heard nothing of that phone"
+
+
+def test_tap_advertise_warns_of_any_phone_and_refuses_options_elsewhere(tmp_path: Path) -> None:
+    done = run("tap", "pty", "sim://", "--allow", "11:22:33:44:55:66", "--record",
+               str(tmp_path / "t.transcript"))  # fmt: skip
+    assert done.returncode == 2
+    assert "--allow and --secure are for an advertised app side" in done.stderr
+    bad = run("board", "--advertise", NAME, "--allow", "not-an-address")
+    assert bad.returncode == 2 and "is not a Bluetooth address" in bad.stderr
 
 
 def test_scan_lists_the_advertised_module_and_params_reach_it_over_spp_and_ble(

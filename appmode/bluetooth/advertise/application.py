@@ -26,6 +26,7 @@ from dbus_fast.annotations import DBusDict, DBusObjectPath, DBusStr, DBusUnixFd
 from dbus_fast.constants import PropertyAccess
 from dbus_fast.service import ServiceInterface, dbus_method, dbus_property
 
+from appmode.bluetooth.advertise.admission import ANY_PHONE, SECURE_FLAGS, Admission
 from appmode.bluetooth.availability import explain
 from appmode.bluetooth.calls import BLUEZ, add_match, call
 from appmode.bluetooth.gatt import Characteristic, Service
@@ -37,6 +38,7 @@ from appmode.errors import AppmodeError
 
 Log = Callable[[str], None]
 NOT_PERMITTED = "org.bluez.Error.NotPermitted"
+
 ROOT = "/org/appmode/module"
 """Where the application's objects are exported (one module per process)."""
 
@@ -100,8 +102,11 @@ class AdvertisedModule:
         log: Log,
         received: Callable[[bytes], None],
         left: Callable[[str], None] = lambda why: None,
+        admission: Admission = ANY_PHONE,
     ) -> None:
-        self.name, self.service = name, service
+        self.name, self.service, self.admission = name, service, admission
+        self._refused: set[str] = set()
+        """The phones refused, each said once."""
         self._log, self._received, self._left = log, received, left
         self._holder = ""
         """The device of the phone that holds the BLE link (one at a time, as a module)."""
@@ -115,11 +120,14 @@ class AdvertisedModule:
         self._objects: list[tuple[str, ServiceInterface]] = [
             (base, Service(service.service)),
         ]
-        self.characteristic = Characteristic(service.write, base, self._from_ble, self._subscribed)
+        flags = SECURE_FLAGS if admission.secure else []
+        self.characteristic = Characteristic(
+            service.write, base, self._from_ble, self._subscribed, flags
+        )
         self._objects.append((f"{base}/char0", self.characteristic))
         if service.notify != service.write:  # the Nordic UART service: RX and TX
             self.characteristic = Characteristic(
-                service.notify, base, self._from_ble, self._subscribed
+                service.notify, base, self._from_ble, self._subscribed, flags
             )
             self._objects.append((f"{base}/char1", self.characteristic))
         self._advert = Advertisement(name, service.service, self._released)
@@ -152,7 +160,7 @@ class AdvertisedModule:
             "Name": Variant("s", self.name),
             "Role": Variant("s", "server"),
             "Channel": Variant("q", 1),
-            "RequireAuthentication": Variant("b", False),
+            "RequireAuthentication": Variant("b", self.admission.secure),
             "RequireAuthorization": Variant("b", False),
         }
         await self._call(
@@ -226,7 +234,11 @@ class AdvertisedModule:
 
     def _from_ble(self, data: bytes, device: str) -> None:
         """A phone's write. The first phone to write holds the module until it leaves;
-        another's writes are refused (a module takes one link)."""
+        another's writes are refused (a module takes one link), as are those of a phone
+        the admission does not take."""
+        if not self.admission.admits(device):
+            self._refuse(device, "ble")
+            raise DBusError(NOT_PERMITTED, "this phone is not on the module's allow-list")
         if device != "/" and device != self._holder:
             if self._holder:
                 raise DBusError(NOT_PERMITTED, "the module is held by another phone")
@@ -283,8 +295,17 @@ class AdvertisedModule:
 
     # ------------------------------------------------------------ SPP
 
+    def _refuse(self, device: str, kind: str) -> None:
+        if device not in self._refused:
+            self._refused.add(device)
+            self._log(f"{kind}: refused {device}: not on the allow-list (--allow)")
+
     def _spp_connected(self, device: str, fd: int) -> None:
         link = socket.socket(fileno=fd)
+        if not self.admission.admits(device):
+            link.close()
+            self._refuse(device, "spp")
+            return
         if self._spp is not None:
             link.close()
             self._log(f"spp: refused a second link from {device}: one link at a time")

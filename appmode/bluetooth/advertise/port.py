@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import threading
 
+from appmode.bluetooth.advertise.admission import ANY_PHONE, Admission
 from appmode.bluetooth.advertise.application import AdvertisedModule, Log
 from appmode.bluetooth.inbox import Inbox
 from appmode.bluetooth.loop import LoopThread
@@ -23,13 +24,22 @@ class AdvertisedPort:
     baudrate = BAUD
     """The module's UART rate, which the tap paces the phone's bytes at."""
 
-    def __init__(self, name: str, service: UartService, log: Log, timeout: float) -> None:
+    def __init__(
+        self,
+        name: str,
+        service: UartService,
+        log: Log,
+        timeout: float,
+        admission: Admission = ANY_PHONE,
+    ) -> None:
         self._timeout = timeout
         self._ready = threading.Condition()
         self._received = Inbox(self._ready)
         self._left: str | None = None
         self._runner = LoopThread("advertised module")
-        self.module = AdvertisedModule(name, service, log, self._received.add, left=self._gone)
+        self.module = AdvertisedModule(
+            name, service, log, self._received.add, left=self._gone, admission=admission
+        )
         try:
             self._runner.run(self.module.start(), START)
         except BaseException:

@@ -119,6 +119,8 @@ class Device(ServiceInterface):
         self.connected = False
         self.resolved = False
         self.rssi = -58
+        self.paired = self.trusted = not le
+        """Classic modules come paired (`bluetoothctl pair`); a BLE one once Pair is called."""
 
     @dbus_property(access=PropertyAccess.READ)
     def Address(self) -> DBusStr:
@@ -142,15 +144,20 @@ class Device(ServiceInterface):
 
     @dbus_property(access=PropertyAccess.READ)
     def Paired(self) -> DBusBool:
-        return not self.le
+        return self.paired
 
     @dbus_property(access=PropertyAccess.READ)
     def Bonded(self) -> DBusBool:
-        return not self.le
+        return self.paired
 
-    @dbus_property(access=PropertyAccess.READ)
+    @dbus_property()
     def Trusted(self) -> DBusBool:
-        return not self.le
+        return self.trusted
+
+    @Trusted.setter  # type: ignore[no-redef]  # dbus-fast's property setter
+    def Trusted(self, value: DBusBool) -> None:
+        """Set by a central before it pairs (bleak does)."""
+        self.trusted = value
 
     @dbus_property(access=PropertyAccess.READ)
     def Blocked(self) -> DBusBool:
@@ -198,7 +205,11 @@ class Device(ServiceInterface):
 
     @dbus_method()
     def Pair(self) -> Nothing:
-        """Already paired (classic), or nothing to pair (the BLE module has no security)."""
+        """Paired and bonded at once (Just Works: no passkey to confirm); already, for a
+        classic module."""
+        if not self.paired:
+            self.paired = True
+            self.emit_properties_changed({"Paired": True, "Bonded": True})
 
     @dbus_method()
     def CancelPairing(self) -> Nothing:

@@ -11,9 +11,11 @@ import asyncio
 import contextlib
 import selectors
 import socket
+import sys
 import threading
 from collections.abc import Callable, Coroutine
 
+from appmode.bluetooth.advertise.admission import ANY_PHONE, Admission
 from appmode.bluetooth.advertise.application import AdvertisedModule
 from appmode.bluetooth.loop import chunks
 from appmode.bluetooth.standin.bluez import BLE_ADDRESS, BLE_NAME, SPP_ADDRESS, StandIn
@@ -129,12 +131,15 @@ class AdvertisedEndpoint(LoopEndpoint):
         name: str,
         service: UartService,
         baud: int | None = None,
+        admission: Admission = ANY_PHONE,
     ) -> None:
         super().__init__(sel, log, f"the advertised module {name}")
         self.baud = baud
         self.url = f"ble://{name}"
-        self.module = AdvertisedModule(name, service, log, self._to_board)
+        self.module = AdvertisedModule(name, service, log, self._to_board, admission=admission)
         self._start(self._serve)
+        if (warning := admission.warning(name)) is not None:  # said once it is on the air
+            print(f"board: {warning}", file=sys.stderr, flush=True)
         self.details = (
             f"ble: advertised as {name} ({service.name}) on {self.module.adapter}",
             f"spp: {name} (server)",

@@ -191,16 +191,20 @@ class Peers:
         objects: dict[str, dict[str, dict[str, Variant]]] = await self._ask(
             peer.sender, path, "org.freedesktop.DBus.ObjectManager", "GetManagedObjects", "", []
         )
-        services, characteristics = {}, {}
+        services, characteristics, secured = {}, {}, set()
         for where, interfaces in sorted(objects.items()):
             if "org.bluez.GattService1" in interfaces:
                 services[where] = str(interfaces["org.bluez.GattService1"]["UUID"].value)
             if CHARACTERISTIC in interfaces:
                 props = interfaces[CHARACTERISTIC]
                 characteristics[where] = (str(props["UUID"].value), str(props["Service"].value))
+                flags = props.get("Flags", Variant("as", [])).value
+                if any(flag.startswith(("encrypt-", "secure-")) for flag in flags):
+                    secured.add(where)
         if not services or any(s not in services for _, s in characteristics.values()):
             raise DBusError(INVALID, f"{path}: no GATT service, or a characteristic outside one")
         peer.application, peer.services, peer.characteristics = path, services, characteristics
+        peer.secured = secured
 
     async def _advertisement(self, peer: Peer, path: str) -> None:
         props: dict[str, Variant] = await self._ask(
@@ -356,7 +360,11 @@ class Peers:
 
     def _write(self, peer: Peer, path: str, data: bytes, _: str) -> None:
         """A central's write, forwarded in order (write without response: no wait); the
-        application hears it from the central's device."""
+        application hears it from the central's device. One to a characteristic that
+        asks for an authenticated link is dropped until the central has paired."""
+        if path in peer.secured and not (peer.ble is not None and peer.ble.paired):
+            self._log(f"ble: a write to {path} refused: insufficient authentication (pair first)")
+            return
         options = {
             "device": Variant("o", CENTRAL),
             "link": Variant("s", "LE"),

@@ -62,6 +62,9 @@ class Peer:
     """The application's service paths and UUIDs."""
     characteristics: dict[str, tuple[str, str]] = field(default_factory=dict)
     """The application's characteristic paths, each with its UUID and service path."""
+    secured: set[str] = field(default_factory=set)
+    """The characteristics whose flags ask for an encrypted, authenticated link: BlueZ
+    takes a central's writes to them only once it is paired."""
     advertisement: str = ""
     name: str = ""
     service_uuids: list[str] = field(default_factory=list)
