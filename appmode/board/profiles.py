@@ -7,7 +7,6 @@ reference firmware as measured (§13). A third board is a third row.
 
 from __future__ import annotations
 
-import hashlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -316,6 +315,8 @@ def digest(profile: Profile) -> str | None:
     which a recording keeps beside its name; None for what appmode ships."""
     if profile.file is None or profile.name in profile_file.SHIPPED:
         return None
+    import hashlib  # only a user's file needs it: start-up stays short
+
     return hashlib.sha256(profile.file.text.encode()).hexdigest()[:16]
 
 
