@@ -7,6 +7,7 @@ from __future__ import annotations
 import asyncio
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -373,3 +374,22 @@ def test_scan_shows_a_hostile_device_name_escaped(appmode_ble_board: ServedBoard
     listed = run("scan", "--time", "2", "--json")
     names = [json.loads(line)["name"] for line in listed.stdout.splitlines()]
     assert HOSTILE in names and "\x1b" not in listed.stdout
+
+
+@pytest.mark.parametrize("kind", ["ble", "spp"])
+def test_what_the_user_sees_while_driving_over_each_link_kind(
+    appmode_ble_board: ServedBoard, kind: str
+) -> None:
+    """Issue 69.1: over bt:// the console showed 2–4 records/s and y 0 while the board
+    drove (the port said 1 byte waiting whatever it held: a byte a pass). What the user
+    sees: the stream at the board's rate and the velocity it reports."""
+    url = appmode_ble_board.ble if kind == "ble" else appmode_ble_board.spp
+    assert url is not None
+    started = time.monotonic()
+    done = run("drive", url, stdin=b"drive A\nwait 2\nstatus\nquit\n")
+    took = time.monotonic() - started
+    assert done.returncode == 0, done.stderr
+    rate = re.search(r"link up\s+(\d+) records/s", done.stdout)
+    assert rate is not None and int(rate.group(1)) >= 15, done.stdout
+    assert re.search(r"velocity\s+x\s+0\s+y\s+500\s+z\s+0", done.stdout), done.stdout
+    assert took < 8, took

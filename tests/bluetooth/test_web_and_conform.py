@@ -22,6 +22,23 @@ SOME = ("s2_2_read_params", "s2_2_q_separator", "s5_save")
 few seconds each; the whole suite over ble:// passes too (12 of 12, 109 s)."""
 
 
+async def shown_while_held(socket: Any, seconds: float = 6.0) -> dict[str, float]:
+    """What the page is told while forward is held (beating as a page does): the link's
+    records a second and the y velocity, once both are the board's (the stream at its
+    rate, y 500), or as they last were."""
+    end = asyncio.get_running_loop().time() + seconds
+    seen: dict[str, float] = {}
+    while asyncio.get_running_loop().time() < end:
+        await socket.send_json({"t": "hold", "key": "forward"})
+        shown = await status(socket)
+        ins = shown["instruments"]
+        motion = dict(ins["telemetry"]["motion"] or ())
+        seen = {"rate": ins["link"]["rate"], "y": motion.get("y (forward +)", motion.get("y", 0))}
+        if seen["rate"] >= 15 and seen["y"] == 500:
+            break
+    return seen
+
+
 @pytest.mark.parametrize("which", ["ble", "spp"])
 def test_the_page_drives_the_car_over_the_module(tmp_path: Path, which: str) -> None:
     async def scenario(web: WebProcess) -> None:
@@ -30,6 +47,8 @@ def test_the_page_drives_the_car_over_the_module(tmp_path: Path, which: str) -> 
             await ready(socket)
             await socket.send_json({"t": "press", "key": "forward"})
             await beat_until_sent(socket, web, "A")
+            seen = await shown_while_held(socket)
+            assert seen["rate"] >= 15 and seen["y"] == 500, seen  # issue 69.1
             await socket.send_json({"t": "release"})
             wait_sent(web, "Z")
             await socket.send_json({"t": "press", "key": "left"})

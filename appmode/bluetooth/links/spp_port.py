@@ -28,6 +28,7 @@ from appmode.bluetooth.loop import LoopThread
 from appmode.line.pacing import Ahead
 from appmode.ports.radio import BT_USAGE, BtTarget
 from appmode.ports.urls import port_target
+from appmode.ports.waiting import bytes_waiting
 
 CONNECT = 10.0
 BAUD = 9600
@@ -79,8 +80,7 @@ class SppSerial(SerialBase):  # type: ignore[misc]  # pyserial has no types
     def in_waiting(self) -> int:
         if not self.is_open:
             raise SerialException("the port is not open")
-        ready, _, _ = select.select([self._socket], [], [], 0)
-        return 1 if ready else 0
+        return bytes_waiting(self._socket)
 
     def read(self, size: int = 1) -> bytes:
         if not self.is_open:
