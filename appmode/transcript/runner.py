@@ -284,7 +284,9 @@ def run_conform(
         _run_all(transcripts, board, progress, interactive, results, out, board2, between)
     finally:
         if board is not None and found is not None:
-            out.write(restore_params(board, found, chosen) + "\n")
+            started = transcripts[: len(results) + 1]  # the one cut short too
+            saved = any(_saves(t) for t in started)
+            out.write(restore_params(board, found, chosen, saved) + "\n")
     if board2 is not None and not board2.simulated and _sent_on_uart2(transcripts, results):
         out.write(wrapped(f"note: {TAKEN_OVER}") + "\n")
     failed = sum(not r.passed for r in results)
@@ -303,6 +305,18 @@ TAKEN_OVER = (
     "drive letters on the APP port (the phone app, appmode send, drive) do nothing until "
     "the board is reset or powered off; nothing sent can give the APP port its motion back"
 )
+
+
+def _saves(transcript: Transcript) -> bool:
+    """Whether `transcript` sends the board a save ({Q:W}): its flash may hold what the
+    run set."""
+    decoder = app_decoders.HostDecoder()
+    return any(
+        isinstance(event, app.SaveParams)
+        for entry in transcript.entries
+        if entry.direction == SENT
+        for event in decoder.feed(entry.data)
+    )
 
 
 def _sent_on_uart2(transcripts: list[Transcript], results: list[Result]) -> bool:
@@ -398,18 +412,29 @@ def put_back(url: Target, values: tuple[int, ...], profile: Profile) -> str | No
     return None
 
 
-def restore_params(url: Target, values: tuple[int, ...], profile: Profile) -> str:
-    """Set the board's parameters back to `values` (verified) and send `{Q:W}`: what a
-    run against a real board changed is undone. Returns what was done, in a line."""
+def restore_params(
+    url: Target, values: tuple[int, ...], profile: Profile, saved: bool = False
+) -> str:
+    """Set the board's parameters back to `values` (verified), and send `{Q:W}` only when
+    a transcript `saved` (the flash may hold what it set): what a run against a real board
+    changed is undone, with no flash write for nothing. Returns what was done, a line."""
     try:
         with Host(url, profile=profile) as host:
             changed = _set_back(host, values)
-            host.save()
+            if saved:
+                host.save()
     except AppmodeError as exc:
         pairs = zip(profile.a_layout.params, values, strict=True)
         shown = ", ".join(f"{p.name}={param_values.to_user(p, v)}" for p, v in pairs)
         return f"could not restore the parameters found at the start ({shown}): {exc}"
-    return (
-        f"restored the parameters found at the start ({len(changed)} had changed) and "
-        "sent {Q:W} to save them"
-    )
+    if saved:
+        return (
+            f"restored the parameters found at the start ({len(changed)} had changed) and "
+            "sent {Q:W} to save them (a transcript had saved)"
+        )
+    if changed:
+        return (
+            f"restored the parameters found at the start ({len(changed)} had changed; not "
+            "saved: no transcript saved, so the flash holds what it held)"
+        )
+    return "the parameters are as found at the start: nothing to restore, nothing saved"

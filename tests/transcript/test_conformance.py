@@ -239,13 +239,37 @@ def _live(name: str) -> str | None:
     checks = {
         "exit status 0": done.returncode == 0,
         f"{counts}": f"{counts} against /dev/" in done.stdout,
-        "the parameters restored": "restored the parameters found at the start (" in done.stdout,
+        "the parameters restored": "restored the parameters found at the start (" in done.stdout
+        or "the parameters are as found at the start" in done.stdout,
         "UART2's take-over noted when it took over": takes_over
         == ("note: the board's control port (UART2) has taken over" in done.stdout),
         "max_speed 800 and the rest at their defaults": values == (800, *params.DEFAULTS[1:]),
     }
     failed = [what for what, held in checks.items() if not held]
     return f"{name}: not {', '.join(failed)}\n{done.stdout}" if failed else None
+
+
+@pytest.mark.parametrize(
+    ("name", "saves"), [("s2_2_read_params", False), ("s5_save", True)], ids=["reads", "saves"]
+)
+def test_conform_on_a_board_saves_only_when_a_transcript_saved(
+    tmp_path: Path, name: str, saves: bool
+) -> None:
+    """Issue 69.8: `conform --board` ended with `{Q:W}` though nothing had changed: a flash
+    write on a real car for nothing. It saves only when a transcript saved."""
+    record = tmp_path / "board.transcript"
+    path = SUITE_DIR / f"{name}.transcript"
+    with board_process("--pty", "--quiet", "--record", str(record)) as board:
+        done = run("conform", "--board", board.url, "--yes", str(path), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    heard = [e.data for e in read_transcript(record).entries if e.direction == ">"]
+    after_run = heard[len([e for e in read_transcript(path).entries if e.direction == ">"]) :]
+    if saves:
+        assert b"{Q:W}" in after_run, after_run  # after setting back, before the final Z
+        assert "sent {Q:W} to save them (a transcript had saved)" in done.stdout
+    else:
+        assert b"{Q:W}" not in heard, heard
+        assert "nothing saved" in done.stdout or "not saved" in done.stdout, done.stdout
 
 
 @pytest.mark.slow
