@@ -52,27 +52,41 @@ def open_control_host(
     return with_recording(stack, host, record, view)
 
 
-def show(
-    host: ControlHost,
-    direction: str,
-    event: reader.Event | LinkStatus | PortMode,
-    out: TextIO,
-    as_json: bool,
-) -> None:
-    """One event: a line of text, or (what the board sent) a JSON line; link and mode
-    changes on stderr. APP records show as such while APP mode (bit 7) moves them here
-    (§12)."""
-    if isinstance(event, (LinkStatus, PortMode)):
-        print(f"appmode: {event.text}", file=sys.stderr, flush=True)
-        return
-    if as_json and direction == host.sent:
-        return  # JSON Lines hold what came back, as for the APP port
-    body, text, shown = view(event)
-    if as_json:
-        out.write(json.dumps({"t": round(host.now(), 3), **body}) + "\n")
-    else:
-        out.write(line(host.now(), direction, event.raw, text, shown) + "\n")
-    out.flush()
+WHY_TWICE = "every read goes twice: UART2 has no checksum, so two replies must agree"
+"""Said once, on stderr, when a read's second copy is first shown."""
+
+
+class Shown:
+    """The events of a UART2 session as lines: a line of text, or (what the board sent) a
+    JSON line; link and mode changes on stderr. APP records show as such while APP mode
+    (bit 7) moves them here (§12). A read's second copy says why it is there."""
+
+    def __init__(self, host: ControlHost, out: TextIO, as_json: bool) -> None:
+        self._host, self._out, self._as_json = host, out, as_json
+        self._last = b""
+        self._explained = False
+
+    def __call__(self, direction: str, event: reader.Event | LinkStatus | PortMode) -> None:
+        host = self._host
+        if isinstance(event, (LinkStatus, PortMode)):
+            print(f"appmode: {event.text}", file=sys.stderr, flush=True)
+            return
+        if self._as_json and direction == host.sent:
+            return  # JSON Lines hold what came back, as for the APP port
+        body, text, shown = view(event)
+        if self._as_json:
+            self._out.write(json.dumps({"t": round(host.now(), 3), **body}) + "\n")
+        else:
+            again = isinstance(event, control.ReadFrame) and event.raw == self._last
+            if direction == host.sent:
+                self._last = b"" if again else event.raw
+            if again:
+                text += " again"
+                if not self._explained:
+                    print(f"appmode: {WHY_TWICE}", file=sys.stderr, flush=True)
+                self._explained = True
+            self._out.write(line(host.now(), direction, event.raw, text, shown) + "\n")
+        self._out.flush()
 
 
 # ---------------------------------------------------------------- params --uart2
@@ -139,7 +153,7 @@ def run_send(
         print(f"appmode: note: {UNLIMITED}", file=sys.stderr)
     with ExitStack() as stack:
         host = open_control_host(stack, choice, record)
-        host.watch = lambda direction, event: show(host, direction, event, out, as_json)
+        host.watch = Shown(host, out, as_json)
         report_bit = params.MODE_BIT["encoder_report"]
         report = report and profile.answers_reads
         mode = host.read("system_mode") if report else report_bit
@@ -191,7 +205,7 @@ def run_monitor(
         view = stack.enter_context(live_view(foxglove, choice.profile.a_layout))
         host = open_control_host(stack, choice, record, stop_on_exit, view)
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
-        host.watch = lambda direction, event: show(host, direction, event, out, as_json)
+        host.watch = Shown(host, out, as_json)
         try:
             for event in until_count(host.events(duration), _is_answer, count):
                 errors += isinstance(event, control.Garbage)

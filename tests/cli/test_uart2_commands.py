@@ -101,3 +101,13 @@ def test_monitor_prints_reports_as_json_lines_and_sends_nothing() -> None:
     assert done.returncode == 0, done.stderr
     assert done.stdout == "", "no report unless turned on; a monitor sends nothing"
     assert "0 replies and reports" in done.stderr
+
+
+def test_send_uart2_says_why_each_read_goes_twice() -> None:
+    """Issue 69.9: `send --uart2` showed `read system_mode` twice, unexplained."""
+    done = run("send", "sim://", "--uart2", "stop")
+    assert done.returncode == 0, done.stderr
+    reads = [line.split(None, 2)[2] for line in done.stdout.splitlines() if "read " in line]
+    assert reads[:2] == ["FF FE 80 80 19 00 00 00 00 00      read system_mode",
+                         "FF FE 80 80 19 00 00 00 00 00      read system_mode again"]  # fmt: skip
+    assert done.stderr.count("UART2 has no checksum, so two replies must agree") == 1
