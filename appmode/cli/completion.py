@@ -13,7 +13,7 @@ from appmode.errors import AppmodeError
 SHELLS = ("bash", "zsh", "fish")
 
 INSTALL = {
-    "bash": "appmode completion bash > ~/.local/share/bash-completion/completions/appmode",
+    "bash": "echo 'eval \"$(appmode completion bash)\"' >> ~/.bashrc",
     "zsh": "echo 'eval \"$(appmode completion zsh)\"' >> ~/.zshrc",
     "fish": "appmode completion fish > ~/.config/fish/completions/appmode.fish",
 }

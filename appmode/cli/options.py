@@ -109,13 +109,23 @@ def add_profile(
 ) -> None:
     """`--profile NAME`; with `default` None it is None when not given (`unset` says what
     then applies)."""
-    parser.add_argument(
+    action = parser.add_argument(
         "--profile",
         type=profile_name,
         metavar="NAME|FILE",
         default=default,
         help=f"{what} (default: {default or unset})",
     )
+    action.completer = profiles_offered  # type: ignore[attr-defined]  # argcomplete's
+
+
+def profiles_offered(prefix: str, **_: object) -> list[str]:
+    """What `--profile <Tab>` offers (argcomplete): the shipped profiles, then profile
+    files (`.toml`) and folders."""
+    from argcomplete.completers import FilesCompleter
+
+    names = [name for name in SHIPPED_PROFILES if name.startswith(prefix)]
+    return names + list(FilesCompleter(allowednames=("toml",))(prefix))
 
 
 def profile_name(text: str) -> str:

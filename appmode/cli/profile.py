@@ -8,7 +8,7 @@ import sys
 
 from appmode.board.profiles import load
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, profiles_offered
 from appmode.protocol import param_values
 from appmode.protocol.profile_file import SHIPPED, Field, ProfileError, ProfileFile
 from appmode.text import escaped
@@ -26,10 +26,12 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     actions = profile.add_subparsers(dest="action", metavar="ACTION", required=True)
     actions.add_parser("list", help="the shipped profiles, one a line")
     show = actions.add_parser("show", help="one profile: its records, parameters and pages")
-    show.add_argument("name", metavar="NAME|PATH", help="a shipped profile or a file")
+    name = show.add_argument("name", metavar="NAME|PATH", help="a shipped profile or a file")
+    name.completer = profiles_offered  # type: ignore[attr-defined]  # argcomplete's
     show.add_argument("--toml", action="store_true", help="print its file as it is")
     check = actions.add_parser("check", help="check a profile file: one line a mistake")
-    check.add_argument("path", metavar="FILE", help="the profile file (TOML)")
+    path = check.add_argument("path", metavar="FILE", help="the profile file (TOML)")
+    path.completer = profiles_offered  # type: ignore[attr-defined]  # argcomplete's
     return profile
 
 
