@@ -185,15 +185,20 @@ class Boards:
     def serve(self, example: Example) -> list[str]:
         """A server a document starts (`appmode share`, `appmode router`): its first line,
         as the document shows it."""
-        proc = subprocess.Popen(
-            [sys.executable, "-m", *shlex.split(example.command)],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL,
-            text=True,
-            cwd=self.cwd,
-        )
+        said = self.cwd / f"server-{len(self.procs)}.err"
+        with said.open("w") as errors:  # what it said, should it print nothing
+            proc = subprocess.Popen(
+                [sys.executable, "-m", *shlex.split(example.command)],
+                stdout=subprocess.PIPE,
+                stderr=errors,
+                text=True,
+                cwd=self.cwd,
+            )
         self.procs.append(proc)
         shown = [_line(proc.stdout)]
+        if not shown[0]:  # it ended: its stderr says why
+            proc.wait(10)
+            shown += said.read_text().splitlines()
         time.sleep(SWITCH)
         return shown
 
