@@ -51,8 +51,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "--link",
         type=file_name,
         metavar="PATH",
-        help="with --pty: keep a symlink PATH to the pty, so clients find a restarted board "
-        "at the same path",
+        help="with --pty: keep a symlink PATH to the pty, and PATH.uart2 to the control "
+        "port's, so clients find a restarted board at the same paths",
     )
     add_profile(
         board,
@@ -245,4 +245,5 @@ def _uart2_endpoint(args: argparse.Namespace) -> MakeEndpoint:
         return partial(endpoints.TcpEndpoint, host=host, port=port, baud=None)
     if args.port2 is not None:
         return partial(endpoints.SerialEndpoint, device=args.port2, baud=UART2_BAUD)
-    return partial(endpoints.PtyEndpoint, link=None, baud=UART2_BAUD if args.baud else None)
+    link = f"{args.link}.uart2" if args.link else None  # the control port's stable name
+    return partial(endpoints.PtyEndpoint, link=link, baud=UART2_BAUD if args.baud else None)

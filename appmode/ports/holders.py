@@ -45,6 +45,33 @@ def holders(device: str, proc: str = PROC) -> list[Holder]:
     return sorted(found.values(), key=lambda h: (not h.locks, h.pid))
 
 
+def terminal_of(device: str, proc: str = PROC) -> list[Holder]:
+    """The processes whose controlling terminal is `device`: a shell's pseudo-terminal,
+    say, never a board's (appmode board's pty is no program's terminal). [] where the OS
+    does not tell."""
+    try:
+        number = os.stat(device).st_rdev
+    except OSError:
+        return []
+    if not hasattr(os, "major") or not number:
+        return []
+    major, minor = os.major(number), os.minor(number)
+    tty_nr = (minor & 0xFF) | (major << 8) | ((minor & ~0xFF) << 12)  # /proc/PID/stat's
+    found = []
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(proc):
+            if not entry.name.isdigit():
+                continue
+            try:
+                with open(f"{entry.path}/stat", "rb") as file:
+                    fields = file.read(4096).rsplit(b")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if len(fields) > 4 and fields[4] == b"%d" % tty_nr:
+                found.append(Holder(int(entry.name), _name(entry.path), False))
+    return sorted(found, key=lambda h: h.pid)
+
+
 def _has_open(fds: str, target: str) -> bool:
     with contextlib.suppress(OSError):
         for fd in os.scandir(fds):

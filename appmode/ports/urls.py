@@ -58,12 +58,32 @@ def open_link(url: AnyTarget, timeout: float | None = 0.05, baud: int = BAUD) ->
             return _own_port(target, baud, timeout)
         if target.scheme:
             return serial.serial_for_url(target.url, baudrate=baud, timeout=timeout)
+        _refuse_a_terminal(target.path)
         return serial.Serial(
             target.path, baudrate=target.baud or baud, timeout=timeout, exclusive=os.name == "posix"
         )
     except (serial.SerialException, ValueError, OSError) as exc:
         where = target.url if target.scheme else target.path
         raise AppmodeError(explain_open_error(where, exc, target.scheme)) from None
+
+
+def _refuse_a_terminal(path: str) -> None:
+    """AppmodeError when `path` is a pseudo-terminal some program has as its terminal (a
+    shell's): frames written there would reach that program, not a board. Told on Linux;
+    elsewhere nothing is refused."""
+    device = os.path.realpath(path)
+    if not device.startswith("/dev/pts/"):
+        return
+    from appmode.ports.holders import terminal_of
+    from appmode.text import escaped
+
+    users = terminal_of(device)
+    if users:
+        raise AppmodeError(
+            f"{path} is not a board: it is the terminal of {escaped(str(users[0]))} (a board's "
+            "pseudo-terminal is no program's terminal); use the path appmode board printed, "
+            "or its --link name"
+        )
 
 
 def _own_port(target: Target, baud: int, timeout: float | None) -> serial.SerialBase:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import socket
 import struct
@@ -11,6 +12,8 @@ import sys
 import threading
 import time
 from pathlib import Path
+
+import pytest
 
 from appmode.host.app.client import Host
 from appmode.host.events import LinkStatus
@@ -186,14 +189,42 @@ def test_a_board_survives_an_app_client_reset_while_uart2_data_arrives() -> None
     assert "Traceback" not in err and "AssertionError" not in err
 
 
-def test_a_link_left_by_a_board_that_crashed_leads_nowhere(tmp_path: Path) -> None:
-    """Issue 23.6: the link pointed at /dev/pts/N, which another program may own once
-    the board is gone; it now points at the board's own descriptor of it (Linux)."""
-    link = tmp_path / "board"
+def test_links_name_both_ports_and_one_left_by_a_crash_reaches_no_terminal(
+    tmp_path: Path,
+) -> None:
+    """Issue 69.2 and 69.5: `--link car` names both ports (`car`, `car.uart2`), each at the
+    device it names; a link left by a board that crashed leads to no port, and a pty
+    number taken since by a shell is refused (issue 23.6's danger, told at the open)."""
+    link = tmp_path / "car"
     board = BoardProcess("--pty", "--link", str(link), "--quiet")
-    assert os.path.realpath(link) == board.url
-    assert os.readlink(link) != board.url, "not /dev/pts/N: a path that dies with the board"
-    board.kill()  # no clean-up: the link stays
-    assert link.is_symlink() and not link.exists(), "it leads nowhere, not to /dev/pts/N"
+    assert os.readlink(link) == board.url
+    assert os.readlink(f"{link}.uart2") == board.uart2
+    done = run("send", f"{link}.uart2", "--uart2", "stop")
+    assert done.returncode == 0, done.stderr
+    board.kill()  # no clean-up: the links stay
     done = run("monitor", str(link), "--count", "1")
-    assert done.returncode == 2 and "no such port" in done.stderr, done.stderr
+    assert done.returncode == 2, done.stderr
+    assert "no such port" in done.stderr or "is not a board" in done.stderr, done.stderr
+    clean = BoardProcess("--pty", "--link", str(tmp_path / "other"), "--quiet")
+    clean.stop()
+    assert not (tmp_path / "other").is_symlink() and not (tmp_path / "other.uart2").is_symlink()
+
+
+def test_a_shell_s_terminal_is_not_taken_for_a_board(tmp_path: Path) -> None:
+    """Issue 69.2: the README's UART2 example wrote to /dev/pts/1, on that machine
+    someone's terminal. A pty that is a program's terminal is refused in a line."""
+    if shutil.which("tmux") is None:
+        pytest.fail("tmux is needed for a shell's terminal (apt-get install tmux)")
+    server = ["tmux", "-L", f"appmode-terminal-{os.getpid()}"]
+    subprocess.run([*server, "new-session", "-d", "-s", "t", "bash --norc"], check=True)
+    try:
+        tty = subprocess.run([*server, "display", "-p", "-t", "t", "#{pane_tty}"],
+                             capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
+        wait_for(lambda: b"bash" in subprocess.run(["ps", "-t", tty], capture_output=True).stdout)
+        for command in (("send", tty, "--uart2", "stop"), ("params", tty)):
+            done = run(*command)
+            assert done.returncode == 2, done.stderr
+            assert f"{tty} is not a board: it is the terminal of bash" in done.stderr
+            assert done.stderr.count("\n") == 1
+    finally:
+        subprocess.run([*server, "kill-server"], capture_output=True, check=False)
