@@ -393,3 +393,18 @@ def test_what_the_user_sees_while_driving_over_each_link_kind(
     assert rate is not None and int(rate.group(1)) >= 15, done.stdout
     assert re.search(r"velocity\s+x\s+0\s+y\s+500\s+z\s+0", done.stdout), done.stdout
     assert took < 8, took
+
+
+def test_scan_shows_its_progress_on_a_terminal_and_not_in_a_pipe(
+    appmode_ble_board: ServedBoard,
+) -> None:
+    """Issue 69.7: a long job shows what it waits for on a terminal, and stays quiet
+    when piped."""
+    from tests.support.terminal import stderr_on_a_terminal
+
+    status, shown = stderr_on_a_terminal("scan", "--time", "2")
+    assert status == 0
+    assert "scanning" in shown and "/2 s:" in shown and " heard" in shown, shown
+    assert shown.endswith("\r\x1b[K"), "the progress line is cleared"
+    piped = run("scan", "--time", "2")
+    assert "scanning" not in piped.stderr and "\r" not in piped.stderr

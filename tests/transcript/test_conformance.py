@@ -272,6 +272,20 @@ def test_conform_on_a_board_saves_only_when_a_transcript_saved(
         assert "nothing saved" in done.stdout or "not saved" in done.stdout, done.stdout
 
 
+def test_conform_on_a_board_shows_its_progress_on_a_terminal_only() -> None:
+    """Issue 69.7: `conform --board` ran for minutes with nothing shown. On a terminal a
+    line says which transcript runs and how far it is; in a pipe, nothing."""
+    from tests.support.terminal import stderr_on_a_terminal
+
+    path = str((SUITE_DIR / "s3_4_telemetry_rate.transcript").relative_to(ROOT))
+    with board_process("--pty", "--quiet") as board:
+        status, shown = stderr_on_a_terminal("conform", "--board", board.url, "--yes", path)
+        piped = run("conform", "--board", board.url, "--yes", path, timeout=120)
+    assert status == 0 and piped.returncode == 0, piped.stdout
+    assert re.search(rf"{re.escape(path)}:\s+\d+\.\d / \d+\.\d s", shown), shown
+    assert "\r" not in piped.stderr and path + ":" not in piped.stderr
+
+
 @pytest.mark.slow
 @pytest.mark.alone
 def test_the_suite_passes_in_real_time_against_board_processes() -> None:
