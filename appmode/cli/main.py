@@ -47,7 +47,11 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         "(9600 bps: letters drive, {…} frames read and set parameters).",
     )
     parser.add_argument(
-        "--version", action=_Version, nargs=0, help="print the version (and commit) and exit"
+        "-V",
+        "--version",
+        action=_Version,
+        nargs=0,
+        help="print the version (and, run from a git checkout, its commit) and exit",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from appmode.cli.commands import COMMANDS
@@ -18,15 +19,28 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     plot.add_argument("file", type=file_name, metavar="FILE", help="the transcript")
     plot.add_argument(
-        "-o", "--output", required=True, type=file_name, metavar="PNG", help="the image to write"
+        "-o",
+        "--output",
+        type=file_name,
+        metavar="PNG",
+        help="the image to write (default: FILE's name with .png, beside it, if no such "
+        "file is there yet)",
     )
     add_profile(plot, default=None, unset="the transcript's @board profile=…, else sheet")
     return plot
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from appmode.errors import AppmodeError
     from appmode.transcript.plot import run_plot
 
-    run_plot(args.file, args.output, args.profile)
-    print(f"wrote {args.output}", file=sys.stderr)
+    output = args.output
+    if output is None:
+        output = str(Path(args.file).with_suffix(".png"))
+        if os.path.lexists(output):  # a file of the user's that they did not name
+            raise AppmodeError(f"{output} is already there: name the image with -o PNG")
+    run_plot(args.file, output, args.profile)
+    print(f"wrote {output}", file=sys.stderr)
     return 0

@@ -22,5 +22,7 @@ def status_fragments(session: BaseSession, waveforms: bool = False) -> Fragments
 
 
 def status_text(session: BaseSession) -> str:
-    """The panel as plain text."""
-    return "".join(fragment[1] for fragment in status_fragments(session)).rstrip("\n")
+    """The panel's status as plain text, for a script: its header and rows (no key
+    grid and no keys: a script types no keys)."""
+    out = header(session) + rows(session.status_rows())
+    return "".join(fragment[1] for fragment in out).rstrip("\n")

@@ -34,7 +34,7 @@ from prompt_toolkit.layout.menus import CompletionsMenu
 from prompt_toolkit.output import Output
 
 from appmode.console.log import MESSAGES, MessageLog
-from appmode.console.panel import status_fragments, status_text
+from appmode.console.panel import status_fragments
 from appmode.console.panel_parts import ARROWS, KEY_GRID, Fragments
 from appmode.console.script import show
 from appmode.files import data_folder
@@ -309,7 +309,8 @@ class Console:
 
 def _shown(session: BaseSession) -> str:
     """What the panel and the messages show, as text (to tell whether to draw again)."""
-    return status_text(session) + "\n".join(session.messages)
+    panel = "".join(fragment[1] for fragment in status_fragments(session))
+    return panel + "\n".join(session.messages)
 
 
 def _completer(session: BaseSession) -> NestedCompleter:
