@@ -134,6 +134,14 @@ def explain_open_error(where: str, exc: Exception, scheme: str = "") -> str:
     if code == errno.ENOENT or "No such file" in text:
         if is_rfcomm(where):
             return f"no such port {where}: the Bluetooth serial port is not bound: {RFCOMM_BIND}"
+        if os.path.islink(where):  # a board's --link, its board gone
+            gone = os.readlink(where)
+            why = (
+                "a pseudo-terminal that is gone (its board has stopped: start it again with --link)"
+                if gone.startswith("/dev/pts/")
+                else "a device that is not there"
+            )
+            return f"no such port {where}: it is a link to {gone}, {why}; {LIST_PORTS}"
         return (
             f"no such port {where}: check the adapter is plugged in (and paired, for "
             f"Bluetooth); {LIST_PORTS}"

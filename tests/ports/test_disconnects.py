@@ -204,7 +204,8 @@ def test_links_name_both_ports_and_one_left_by_a_crash_reaches_no_terminal(
     board.kill()  # no clean-up: the links stay
     done = run("monitor", str(link), "--count", "1")
     assert done.returncode == 2, done.stderr
-    assert "no such port" in done.stderr or "is not a board" in done.stderr, done.stderr
+    gone = f"no such port {link}: it is a link to {board.url}, a pseudo-terminal that is gone"
+    assert gone in done.stderr or "is not a board" in done.stderr, done.stderr
     clean = BoardProcess("--pty", "--link", str(tmp_path / "other"), "--quiet")
     clean.stop()
     assert not (tmp_path / "other").is_symlink() and not (tmp_path / "other.uart2").is_symlink()
