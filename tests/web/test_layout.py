@@ -81,12 +81,12 @@ def test_the_drive_view_fits_one_screen_with_finger_sized_targets(
                 on_screen(page, selector, width, height)
             if not uart2:
                 on_screen(page, "#pages", width, height)
-                page.get_by_role("button", name="Button page").click()
+                page.get_by_role("button", name="Spin").click()
                 page.get_by_role("button", name="rotate-cw", exact=True).wait_for()
                 for selector in ("#pad", "#extra", "#in-force", "#speed", "#battery-tile"):
                     on_screen(page, selector, width, height)
                 assert small_targets(page) == [], (width, height)
-                page.get_by_role("button", name="Direction page").click()
+                page.get_by_role("button", name="Move").click()
                 page.locator("#stick").wait_for()
             assert page.locator("#link").inner_text().startswith("link up")
             assert small_targets(page) == [], (width, height)
@@ -129,7 +129,7 @@ def test_the_joystick_drives_by_sector_stops_in_its_dead_zone_and_on_release(
         until(page, "() => document.querySelector('#sectors .lit')?.dataset.name === 'forward'")
         page.keyboard.up("w")
         until(page, "() => document.querySelector('#sectors .lit') === null")
-        page.get_by_role("button", name="Button page").click()  # the button page: the pad
+        page.get_by_role("button", name="Spin").click()  # the button page: the pad
         page.get_by_role("button", name="rotate-cw", exact=True).wait_for()
         assert not page.locator("#stick").is_visible()
 

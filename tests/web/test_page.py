@@ -98,6 +98,36 @@ def test_keys_drive_while_held_and_space_stops(browser: Browser, tmp_path: Path)
         page.close()
 
 
+@pytest.mark.parametrize("control", ["stick", "pad"])
+def test_the_first_screen_says_how_to_drive_and_always_shows_a_stop(
+    browser: Browser, tmp_path: Path, control: str
+) -> None:
+    """Issue 69.6: the first screen hid how to drive and had no stop with the joystick;
+    the joystick's sectors had no labels; the pages had the firmware's names."""
+    with web_process(tmp_path) as web:
+        page = phone(browser, web, control)
+        hint = page.get_by_text("Hold a direction to drive; let go to stop.")
+        stop = page.get_by_role("button", name="Stop", exact=True)
+        for shown in (hint, stop, page.get_by_role("button", name="Move", exact=True),
+                      page.get_by_role("button", name="Spin", exact=True)):  # fmt: skip
+            assert shown.is_visible()
+            box = shown.bounding_box()
+            assert box is not None and box["y"] + box["height"] <= 640, "on the first screen"
+        if control == "stick":
+            labels = page.locator("#sectors text").evaluate_all(
+                "els => els.map(e => e.textContent)"
+            )
+            assert labels == ["→", "↗", "↑", "↖", "←", "↙", "↓", "↘"]
+        page.keyboard.down("w")  # something else drives: a key held
+        wait_sent(web, "A")
+        stop.click()
+        wait_sent(web, "Z")
+        page.wait_for_timeout(400)  # the key is still down: no heartbeat starts it again
+        assert web.sent()[-1] == "Z", web.sent()[-5:]
+        page.keyboard.up("w")
+        page.context.close()
+
+
 def test_closing_or_hiding_the_page_stops_the_car(browser: Browser, tmp_path: Path) -> None:
     with web_process(tmp_path) as web:
         page = phone(browser, web)
@@ -160,7 +190,7 @@ def test_tilting_drives_past_the_dead_zone_and_level_stops(
 def test_the_button_page_rotates_and_the_pad_says_so(browser: Browser, tmp_path: Path) -> None:
     with web_process(tmp_path) as web:
         page = phone(browser, web)
-        page.get_by_role("button", name="Button page").click()
+        page.get_by_role("button", name="Spin").click()
         rotate = page.get_by_role("button", name="rotate-cw", exact=True)
         rotate.wait_for(timeout=5000)
         x, y = centre(page, "rotate-cw")
@@ -283,7 +313,7 @@ def test_over_uart2_the_analog_pad_s_deflection_is_the_speed(
         page = browser.new_page()
         page.goto(web.address)
         page.get_by_text("settings read").wait_for(timeout=10_000)
-        for name in ("Direction page", "Button page"):  # the APP port's pages: not here
+        for name in ("Move", "Spin"):  # the APP port's pages: not here
             assert not page.get_by_role("button", name=name, exact=True).is_visible()
         box = page.get_by_role("application").bounding_box()
         assert box is not None

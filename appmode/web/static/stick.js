@@ -2,10 +2,11 @@
 // dead zone in the middle, the sector under the finger held as a key is. On UART2 it is
 // analog: the farther from the centre, the faster. Either way, letting go stops the car.
 import { SEND } from "./messages.js";
-import { $, HEARTBEAT_MS, page, press, release, send } from "./link.js";
+import { $, HEARTBEAT_MS, page, press, release, releaseAll, send } from "./link.js";
 
 const SECTORS = ["right", "front-right", "forward", "front-left", "left", "rear-left",
   "backward", "rear-right"]; // by angle, counter-clockwise from the right
+const ARROWS = ["→", "↗", "↑", "↖", "←", "↙", "↓", "↘"]; // each sector's label, in that order
 const STICK_DEAD_ZONE = 0.28; // of the radius
 const stick = { id: null, x: 0, y: 0, beat: null };
 let usePad = localStorage.getItem("appmode-control") === "pad";
@@ -26,11 +27,17 @@ function drawSectors() {
     const [from, to] = [i * 45 - 22.5, i * 45 + 22.5];
     return `M${point(from, 28)} L${point(from, 98)} A98 98 0 0 0 ${point(to, 98)} L${point(to, 28)} A28 28 0 0 1 ${point(from, 28)}Z`;
   };
-  $("sectors").replaceChildren(...SECTORS.map((name, i) => {
-    const path = document.createElementNS("http://www.w3.org/2000/svg", "path");
+  const svg = (tag) => document.createElementNS("http://www.w3.org/2000/svg", tag);
+  $("sectors").replaceChildren(...SECTORS.flatMap((name, i) => {
+    const path = svg("path");
     path.setAttribute("d", wedge(i));
     path.dataset.name = name;
-    return path;
+    const label = svg("text"); // where the finger goes for it
+    const a = (i * 45 * Math.PI) / 180;
+    label.setAttribute("x", (64 * Math.cos(a)).toFixed(1));
+    label.setAttribute("y", (-64 * Math.sin(a)).toFixed(1));
+    label.textContent = ARROWS[i];
+    return [path, label];
   }));
 }
 
@@ -92,6 +99,10 @@ export function setUpStick() {
     $("stick").addEventListener(name, letGo);
   }
   $("stick").addEventListener("contextmenu", (event) => event.preventDefault());
+  $("stop-now").addEventListener("click", () => { // always there, whatever drives
+    releaseAll();
+    send({ t: SEND.stop });
+  });
   $("use-pad").addEventListener("click", () => {
     usePad = !usePad;
     localStorage.setItem("appmode-control", usePad ? "pad" : "stick");
