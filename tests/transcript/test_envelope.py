@@ -55,7 +55,6 @@ def test_bins_merge_pairs_as_time_outgrows_them() -> None:
 @pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="os.wait4 gives the child's peak memory")
 def test_plot_s_memory_does_not_grow_with_the_file(tmp_path: Path) -> None:
-    pytest.importorskip("matplotlib")
     peaks = []
     for lines in (30_000, 90_000):  # both past what the picture holds
         path = tmp_path / f"drive{lines}.transcript"
