@@ -4,24 +4,18 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import difflib
 import errno
 import importlib
 import os
-import subprocess
 import sys
-import traceback
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from types import ModuleType
 
 from appmode import __version__
-from appmode.cli import outlet
 from appmode.cli.commands import COMMANDS, EXAMPLES
 from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
 from appmode.host import signals
-from appmode.text import shortened
 
 OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
@@ -79,6 +73,9 @@ class _Version(argparse.Action):
 
 def checkout_commit() -> str | None:
     """`git describe --always --dirty` of the checkout appmode runs from, or None."""
+    import subprocess  # here: only --version asks git, and start-up stays short
+    from pathlib import Path
+
     root = Path(__file__).resolve().parents[2]
     if not (root / ".git").exists():
         return None
@@ -99,6 +96,8 @@ def checkout_commit() -> str | None:
 
 def unknown_command(word: str) -> str:
     """What to say of a command that is none: the nearest ones, if any are near."""
+    import difflib
+
     near = difflib.get_close_matches(word, list(COMMANDS), n=2, cutoff=0.6)
     hint = f": did you mean {' or '.join(repr(n) for n in near)}?" if near else ""
     return f"unknown command {word!r}{hint} (appmode --help lists the commands)"
@@ -136,7 +135,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 0
     signals.install()
-    outlets = outlet.install() if command in DRIVES else None
+    outlets = None
+    if command in DRIVES:  # what drives a car writes through bounded writers
+        from appmode.cli import outlet
+
+        outlets = outlet.install()
     try:
         status = _run(parser, words)
     finally:
@@ -163,6 +166,8 @@ def _run(parser: argparse.ArgumentParser, words: Sequence[str]) -> int:
         sys.stdout.flush()  # here, where a full disk or a closed pipe can be reported
         return status
     except AppmodeError as exc:
+        from appmode.text import shortened
+
         print(f"appmode: error: {shortened(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
@@ -184,6 +189,8 @@ def _run(parser: argparse.ArgumentParser, words: Sequence[str]) -> int:
 def report_bug(exc: Exception) -> None:
     """Say on stderr, in a line, that appmode failed (what, where in its code) and how to
     get the traceback for a report; with SHOW_TRACEBACK set, print the traceback."""
+    import traceback
+
     if os.environ.get(SHOW_TRACEBACK):
         traceback.print_exception(exc)
         return
