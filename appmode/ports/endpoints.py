@@ -99,8 +99,9 @@ class PtyEndpoint:
         self.url = os.ttyname(self._slave)
         self._out = Overrun(log, self.url)
         self._link = link
+        self._link_target = _lasting_path(self._slave, self.url)
         if link is not None:
-            _symlink(self.url, link)
+            _symlink(self._link_target, link)
             self.details = (f"link: {link} -> {self.url}",)
         self._sel = sel
         sel.register(self._master, selectors.EVENT_READ, self)
@@ -136,10 +137,19 @@ class PtyEndpoint:
 
     def close(self) -> None:
         link = self._link
-        if link is not None and os.path.islink(link) and os.readlink(link) == self.url:
+        if link is not None and os.path.islink(link) and os.readlink(link) == self._link_target:
             os.unlink(link)
         os.close(self._master)
         os.close(self._slave)
+
+
+def _lasting_path(fd: int, device: str) -> str:
+    """A path to the pty that lasts only as long as this board: on Linux the board's own
+    descriptor under /proc, so a link left by a board that died leads nowhere — never to
+    the pty number another program (or another board's other port) took since; elsewhere
+    the device. The link's line names the device it reaches."""
+    path = f"/proc/{os.getpid()}/fd/{fd}"
+    return path if os.path.realpath(path) == device else device
 
 
 def _symlink(target: str, link: str) -> None:

@@ -136,9 +136,10 @@ def explain_open_error(where: str, exc: Exception, scheme: str = "") -> str:
             return f"no such port {where}: the Bluetooth serial port is not bound: {RFCOMM_BIND}"
         if os.path.islink(where):  # a board's --link, its board gone
             gone = os.readlink(where)
+            board = gone.startswith(("/dev/pts/", "/proc/"))  # a board's pty, or its fd
             why = (
-                "a pseudo-terminal that is gone (its board has stopped: start it again with --link)"
-                if gone.startswith("/dev/pts/")
+                "the pseudo-terminal of a board that has stopped (start it again with --link)"
+                if board
                 else "a device that is not there"
             )
             return f"no such port {where}: it is a link to {gone}, {why}; {LIST_PORTS}"
