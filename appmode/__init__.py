@@ -25,7 +25,6 @@ import appmode.cli.entry  # noqa: F401 - for its effect
 # isort: on
 
 import importlib
-from typing import TYPE_CHECKING, Any
 
 import serial
 
@@ -35,7 +34,11 @@ for _package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):  # 
     if _package not in serial.protocol_handler_packages:
         serial.protocol_handler_packages.append(_package)
 
+TYPE_CHECKING = False
+"""typing.TYPE_CHECKING, without importing typing here (start-up: mypy reads the name)."""
 if TYPE_CHECKING:
+    from typing import Any
+
     from appmode.board.firmware import Board
     from appmode.host.app.client import Host
     from appmode.host.control.client import ControlHost

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import errno
+import functools
 import importlib
 import os
 import sys
@@ -57,8 +58,23 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
             if isinstance(command_parser, Parser):
                 command_parser.examples = EXAMPLES[name]
         else:
-            sub.add_parser(name, help=help)  # its arguments are loaded when it runs
+            _listed(sub, name, help)  # its arguments are loaded when it runs
     return parser
+
+
+def _listed(sub: argparse._SubParsersAction[Parser], name: str, help: str) -> None:
+    """`name` in the list of commands, with its help, and no parser of its own: only the
+    command that runs is built (each ArgumentParser costs start-up, its gettext lookups
+    most). The command line that names it builds it."""
+    sub._choices_actions.append(sub._ChoicesPseudoAction(name, (), help))
+    sub._name_parser_map[name] = _stand_in()
+
+
+@functools.cache
+def _stand_in() -> Parser:
+    """What stands for a command listed but not built: a choice argparse accepts, never
+    parsed with (the command that runs is the one built)."""
+    return Parser(add_help=False)
 
 
 class _Version(argparse.Action):

@@ -6,9 +6,11 @@ import argparse
 import math
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, NoReturn, TypeAlias
 
-if TYPE_CHECKING:  # the rest is imported where it is used: start-up stays short
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:  # the rest is imported where it is used
+    from typing import Any, NoReturn, TypeAlias
+
     from _typeshed import SupportsWrite
 
     from appmode.ports.choice import BoardChoice
@@ -189,7 +191,10 @@ class Parser(argparse.ArgumentParser):
             (file or sys.stderr).write(message)
 
 
-Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
+if TYPE_CHECKING:
+    Subparsers: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
+else:  # a name the commands import; their annotations are never evaluated
+    Subparsers = "argparse._SubParsersAction[argparse.ArgumentParser]"
 """What `add_subparsers()` returns."""
 
 

@@ -9,10 +9,10 @@ shipped `sheet` and `minibalance` files: one source of truth.
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable, Mapping
 from functools import cache
-from importlib import resources
 from typing import Any, NamedTuple
 
 from appmode.protocol.profile_checks import (
@@ -119,7 +119,9 @@ def shipped(name: str) -> ProfileFile:
     """A profile appmode ships, from the package's own data (`profiles/NAME.toml`)."""
     if name not in SHIPPED:
         raise ProfileError(name, [f"no shipped profile: choose one of {', '.join(SHIPPED)}"])
-    text = resources.files(__package__).joinpath("profiles", f"{name}.toml").read_text("utf-8")
+    path = os.path.join(os.path.dirname(__file__), "profiles", f"{name}.toml")
+    with open(path, encoding="utf-8") as file:  # beside this module, in the package
+        text = file.read()
     return parse(text, f"{name} (shipped)", ours=True)
 
 
