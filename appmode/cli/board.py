@@ -18,7 +18,7 @@ from appmode.cli.options import (
     number_type,
 )
 from appmode.errors import AppmodeError
-from appmode.protocol.params import DRIVE_NAMES
+from appmode.protocol.drive_types import DRIVE_NAMES
 
 ADVERTISED_NAME = "HC-08"
 """The name a BLE module ships with, and the vendor's app lists."""

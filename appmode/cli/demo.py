@@ -12,7 +12,7 @@ from appmode.board.profiles import SHEET, Profile, profile_named
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile
 from appmode.protocol import app
-from appmode.protocol.params import DRIVE_NAMES, DriveType
+from appmode.protocol.drive_types import DRIVE_NAMES, DriveType
 
 ROUTE: tuple[tuple[float, app.Command], ...] = (
     (0.00, app.ReadParams()),

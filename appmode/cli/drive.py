@@ -17,7 +17,7 @@ from appmode.cli.options import (
     number_type,
     target,
 )
-from appmode.protocol.params import DRIVE_NAMES
+from appmode.protocol.drive_types import DRIVE_NAMES
 from appmode.session.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 

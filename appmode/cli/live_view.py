@@ -8,9 +8,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
-from appmode.protocol.layouts import Layout
-
 if TYPE_CHECKING:
+    from appmode.protocol.layouts import Layout
     from appmode.viewers.live import LiveView
 
 HELP = (

@@ -8,11 +8,12 @@ nothing else in appmode spells out a parameter's name, range or default.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from enum import IntEnum
 from typing import NamedTuple
 
 from appmode.errors import InvalidValue
 from appmode.protocol import profile_file
+from appmode.protocol.drive_types import DRIVE_NAMES as DRIVE_NAMES
+from appmode.protocol.drive_types import DriveType as DriveType
 
 U16 = 0xFFFF
 U32 = 0xFFFF_FFFF
@@ -47,38 +48,6 @@ MAX_SPEED = BY_NAME["max_speed"].index
 SYSTEM_MODE = BY_NAME["system_mode"].index
 
 
-class DriveType(IntEnum):
-    """System-mode bits 0–2."""
-
-    OMNI = 0
-    MECANUM = 1
-    DIFF = 2
-    DIFF_GYRO = 3
-
-    @property
-    def cli_name(self) -> str:
-        return _DRIVE_CLI_NAMES[self]
-
-    @property
-    def differential(self) -> bool:
-        return self in (DriveType.DIFF, DriveType.DIFF_GYRO)
-
-    @classmethod
-    def from_cli_name(cls, name: str) -> DriveType:
-        for drive, text in _DRIVE_CLI_NAMES.items():
-            if text == name:
-                return drive
-        choices = ", ".join(_DRIVE_CLI_NAMES.values())
-        raise InvalidValue(f"unknown drive type {name!r}: choose one of {choices}")
-
-
-_DRIVE_CLI_NAMES = {
-    DriveType.OMNI: "omni",
-    DriveType.MECANUM: "mecanum",
-    DriveType.DIFF: "diff",
-    DriveType.DIFF_GYRO: "diff-gyro",
-}
-DRIVE_NAMES: tuple[str, ...] = tuple(_DRIVE_CLI_NAMES.values())
 DRIVE_MASK = 0b111
 _DRIVES: dict[int, DriveType] = {drive.value: drive for drive in DriveType}
 
