@@ -18,7 +18,7 @@ from appmode.cli.options import (
     target,
 )
 from appmode.protocol.drive_types import DRIVE_NAMES
-from appmode.session.hold import FIRST_TIMEOUT, REPEAT_TIMEOUT
+from appmode.session.timeouts import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:

@@ -13,10 +13,13 @@ from __future__ import annotations
 import errno
 import os
 import sys
-from typing import TextIO, cast
 
 from appmode.host import signals
 from appmode.writer import CLOSE_WAIT, BoundedWriter
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from typing import TextIO
 
 STEP = 0.1
 """Seconds between looks at a draining writer (a signal is acted on between them)."""
@@ -69,7 +72,7 @@ def install() -> tuple[Outlet, Outlet] | None:
         outlets = first, Outlet(err, "standard error", first.writer)
     except (OSError, ValueError, AttributeError):
         return None
-    sys.stdout, sys.stderr = (cast(TextIO, outlet) for outlet in outlets)
+    sys.stdout, sys.stderr = outlets  # as much of a TextIO as print and prompt_toolkit use
     return outlets
 
 

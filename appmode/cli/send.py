@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 from contextlib import ExitStack
-from typing import TYPE_CHECKING, TextIO
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
@@ -21,7 +20,10 @@ from appmode.cli.options import (
 )
 from appmode.host.token_help import APP_TOKENS, CONTROL_TOKENS
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
+    from typing import TextIO
+
     from appmode.ports.choice import BoardChoice
 
 

@@ -12,9 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from appmode.protocol.directions import STOP_LETTER
-
-FIRST_TIMEOUT = 0.6
-REPEAT_TIMEOUT = 0.15
+from appmode.session.timeouts import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 
 @dataclass(slots=True)
