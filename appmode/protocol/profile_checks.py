@@ -42,11 +42,7 @@ def in_scales(value: object) -> bool:
 
 def plain(value: object) -> bool:
     """A text a view can show as it is: no control characters, not too long."""
-    return (
-        isinstance(value, str)
-        and len(value) <= MAX_TEXT
-        and all(ch.isprintable() or ch == " " for ch in value)
-    )
+    return isinstance(value, str) and len(value) <= MAX_TEXT and value.isprintable()
 
 
 def text_value(

@@ -42,8 +42,8 @@ class TimeBins(Generic[T]):
         """Every bin twice as wide: each pair of neighbours merged into one."""
         bins, merge = self._bins, self._merge
         merged: list[T | None] = []
-        for i in range(0, self._size - 1, 2):
-            first, second = bins[i], bins[i + 1]
+        for i in range(0, self._size, 2):
+            first, second = bins[i], bins[i + 1] if i + 1 < self._size else None
             merged.append(
                 first if second is None else second if first is None else merge(first, second)
             )

@@ -310,21 +310,25 @@ class _CappedRunner(web.AppRunner):
 
     async def _make_server(self) -> web.Server:
         server = await super()._make_server()
-        made, owners = server.connection_made, self._owners
+        made, lost, owners = server.connection_made, server.connection_lost, self._owners
 
         def connection_made(handler: Any, transport: asyncio.Transport) -> None:
             made(handler, transport)
             connections = server.connections  # oldest first
             if len(connections) <= MAX_CONNECTIONS:
                 return
-            owners.intersection_update(connections)  # forget those that ended
             for stranger in connections:  # at worst the newcomer, `handler`
                 link = stranger.transport
                 if stranger not in owners and link is not None and not link.is_closing():
                     link.close()
                     return
 
+        def connection_lost(handler: Any, exc: BaseException | None = None) -> None:
+            owners.discard(handler)  # the set holds live connections only
+            lost(handler, exc)
+
         server.connection_made = connection_made  # type: ignore[method-assign]
+        server.connection_lost = connection_lost  # type: ignore[method-assign]
         return server
 
 

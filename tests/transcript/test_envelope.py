@@ -46,6 +46,10 @@ def test_bins_merge_pairs_as_time_outgrows_them() -> None:
         bins.put(float(t), 1)
     kept = bins.kept()
     assert len(kept) <= 8 and sum(kept) == 1000, "every value counted once"
+    odd: TimeBins[int] = TimeBins(lambda a, b: a + b, size=7)
+    for t in range(1000):
+        odd.put(float(t), 1)
+    assert len(odd.kept()) <= 7 and sum(odd.kept()) == 1000, "an odd last bin is kept too"
     marks = Marks(size=4)
     for t in range(100):
         marks.add(t * 1.0, f"c{t}")
