@@ -13,7 +13,8 @@ The public API (docs/api.md):
 - `AppmodeError` (what went wrong, where, how to fix it) and its `TranscriptError`.
 
 Each name is imported when first used, so `import appmode` (and the pytest plugin that
-pytest loads wherever appmode is installed) costs only pyserial's import.
+pytest loads wherever appmode is installed) costs only pyserial's import; the `appmode`
+program imports pyserial only for a command that opens a port (start-up).
 """
 
 from __future__ import annotations
@@ -21,18 +22,26 @@ from __future__ import annotations
 # isort: off
 # First, before anything else loads: started as the `appmode` program, a Ctrl-C from now
 # on ends it quietly (appmode.cli.entry), never with a traceback.
-import appmode.cli.entry  # noqa: F401 - for its effect
+import appmode.cli.entry
 # isort: on
 
 import importlib
 
-import serial
-
 from appmode.errors import AppmodeError
 
-for _package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):  # sim://, …
-    if _package not in serial.protocol_handler_packages:
-        serial.protocol_handler_packages.append(_package)
+
+def register_urls() -> None:
+    """Have pyserial open appmode's URLs (`serial.serial_for_url("sim://")`): sim://,
+    ble://, bt:// and zenoh://, whose modules these packages hold."""
+    import serial
+
+    for package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):
+        if package not in serial.protocol_handler_packages:
+            serial.protocol_handler_packages.append(package)
+
+
+if not appmode.cli.entry.AS_PROGRAM:  # the program's ports.urls registers them itself
+    register_urls()
 
 TYPE_CHECKING = False
 """typing.TYPE_CHECKING, without importing typing here (start-up: mypy reads the name)."""

@@ -4,9 +4,10 @@ outside (a device's name, a profile's labels, a board's bytes) made safe to show
 from __future__ import annotations
 
 import re
-import textwrap
 
-_UNSAFE = re.compile(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
+from appmode.patterns import deferred
+
+_UNSAFE = deferred(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
 """What a terminal or a page would act on rather than show: C0 and C1 controls (ESC
 starts a terminal's commands: colours, the clipboard, the title, erasing a line), DEL,
 the line and paragraph separators, and the bidirectional marks and overrides that
@@ -26,7 +27,7 @@ def _escape(found: re.Match[str]) -> str:
 
 LONGEST_WORD = 120
 """The longest run of characters without a space an error message shows whole."""
-_LONG_WORD = re.compile(rf"\S{{{LONGEST_WORD + 1},}}")
+_LONG_WORD = deferred(rf"\S{{{LONGEST_WORD + 1},}}")
 
 
 def shortened(text: str) -> str:
@@ -42,6 +43,8 @@ def counted(count: int, noun: str, plural: str | None = None) -> str:
 
 def wrapped(text: str, width: int = 80, indent: str = "  ") -> str:
     """`text` in lines of at most `width` columns, whole words, the later lines indented."""
+    import textwrap  # here: start-up
+
     return textwrap.fill(
         text,
         width,

@@ -42,7 +42,8 @@ class Steer:
 
 
 _STEER = tuple(
-    tuple(Steer(event, framed) for event in app_decoders.SINGLE_BYTE) for framed in (False, True)
+    tuple(Steer(event, framed) for event in app_decoders.single_byte_events())
+    for framed in (False, True)
 )
 
 

@@ -5,13 +5,15 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Iterable, Iterator
-from typing import TYPE_CHECKING, BinaryIO, TextIO
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile
 from appmode.errors import AppmodeError
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:  # the codec is imported when the command runs: start-up stays short
+    from typing import BinaryIO, TextIO
+
     from appmode.protocol import app
     from appmode.protocol.layouts import Layout
 
@@ -93,9 +95,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.board.profiles import profile_named
+    layout = None  # the sheet's
+    if args.profile:
+        from appmode.board.profiles import profile_named
 
-    layout = profile_named(args.profile).a_layout if args.profile else None  # None: the sheet's
+        layout = profile_named(args.profile).a_layout
     if args.file in (None, "-"):
         run_decode(sys.stdin.buffer, sys.stdout, args.source, layout=layout)
         return 0

@@ -29,7 +29,7 @@ def main() -> int:
             signal.signal(signum, signal.SIG_IGN)  # the command is over: its exit stands
 
 
-def _started_as_program() -> bool:
+def started_as_program() -> bool:
     """This interpreter runs `appmode` or `python -m appmode` (not a program that imports
     appmode, whose signals are its own)."""
     argv = getattr(sys, "argv", None) or [""]  # an embedding interpreter may have none
@@ -38,7 +38,9 @@ def _started_as_program() -> bool:
     return argv[0].replace("\\", "/").rsplit("/", 1)[-1] in ("appmode", "appmode.exe")
 
 
-if _started_as_program():
+AS_PROGRAM = started_as_program()
+"""This process is the `appmode` program (its commands open ports through ports.urls)."""
+if AS_PROGRAM:
     quit_while_loading()
 
 if __name__ == "__main__":

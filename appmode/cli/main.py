@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import errno
-import functools
 import importlib
 import os
 import sys
@@ -17,6 +16,10 @@ from appmode.cli.commands import COMMANDS, EXAMPLES
 from appmode.cli.options import Parser
 from appmode.errors import AppmodeError
 from appmode.host import signals
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from appmode.cli.outlet import Outlet
 
 OUTPUT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EBADF}
 """The errors of a write that did not go through (other OSErrors are reported as they are)."""
@@ -58,23 +61,17 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
             if isinstance(command_parser, Parser):
                 command_parser.examples = EXAMPLES[name]
         else:
-            _listed(sub, name, help)  # its arguments are loaded when it runs
+            _listed(sub, name, help, parser)  # its arguments are loaded when it runs
     return parser
 
 
-def _listed(sub: argparse._SubParsersAction[Parser], name: str, help: str) -> None:
+def _listed(sub: argparse._SubParsersAction[Parser], name: str, help: str, top: Parser) -> None:
     """`name` in the list of commands, with its help, and no parser of its own: only the
     command that runs is built (each ArgumentParser costs start-up, its gettext lookups
-    most). The command line that names it builds it."""
+    most). The command line that names it builds it; in argparse's table of choices the
+    top parser stands for it, never parsed with."""
     sub._choices_actions.append(sub._ChoicesPseudoAction(name, (), help))
-    sub._name_parser_map[name] = _stand_in()
-
-
-@functools.cache
-def _stand_in() -> Parser:
-    """What stands for a command listed but not built: a choice argparse accepts, never
-    parsed with (the command that runs is the one built)."""
-    return Parser(add_help=False)
+    sub._name_parser_map[name] = top
 
 
 class _Version(argparse.Action):
@@ -151,15 +148,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 0
     signals.install()
-    outlets = None
-    if command in DRIVES:  # what drives a car writes through bounded writers
-        from appmode.cli import outlet
-
-        outlets = outlet.install()
+    outlets: list[tuple[Outlet, Outlet] | None] = []
     try:
-        status = _run(parser, words)
+        status = _run(parser, words, outlets)
     finally:
-        lost = outlet.finish(outlets) if outlets is not None else None
+        lost = None
+        if outlets and outlets[0] is not None:
+            from appmode.cli import outlet
+
+            lost = outlet.finish(outlets[0])
         signals.finish()
     if lost is not None:
         with contextlib.suppress(OSError):
@@ -168,8 +165,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     return status
 
 
-def _run(parser: argparse.ArgumentParser, words: Sequence[str]) -> int:
-    """Parse and run the command, every mistake as one line on stderr; its exit status."""
+def _run(
+    parser: argparse.ArgumentParser,
+    words: Sequence[str],
+    outlets: list[tuple[Outlet, Outlet] | None],
+) -> int:
+    """Parse and run the command, every mistake as one line on stderr; its exit status.
+    A command that can move a car writes through bounded writers from when it starts
+    (put in `outlets`); its help and usage are written before it can."""
     try:
         try:
             args = parser.parse_args(words)
@@ -177,6 +180,10 @@ def _run(parser: argparse.ArgumentParser, words: Sequence[str]) -> int:
             if exc.code:  # a usage error: argparse has said what, on stderr
                 raise
             args = argparse.Namespace(handler=lambda _: 0)  # --help or --version: printed
+        if getattr(args, "command", None) in DRIVES:  # not after --help
+            from appmode.cli import outlet
+
+            outlets.append(outlet.install())
         handler: Handler = args.handler
         status = handler(args)
         sys.stdout.flush()  # here, where a full disk or a closed pipe can be reported

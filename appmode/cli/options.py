@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from collections.abc import Callable
 
@@ -163,6 +164,21 @@ def board_choice(args: argparse.Namespace) -> BoardChoice:
     )
 
 
+def terminal_columns() -> int:
+    """The terminal's width as `shutil.get_terminal_size` finds it: $COLUMNS, else
+    standard output's terminal, else 80."""
+    try:
+        columns = int(os.environ.get("COLUMNS", ""))
+    except ValueError:
+        columns = 0
+    if columns > 0:
+        return columns
+    try:
+        return os.get_terminal_size(sys.__stdout__.fileno()).columns or 80  # type: ignore[union-attr]
+    except (AttributeError, ValueError, OSError):
+        return 80
+
+
 class Parser(argparse.ArgumentParser):
     """An argument parser that takes options only as spelled: no prefix matching, so a
     mistyped option is an error naming it, never another option."""
@@ -172,6 +188,15 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self.examples: tuple[str, ...] = ()
         """Command lines shown at the end of the help."""
+
+    def _get_formatter(self) -> argparse.HelpFormatter:
+        """argparse's, told the terminal's width: argparse asks shutil for it, whose
+        import (bz2, lzma, zlib) was a twentieth of a command's start-up."""
+        width = terminal_columns() - 2  # every HelpFormatter takes it; typeshed names prog
+        formatter = self.formatter_class(prog=self.prog, width=width)  # type: ignore[call-arg]
+        if hasattr(formatter, "_set_color"):  # Python 3.14: colour, as argparse sets it
+            formatter._set_color(getattr(self, "color", False))
+        return formatter
 
     def format_help(self) -> str:
         """argparse's help, then the examples as they are typed."""

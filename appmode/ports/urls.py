@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 import serial
 
+from appmode import register_urls
 from appmode.errors import AppmodeError
 from appmode.ports.holders import holders
 from appmode.ports.target import AnyTarget, Target, as_target, parse_target
@@ -29,9 +30,7 @@ if TYPE_CHECKING:
 
 NO_PTY = "this system has no pseudo-terminals (Windows)"
 
-for _package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):  # sim://, …
-    if _package not in serial.protocol_handler_packages:
-        serial.protocol_handler_packages.append(_package)
+register_urls()  # sim://, ble://, …, for serial.serial_for_url below
 
 BAUD = 9600
 OWN_PORTS = {

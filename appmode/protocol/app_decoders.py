@@ -10,10 +10,9 @@ how the stream is split into `feed` calls.
 from __future__ import annotations
 
 import functools
-import re
 from collections.abc import Callable
-from typing import TypeVar
 
+from appmode.patterns import deferred
 from appmode.protocol import params
 from appmode.protocol.app import (
     COLON,
@@ -43,10 +42,15 @@ from appmode.protocol.app import (
 from appmode.protocol.bulk import linear
 from appmode.protocol.directions import LETTERS, PAGE_LETTERS
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+
 # ---------------------------------------------------------------- host stream
 
 
-def _single_byte_events() -> tuple[ByteEvent, ...]:
+@functools.cache
+def single_byte_events() -> tuple[ByteEvent, ...]:
+    """What each byte means outside a frame (§2.1), by value: built when a host stream is
+    first decoded (start-up)."""
     table: list[ByteEvent] = []
     for value in range(256):
         raw = bytes([value])
@@ -66,12 +70,11 @@ def _single_byte_events() -> tuple[ByteEvent, ...]:
     return tuple(table)
 
 
-SINGLE_BYTE = _single_byte_events()
-"""What each byte means outside a frame (§2.1), by value."""
+if TYPE_CHECKING:
+    from typing import TypeVar
 
-
-E = TypeVar("E")
-_BRACES = re.compile(rb"\{{2,%d}" % (MAX_RUN + 1))
+    E = TypeVar("E")
+_BRACES = deferred(rb"\{{2,%d}" % (MAX_RUN + 1))
 
 
 def _brace_run(
@@ -119,7 +122,7 @@ def _interrupted(what: str, count: int) -> str:
     return f"{what} interrupted by '{{'" if count == 1 else f"{count} {what}s interrupted by '{{'"
 
 
-_FRAMES = re.compile(rb"(\{[^{}]{0,%d}\})" % (MAX_FRAME - 2))
+_FRAMES = deferred(rb"(\{[^{}]{0,%d}\})" % (MAX_FRAME - 2))
 """A whole frame of up to MAX_FRAME bytes: what the general way would read as one."""
 
 
@@ -163,7 +166,7 @@ class HostDecoder:
     def feed(self, data: bytes) -> list[HostEvent]:
         buf = self._buf + data if self._buf else bytes(data)
         out: list[HostEvent] = []
-        general, parse, single = self._general, _parse_frame, SINGLE_BYTE
+        general, parse, single = self._general, _parse_frame, single_byte_events()
         pos = 0
         # split scans in C: [gap, frame, gap, frame, …, gap]; a gap of single bytes is
         # read here, others go the general way, the last one held where it may continue
@@ -186,7 +189,7 @@ class HostDecoder:
         """Decode buf[pos:end], which holds no whole frame of up to MAX_FRAME bytes;
         at the end of `buf`, stop where more bytes could change the outcome. Returns
         where it stopped."""
-        n, single = len(buf), SINGLE_BYTE
+        n, single = len(buf), single_byte_events()
         while pos < end:
             if self._skip_len:
                 skipped = self._skip(buf, pos, n, out)
@@ -267,7 +270,7 @@ def _overlong(length: int, done: bool = False) -> str:
 
 # ---------------------------------------------------------------- board stream
 
-_FIELDS = re.compile(rb"-?[0-9]+(?::-?[0-9]+)*")
+_FIELDS = deferred(rb"-?[0-9]+(?::-?[0-9]+)*")
 _RECORD_SIZES = {ord("A"): 4, ord("B"): 4, ord("C"): params.PARAM_COUNT}
 
 
@@ -300,11 +303,11 @@ def _parse_record(
     return Attitude(a, b, c, d, terminated, raw)
 
 
-_FAST = re.compile(rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")
+_FAST = deferred(rb"(\{[AB](-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")
 """A complete A or B record: the common case, decoded without the general path. It opens
 with a literal `{`, so the search skips to each `{` and fails within a few bytes there:
 linear in the input, whatever it holds."""
-_FAST_A = re.compile(rb"(\{A(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")
+_FAST_A = deferred(rb"(\{A(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11}):(-?[0-9]{1,11})\}\$)")
 """`_FAST` for A records alone (a profile whose B record has other than four fields)."""
 _FAST_KIND = {0x41: Velocity, 0x42: Attitude}
 

@@ -8,13 +8,16 @@ from __future__ import annotations
 import functools
 import gc
 from collections.abc import Callable
-from typing import TypeVar
 
 BULK = 1 << 16
 """Bytes from which one call pauses the collector."""
 
-T = TypeVar("T")
-R = TypeVar("R")
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from typing import TypeVar
+
+    T = TypeVar("T")
+    R = TypeVar("R")
 
 
 def linear(feed: Callable[[T, bytes], R]) -> Callable[[T, bytes], R]:

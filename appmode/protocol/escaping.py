@@ -6,14 +6,14 @@ other byte is written `\\xNN`.
 
 from __future__ import annotations
 
-import re
+from appmode.patterns import deferred
 
 _TABLE = [chr(b) if 0x21 <= b <= 0x7E else f"\\x{b:02x}" for b in range(256)]
 _TABLE[0x5C] = "\\\\"
 _TEXT_TABLE = {b: text for b, text in enumerate(_TABLE) if text != chr(b)}
-_PLAIN = re.compile(rb"[\x21-\x5b\x5d-\x7e]*")
-_TOKEN = re.compile(r"\\(?:x([0-9a-fA-F]{2})|(\\))|([\x21-\x5b\x5d-\x7e])")
-_NOT_TEXT = re.compile(rb"[^\x20-\x7e\t\r\n]")
+_PLAIN = deferred(rb"[\x21-\x5b\x5d-\x7e]*")
+_TOKEN = deferred(r"\\(?:x([0-9a-fA-F]{2})|(\\))|([\x21-\x5b\x5d-\x7e])")
+_NOT_TEXT = deferred(rb"[^\x20-\x7e\t\r\n]")
 
 
 def text_part(data: bytes) -> bytes:

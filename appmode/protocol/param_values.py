@@ -6,7 +6,6 @@ against the profile's ranges. The sheet's own rules (system_mode's drive type) a
 from __future__ import annotations
 
 from collections.abc import Sequence
-from decimal import Decimal, DecimalException
 
 from appmode.errors import InvalidValue
 from appmode.protocol import params
@@ -58,6 +57,8 @@ def from_user(spec: ParamSpec, text: str) -> int:
         if number is None:
             raise InvalidValue(f"{spec.name} takes a whole number in {range_text(spec)}")
         return number
+    from decimal import Decimal, DecimalException  # here: start-up (`decode` shows no value)
+
     try:
         if len(text) > 40 or not text.isascii() or text.startswith("+") or "_" in text:
             raise DecimalException
@@ -76,6 +77,8 @@ def to_user(spec: ParamSpec, value: int) -> str:
     """The frame's integer as the user's value (42 with scale 100: `0.42`)."""
     if spec.scale == 1:
         return str(value)
+    from decimal import Decimal  # here: start-up (`decode` of records with no scaled value)
+
     shown = Decimal(value) / Decimal(repr(spec.scale))
     text = format(shown.normalize(), "f")
     return text

@@ -8,12 +8,17 @@ nothing else in appmode spells out a parameter's name, range or default.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple
 
 from appmode.errors import InvalidValue
 from appmode.protocol import profile_file
 from appmode.protocol.drive_types import DRIVE_NAMES as DRIVE_NAMES
 from appmode.protocol.drive_types import DriveType as DriveType
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from typing import NamedTuple
+else:
+    from appmode.protocol.tuples import NamedTuple
 
 U16 = 0xFFFF
 U32 = 0xFFFF_FFFF

@@ -4,7 +4,10 @@ numbers, scales, texts a view can show as they are, tables of letters."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from typing import Any
 
 NAME_CHARACTERS = frozenset("abcdefghijklmnopqrstuvwxyz0123456789_")
 """A profile's, a field's and a parameter's name: these, a letter first (a JSON key and

@@ -9,11 +9,11 @@ shipped `sheet` and `minibalance` files: one source of truth.
 
 from __future__ import annotations
 
+import marshal
 import os
 import sys
 from collections.abc import Callable, Mapping
 from functools import cache
-from typing import Any, NamedTuple
 
 from appmode.protocol.profile_checks import (
     SCALE_TEXT,
@@ -26,10 +26,11 @@ from appmode.protocol.profile_checks import (
     whole,
 )
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from typing import Any, NamedTuple
+else:
+    from appmode.protocol.tuples import NamedTuple
 
 SHIPPED = ("sheet", "minibalance", "balance")
 """The profiles appmode ships, in the order `profile list` shows them (the command line's
@@ -119,21 +120,59 @@ def shipped(name: str) -> ProfileFile:
     """A profile appmode ships, from the package's own data (`profiles/NAME.toml`)."""
     if name not in SHIPPED:
         raise ProfileError(name, [f"no shipped profile: choose one of {', '.join(SHIPPED)}"])
-    path = os.path.join(os.path.dirname(__file__), "profiles", f"{name}.toml")
-    with open(path, encoding="utf-8") as file:  # beside this module, in the package
-        text = file.read()
-    return parse(text, f"{name} (shipped)", ours=True)
+    folder = os.path.join(os.path.dirname(__file__), "profiles")
+    with open(os.path.join(folder, f"{name}.toml"), encoding="utf-8") as file:
+        text = file.read()  # beside this module, in the package
+    where = f"{name} (shipped)"
+    return parse(text, where, ours=True, data=_read_through(folder, name, text, where))
 
 
-def parse(text: str, where: str, ours: bool = False) -> ProfileFile:
-    """A profile file's text checked and read (`ours`: one appmode ships, whose name
-    is one of SHIPPED; a user's may not take those names)."""
+def _read_through(folder: str, name: str, text: str, where: str) -> dict[str, Any]:
+    """A shipped file's TOML read, kept as Python keeps bytecode: in `__pycache__`
+    beside it (marshal), holding the text it was read from, used only while the file
+    still holds that text. Start-up: tomllib's import and parse were a fifth of
+    `appmode decode`'s. Where the folder cannot be written, the file is read each time."""
+    cached = os.path.join(folder, "__pycache__", f"{name}.{sys.implementation.cache_tag}.toml")
     try:
-        data = tomllib.loads(text)
+        with open(cached, "rb") as file:
+            kept_text, data = marshal.load(file)
+        if kept_text == text and isinstance(data, dict):
+            return data
+    except (OSError, EOFError, ValueError, TypeError):
+        pass  # none yet, or one another Python wrote: read the file
+    data = _toml(text, where)
+    try:
+        os.makedirs(os.path.dirname(cached), exist_ok=True)
+        partial = f"{cached}.{os.getpid()}"
+        with open(partial, "wb") as file:
+            marshal.dump((text, data), file)
+        os.replace(partial, cached)  # whole or not at all, as Python writes bytecode
+    except (OSError, ValueError):
+        pass  # a folder nobody may write, or a value marshal cannot keep: read it each time
+    return data
+
+
+def _toml(text: str, where: str) -> dict[str, Any]:
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ProfileError(where, [f"not TOML: {exc}"]) from None
     except RecursionError:
         raise ProfileError(where, ["nested too deeply: a profile's values are flat"]) from None
+
+
+def parse(
+    text: str, where: str, ours: bool = False, data: dict[str, Any] | None = None
+) -> ProfileFile:
+    """A profile file's text checked and read (`ours`: one appmode ships, whose name
+    is one of SHIPPED; a user's may not take those names; `data`: the text's TOML
+    already read)."""
+    if data is None:
+        data = _toml(text, where)
     problems: list[str] = []
     base: ProfileFile | None = None
     like = data.get("like")

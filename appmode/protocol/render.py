@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import json
-from collections.abc import Iterable, Iterator
-from typing import Any
+import functools
+from collections.abc import Callable, Iterable, Iterator
 
 from appmode.protocol import app as p
 from appmode.protocol import param_values
@@ -13,6 +12,10 @@ from appmode.protocol.escaping import escape, text_part
 from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, Layout
 from appmode.protocol.params import DEFAULTS
 from appmode.text import counted
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def record_names(letter: str, layout: Layout = VELOCITY) -> tuple[str, ...]:
@@ -112,7 +115,12 @@ def to_json(event: p.Event, layout: Layout = VELOCITY) -> dict[str, Any]:
     return body
 
 
-_JSON = json.JSONEncoder(ensure_ascii=False).encode
+@functools.cache
+def _json() -> Callable[[object], str]:
+    """json.dumps(…, ensure_ascii=False), json imported when first needed (start-up)."""
+    import json
+
+    return json.JSONEncoder(ensure_ascii=False).encode
 
 
 def json_line(event: p.Event, layout: Layout = VELOCITY) -> str:
@@ -132,7 +140,7 @@ def json_line(event: p.Event, layout: Layout = VELOCITY) -> str:
                 f'{{"kind": "attitude", "pitch": {event.pitch}, "roll": {event.roll}, '
                 f'"yaw": {event.yaw}, "battery": {event.battery}, "raw": "{raw}"}}'
             )
-    return _JSON(to_json(event, layout))
+    return _json()(to_json(event, layout))
 
 
 def motion_text(record: p.Velocity, layout: Layout = VELOCITY) -> str:
