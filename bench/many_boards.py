@@ -24,6 +24,7 @@ import threading
 import time
 import tty
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 from appmode.board.firmware import Board
@@ -33,6 +34,8 @@ from appmode.ports.serve import BoardServer, switched_on
 from appmode.protocol.app import RECORDS
 from appmode.protocol.app_decoders import BoardDecoder
 from bench.common import percentile
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def serve(count: int) -> None:
@@ -133,7 +136,8 @@ def measure(count: int, seconds: float, read: bool = True) -> dict[str, float]:
     False nobody opens the boards' ports (their ptys fill, then what they send is
     dropped: records/s are 0)."""
     proc = subprocess.Popen(
-        [sys.executable, __file__, "--serve", str(count)],
+        [sys.executable, "-m", "bench.many_boards", "--serve", str(count)],
+        cwd=ROOT,  # the checkout's appmode, as `appmode board` run there imports it
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         text=True,

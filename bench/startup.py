@@ -3,12 +3,12 @@ pyserial's own command-line tool, `python -m serial.tools.miniterm --help`.
 
 Each command runs N times as a process (stdin /dev/null, output discarded), after one
 untimed run, in turns (miniterm, then each of appmode's, N rounds: a machine that slows
-down for a while slows them all); each median is printed with its ratio to miniterm's. The commands run as an
-installed program does, from bytecode: the untimed run writes appmode's cache, and
-PYTHONDONTWRITEBYTECODE is cleared for them (set, it had every timed run compile
-appmode's modules from source, 12 to 14 ms more for `decode`). With `--importtime
-MODULE_COUNT`, the modules that `appmode --help` spends most on (`python -X importtime`,
-cumulative µs) follow.
+down for a while slows them all); each median is printed with its ratio to miniterm's.
+The commands run as an installed program does, from bytecode: the untimed run writes
+appmode's cache, and PYTHONDONTWRITEBYTECODE is cleared for them (set, it had every
+timed run compile appmode's modules from source, 12 to 14 ms more for `decode`). With
+`--importtime MODULE_COUNT`, the modules that `appmode --help` spends most on (`python
+-X importtime`, cumulative µs) follow.
 Targets (TARGETS): issue 64.13's 1.0x miniterm for --help, params --help, drive --help
 and decode; issue 28.2's 1.5x for send --help.
 """

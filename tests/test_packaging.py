@@ -5,14 +5,26 @@ installed `appmode conform` runs that suite and `appmode protocol` reads that re
 
 from __future__ import annotations
 
+import os
+import shutil
 import subprocess
 import sys
+import sysconfig
+import time
 import zipfile
 from pathlib import Path
 
 import pytest
 
 from tests.support.processes import ROOT
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+START = time.time()
+"""When this module was loaded: a build after it leaves nothing in the checkout."""
 
 
 @pytest.fixture(scope="module")
@@ -84,17 +96,53 @@ def test_an_installed_appmode_conform_runs_the_shipped_suite(wheel: Path, tmp_pa
     ).read_bytes()
 
 
-def test_the_default_wheel_is_pure_python(wheel: Path) -> None:
-    """The compiled build is made only when asked for (HATCH_BUILD_HOOKS_ENABLE=1):
-    `pip install .` needs no C compiler, on any system."""
-    assert wheel.name.endswith("-py3-none-any.whl")
+def can_compile() -> bool:
+    """This machine has what the compiled build needs (hatch_build.compiler)."""
+    cc = (sysconfig.get_config_var("CC") or "cc").split()[0]
+    headers = Path(sysconfig.get_paths()["include"], "Python.h")
+    return sys.platform != "win32" and shutil.which(cc) is not None and headers.exists()
+
+
+def compiled_list() -> list[str]:
+    text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    return tomllib.loads(text)["tool"]["hatch"]["build"]["targets"]["wheel"]["hooks"]["custom"][
+        "compile"
+    ]
+
+
+def test_the_default_wheel_is_compiled_where_the_machine_can(wheel: Path) -> None:
+    """Issue 64.14: `pip install .` gives the compiled build where a C compiler and
+    Python's headers are (as aiohttp builds its extensions); the checkout is left as it was."""
     names = zipfile.ZipFile(wheel).namelist()
-    assert not [n for n in names if n.endswith((".so", ".pyd"))]
+    compiled = sorted(n.split(".")[0] + ".py" for n in names if n.endswith((".so", ".pyd")))
+    if not can_compile():
+        assert wheel.name.endswith("-py3-none-any.whl") and compiled == []
+        return
+    runtime = [n for n in compiled if "__mypyc" in n]
+    assert len(runtime) == 1 and "/" not in runtime[0], "mypyc's runtime, beside the package"
+    assert sorted(set(compiled) - set(runtime)) == sorted(compiled_list())
+    assert not wheel.name.endswith("-none-any.whl"), "tagged for this platform"
+    assert not [p for p in (ROOT / "appmode").rglob("*.so") if p.stat().st_mtime > START]
+
+
+def test_appmode_pure_builds_pure_python(tmp_path: Path) -> None:
+    """APPMODE_PURE=1: no compiler asked for, on any system."""
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp_path), str(ROOT)],
+        check=True,
+        capture_output=True,
+        timeout=300,
+        env={**os.environ, "APPMODE_PURE": "1"},
+    )
+    (found,) = tmp_path.glob("appmode-*.whl")
+    assert found.name.endswith("-py3-none-any.whl")
+    assert not [n for n in zipfile.ZipFile(found).namelist() if n.endswith((".so", ".pyd"))]
 
 
 def test_compiled_modules_beside_the_sources_are_as_new_as_them() -> None:
-    """The compiled build leaves its modules beside their sources, where Python imports
-    them first: one older than its source (edited since) would be run in its place."""
+    """Compiled modules beside their sources (`python -m bench.compiled` puts them there,
+    for CI's compiled tests and the benchmarks) are what Python imports first: one older
+    than its source (edited since) would be run in its place."""
     stale = [
         compiled.relative_to(ROOT).as_posix()
         for pattern in ("*.so", "*.pyd")
@@ -102,8 +150,8 @@ def test_compiled_modules_beside_the_sources_are_as_new_as_them() -> None:
         if compiled.stat().st_mtime < source_of(compiled).stat().st_mtime
     ]
     assert not stale, (
-        f"{', '.join(stale)}: older than their sources; build again "
-        "(HATCH_BUILD_HOOKS_ENABLE=1 pip install .) or remove them (rm appmode/*/*.so *__mypyc*.so)"
+        f"{', '.join(stale)}: older than their sources; put new ones there "
+        "(python -m bench.compiled) or remove them (python -m bench.compiled --remove)"
     )
 
 

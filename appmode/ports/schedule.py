@@ -48,14 +48,25 @@ class Served:
     def changed(self) -> None:
         """The board ran, or was replaced, outside `pump`: ask it again when it sends."""
         self.sends = None
+        if self.wire is not self._wired:  # replaced (a power cycle): its lines are new
+            self._wire_up()
 
     def __post_init__(self) -> None:
+        self._wire_up()
+
+    def _wire_up(self) -> None:
+        """What `pump` and `wakeup` look at on every pass, looked up once for the wire."""
+        ports = self.wire.ports
+        self._wired = self.wire
         self._grid = tuple(
-            (index, name, RUN[name], self.phase * RUN[name])
+            (index, name, RUN[name], self.phase * RUN[name], ports[name])
             for index, name in enumerate(PORTS)
             if name in self.endpoints
         )
-        """(index in `sends`, name, run, the grid's offset) of each port served."""
+        """(index in `sends`, name, run, the grid's offset, port) of each port served."""
+        self._outputs = tuple((ports[name].to_host, e) for name, e in self.endpoints.items())
+        """(line to the host, endpoint) of each port served."""
+        self._inputs = ports[APP].to_board, ports[UART2].to_board
 
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
@@ -66,14 +77,13 @@ class Served:
         sends = self.sends
         if sends is None:  # the board ran: else its plans are as they were
             sends = self.sends = wire.board.next_sends()
-        self.board_due = min(sends)
-        due = math.inf
-        ports = wire.ports
-        for index, name, run, offset in self._grid:
-            port = ports[name]
+        app, uart2 = sends
+        self.board_due = app if app < uart2 else uart2
+        due = inf = math.inf
+        for index, name, run, offset, port in self._grid:
             to_host, to_board = port.to_host, port.to_board
             mine = sends[index]
-            if mine == math.inf and not to_host.bursts and not to_board.bursts:
+            if mine == inf and not to_host.bursts and not to_board.bursts:
                 continue  # nothing planned, nothing on its lines (and so no read pending)
             step = to_host.byte_time
             mine += step  # the port's next output: its first byte
@@ -100,20 +110,17 @@ class Served:
     def pump(self, now: float) -> bool:
         """Write what the lines deliver by `now`, running the board first when it is due
         or has input; whether it ran (else it made no notes and its input is as it was)."""
-        wire = self.wire
-        ports = wire.ports
-        ran = now >= self.board_due or bool(
-            ports[APP].to_board.bursts or ports[UART2].to_board.bursts
-        )
+        to_app, to_uart2 = self._inputs
+        ran = now >= self.board_due or bool(to_app.bursts or to_uart2.bursts)
         if ran:
-            self.sends = wire.run(now)
-        for name, endpoint in self.endpoints.items():
-            line = ports[name].to_host
+            self.sends = self.wire.run(now)
+        faults = self.faults
+        for line, endpoint in self._outputs:
             if not line.bursts:
                 continue
             out = line.take(now)
-            if out and self.faults is not None:
-                out = self.faults[1].apply(out)
+            if out and faults is not None:
+                out = faults[1].apply(out)
             if out:
                 endpoint.write(out)
         return ran

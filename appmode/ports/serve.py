@@ -269,9 +269,17 @@ class BoardServer:
                 self._log_notes(one)
                 one.throttle()
             ran.append(index)
-        for index in ran:
-            self._reschedule(index)
-        return self._queue[0][0] if self._queue else math.inf
+        inf = math.inf
+        for index in ran:  # as _reschedule, written out: this runs for every write
+            due = served[index].wakeup()
+            if due != dues[index]:
+                dues[index] = due
+                if due < inf:
+                    heapq.heappush(queue, (due, index))
+        if len(queue) > 4 * len(dues) + 64:  # stale entries pile up: rebuild
+            self._queue = queue = [(d, i) for i, d in enumerate(dues) if d < inf]
+            heapq.heapify(queue)
+        return queue[0][0] if queue else inf
 
     def close(self) -> None:
         """Close every port, then the recording (what its decoders hold is written)."""

@@ -294,8 +294,7 @@ class WebServer:
                 while not ended.is_set():
                     if self.session is not None:
                         self.session.tick()
-                    with suppress(asyncio.TimeoutError):
-                        await asyncio.wait_for(ended.wait(), REFRESH)
+                    await asyncio.sleep(REFRESH)  # a signal is acted on within it
             finally:
                 await self.stop()
 
