@@ -7,8 +7,8 @@ down for a while slows them all); each median is printed with its ratio to minit
 The commands run as an installed program does, from bytecode: the untimed run writes
 appmode's cache, and PYTHONDONTWRITEBYTECODE is cleared for them (set, it had every
 timed run compile appmode's modules from source, 12 to 14 ms more for `decode`). With
-`--importtime MODULE_COUNT`, the modules that `appmode --help` spends most on (`python
--X importtime`, cumulative µs) follow.
+`--importtime MODULE_COUNT`, the modules that `appmode decode` (the four's heaviest)
+spends most on follow (`python -X importtime`, cumulative µs).
 Targets (TARGETS): issue 64.13's 1.0x miniterm for --help, params --help, drive --help
 and decode; issue 28.2's 1.5x for send --help.
 """
@@ -65,9 +65,10 @@ def medians_ms(runs: int) -> dict[str, float]:
 
 
 def heaviest(count: int) -> list[tuple[int, str]]:
-    """The modules `appmode --help` imports, by cumulative microseconds."""
+    """The modules `appmode decode </dev/null` imports, by cumulative microseconds."""
     done = subprocess.run(
-        [sys.executable, "-X", "importtime", "-m", "appmode", "--help"],
+        [sys.executable, "-X", "importtime", "-m", "appmode", "decode"],
+        stdin=subprocess.DEVNULL,
         env=ENV,
         capture_output=True,
         text=True,

@@ -11,6 +11,8 @@ from appmode.protocol.app_decoders import BoardDecoder
 from appmode.protocol.profile_file import Field, ParamSpec, ProfileFile
 from appmode.protocol.slotted import Frozen
 
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
+
 
 class Layout(Frozen):
     """One reading of `{A<f0>:<f1>:<f2>:<f3>}$`, `{B…}$` and `{C…}$`: a profile file's."""
@@ -108,5 +110,21 @@ class Layout(Frozen):
 
 
 VELOCITY = Layout("velocity", profile_file.shipped("sheet"))
-SCALED = Layout("scaled", profile_file.shipped("minibalance"))
-A_LAYOUTS: dict[str, Layout] = {layout.name: layout for layout in (VELOCITY, SCALED)}
+if TYPE_CHECKING:
+    SCALED: Layout
+    A_LAYOUTS: dict[str, Layout]
+
+
+def __getattr__(name: str) -> object:
+    """SCALED (the reference firmware's layout) and A_LAYOUTS (every shipped one), made
+    when first asked for: `appmode decode` reads the sheet's alone (start-up)."""
+    if name == "SCALED":
+        value: object = Layout("scaled", profile_file.shipped("minibalance"))
+    elif name == "A_LAYOUTS":
+        scaled = __getattr__("SCALED")
+        assert isinstance(scaled, Layout)
+        value = {layout.name: layout for layout in (VELOCITY, scaled)}
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value

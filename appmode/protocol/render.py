@@ -6,10 +6,10 @@ import functools
 from collections.abc import Callable, Iterable, Iterator
 
 from appmode.protocol import app as p
-from appmode.protocol import param_values
+from appmode.protocol import layouts, param_values
 from appmode.protocol.directions import PAGE_LETTERS, PAGE_NAMES
 from appmode.protocol.escaping import escape, text_part
-from appmode.protocol.layouts import A_LAYOUTS, VELOCITY, Layout
+from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DEFAULTS
 from appmode.text import counted
 
@@ -51,7 +51,7 @@ def json_keys(layout: Layout = VELOCITY) -> tuple[str, ...]:
     """Every key `to_json` may write with `layout`, in the order a table (CSV) shows them:
     its records' fields, then the other shipped A layouts' (a table of any transcript)."""
     names = [record_names(letter, layout) for letter in "ABC"]
-    names += [a.fields for a in A_LAYOUTS.values()]
+    names += [a.fields for a in layouts.A_LAYOUTS.values()]
     return ("kind", *dict.fromkeys(name for group in names for name in group), *OTHER_KEYS)
 
 
