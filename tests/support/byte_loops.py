@@ -192,7 +192,7 @@ class HostByteAtATime:
                 elif len(frame) > app.MAX_FRAME:
                     self.frame = None
             else:
-                self.events.append(app_decoders.SINGLE_BYTE[byte])
+                self.events.append(app_decoders.single_byte_events()[byte])
 
 
 class _Gathering:
