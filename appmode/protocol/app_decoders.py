@@ -109,7 +109,7 @@ def _opening(
     -1)."""
     if pos + 1 < n and buf[pos + 1] == LBRACE:
         return _brace_run(buf, pos, hold, out, event, what), -1
-    limit = min(n, pos + most)
+    limit = pos + most if pos + most < n else n  # min(), without the call
     close = buf.find(b"}", pos + 1, limit)
     reopen = buf.find(b"{", pos + 1, close if close >= 0 else limit)
     if reopen < 0:
@@ -288,7 +288,7 @@ def _parse_record(
     if not _FIELDS.fullmatch(fields):
         return Malformed(raw, "fields are not ':'-separated integers")
     values = tuple(int(f) for f in fields.split(b":"))
-    size = {0x42: b_fields, 0x43: c_fields}.get(letter, _RECORD_SIZES.get(letter))
+    size = b_fields if letter == 0x42 else c_fields if letter == 0x43 else _RECORD_SIZES.get(letter)
     if b_fields is None and len(values) != _RECORD_SIZES.get(letter):
         size = None
     if size is None or (letter == 0x42 and size != 4 and len(values) == size):
@@ -323,17 +323,12 @@ class BoardDecoder:
         (the sheet's four B fields are an `Attitude`; other counts an `OtherRecord` that
         the profile's layout names); `b_fields` None: any count, as an OtherRecord."""
         self._buf = b""
-        self._b_fields = b_fields
-        self._c_fields = c_fields
+        self._sizes = b_fields, c_fields
         self._fast = _FAST if b_fields in (4, None) else _FAST_A
 
     @property
     def buffered(self) -> int:
         return len(self._buf)
-
-    @property
-    def _sizes(self) -> tuple[int | None, int]:
-        return self._b_fields, self._c_fields
 
     @linear
     def feed(self, data: bytes) -> list[BoardEvent]:
@@ -360,7 +355,7 @@ class BoardDecoder:
         Returns where it stopped."""
         while pos < n:
             if buf[pos] != LBRACE:
-                start = buf.find(b"{", pos, min(n, pos + MAX_RUN))
+                start = buf.find(b"{", pos, pos + MAX_RUN if pos + MAX_RUN < n else n)
                 if start < 0:
                     if n - pos < MAX_RUN:
                         if hold:
