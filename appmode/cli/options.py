@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 from collections.abc import Callable
@@ -164,6 +163,10 @@ def board_choice(args: argparse.Namespace) -> BoardChoice:
     )
 
 
+NAN = float("nan")
+"""What a number that is none reads as (math.nan, without importing math: start-up)."""
+
+
 def terminal_columns() -> int:
     """The terminal's width as `shutil.get_terminal_size` finds it: $COLUMNS, else
     standard output's terminal, else 80."""
@@ -232,9 +235,9 @@ def number_type(
 
     def parse(text: str) -> float:
         try:
-            value = float(text) if text.isascii() else math.nan
+            value = float(text) if text.isascii() else NAN
         except ValueError:
-            value = math.nan
+            value = NAN
         inside = (low < value if low_open else low <= value) and value <= high
         if not inside or (whole and value != int(value)):
             kind = "a whole number" if whole else "a number"
