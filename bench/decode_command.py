@@ -22,10 +22,10 @@ from tests.support.byte_loops import make_stream
 LOOP = r"""
 import sys
 sys.path.insert(0, sys.argv[2])
-from tests.support.byte_loops import make_stream
+from tests.support.byte_loops import SameEventsByteLoop
 from appmode.protocol.layouts import VELOCITY
 from appmode.protocol.render import coalesce, json_line
-loop = decoder.SameEventsByteLoop()
+loop = SameEventsByteLoop()
 with open(sys.argv[1], "rb") as stream:
     while chunk := stream.read(65536):
         loop.feed(chunk)

@@ -301,7 +301,10 @@ class WebServer:
 
 class _CappedRunner(web.AppRunner):
     """An AppRunner whose server, past MAX_CONNECTIONS, closes the oldest connection not
-    in `owners` (those that made a request with the token)."""
+    in `owners` (those that made a request with the token); failing one, the oldest of
+    the owners' that waits idle for a next request (a browser keeps several open a page:
+    ten pages of the owner's filled the cap, and the eleventh was refused); failing that,
+    the newcomer."""
 
     def __init__(self, owners: set[object], *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -316,11 +319,12 @@ class _CappedRunner(web.AppRunner):
             connections = server.connections  # oldest first
             if len(connections) <= MAX_CONNECTIONS:
                 return
-            for stranger in connections:  # at worst the newcomer, `handler`
-                link = stranger.transport
-                if stranger not in owners and link is not None and not link.is_closing():
-                    link.close()
-                    return
+            open_ = [c for c in connections if c.transport and not c.transport.is_closing()]
+            strangers = (c for c in open_ if c is not handler and c not in owners)
+            idle = (c for c in open_ if c is not handler and not _busy(c))
+            victim = next(strangers, None) or next(idle, None) or handler
+            if victim.transport is not None:
+                victim.transport.close()
 
         def connection_lost(handler: Any, exc: BaseException | None = None) -> None:
             owners.discard(handler)  # the set holds live connections only
@@ -329,6 +333,12 @@ class _CappedRunner(web.AppRunner):
         server.connection_made = connection_made  # type: ignore[method-assign]
         server.connection_lost = connection_lost  # type: ignore[method-assign]
         return server
+
+
+def _busy(handler: Any) -> bool:
+    """Whether a connection is serving a request (a page's WebSocket, for as long as it
+    lasts), not waiting idle for the next one; unknown counts as busy."""
+    return bool(getattr(handler, "_request_in_progress", True))
 
 
 def _compressed(response: web.Response) -> web.Response:

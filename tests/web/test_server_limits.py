@@ -10,6 +10,7 @@ HTTPS with the "every device" warning.
 from __future__ import annotations
 
 import contextlib
+import http.client
 import socket
 import threading
 import time
@@ -147,6 +148,30 @@ def test_the_owner_gets_in_beside_300_slow_clients(tmp_path: Path) -> None:
         finally:
             stop.set()
             for conn in held:
+                conn.close()
+
+
+def test_the_owner_s_own_idle_connections_never_lock_the_owner_out(tmp_path: Path) -> None:
+    """Ten pages of the owner's held 64 connections (a browser keeps several open a page,
+    idle between requests): the eleventh page's were all refused at the cap. Now the
+    oldest idle one of the owner's goes, and the newcomer is served."""
+    with web_process(tmp_path) as web:
+        kept = []
+        try:
+            for _ in range(MAX_CONNECTIONS + 6):
+                conn = http.client.HTTPConnection("127.0.0.1", port_of(web), timeout=5)
+                conn.request("GET", "/", headers=cookie(web))
+                answer = conn.getresponse()
+                assert answer.status == 200 and answer.read()  # the connection stays open
+                kept.append(conn)
+            code, _, body = get(web.origin + "/", cookie(web))
+            assert code == 200 and 'aria-label="forward"' in body
+            time.sleep(0.3)
+            still_open = [c for c in kept if c.sock is not None and not is_closed(c.sock)]
+            assert len(still_open) <= MAX_CONNECTIONS
+            assert kept[-1] in still_open, "the newest kept, the oldest closed"
+        finally:
+            for conn in kept:
                 conn.close()
 
 
