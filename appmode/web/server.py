@@ -15,6 +15,7 @@ import json
 import logging
 import ssl
 import sys
+import time
 from collections.abc import Awaitable, Callable
 from contextlib import suppress
 from importlib import resources
@@ -43,6 +44,9 @@ HEADER_TIMEOUT = 10.0
 """Seconds a connection may take to send a whole request (aiohttp's keep-alive timeout
 also closes a connection whose first request never completes)."""
 MAX_CONNECTIONS = 64
+GRACE = 2.0
+"""Seconds a connection may wait before its first request with the token (a browser
+asks at once) before, at the cap, it counts as a slow client's."""
 """Connections served at once. Past them the oldest connection that has not yet made a
 request with the token is closed (the newcomer, if every other one has): a flood of
 half-sent requests churns, and can neither use up the server's open files nor lock its
@@ -300,11 +304,12 @@ class WebServer:
 
 
 class _CappedRunner(web.AppRunner):
-    """An AppRunner whose server, past MAX_CONNECTIONS, closes the oldest connection not
-    in `owners` (those that made a request with the token); failing one, the oldest of
-    the owners' that waits idle for a next request (a browser keeps several open a page:
-    ten pages of the owner's filled the cap, and the eleventh was refused); failing that,
-    the newcomer."""
+    """An AppRunner whose server, past MAX_CONNECTIONS, closes the oldest connection that
+    has made no request with the token (`owners` have) for GRACE seconds: a slow client's;
+    failing one, the oldest of the owners' that waits idle for a next request (a browser
+    keeps several open a page: ten pages of the owner's filled the cap); failing that, the
+    oldest without the token, at worst the newcomer. A browser opens a page's connections
+    at once and asks at once: the young ones are the owner's next page's, not taken first."""
 
     def __init__(self, owners: set[object], *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -313,21 +318,26 @@ class _CappedRunner(web.AppRunner):
     async def _make_server(self) -> web.Server:
         server = await super()._make_server()
         made, lost, owners = server.connection_made, server.connection_lost, self._owners
+        since: dict[object, float] = {}  # when each live connection was made
 
         def connection_made(handler: Any, transport: asyncio.Transport) -> None:
             made(handler, transport)
+            now = since[handler] = time.monotonic()
             connections = server.connections  # oldest first
             if len(connections) <= MAX_CONNECTIONS:
                 return
             open_ = [c for c in connections if c.transport and not c.transport.is_closing()]
-            strangers = (c for c in open_ if c is not handler and c not in owners)
-            idle = (c for c in open_ if c is not handler and not _busy(c))
-            victim = next(strangers, None) or next(idle, None) or handler
-            if victim.transport is not None:
+            strangers = [c for c in open_ if c not in owners]
+            slow = (c for c in strangers if now - since.get(c, now) >= GRACE)
+            idle = (c for c in open_ if c in owners and not _busy(c))
+            oldest = strangers[0] if strangers else None  # at worst the newcomer
+            victim = next(slow, None) or next(idle, None) or oldest
+            if victim is not None and victim.transport is not None:
                 victim.transport.close()
 
         def connection_lost(handler: Any, exc: BaseException | None = None) -> None:
-            owners.discard(handler)  # the set holds live connections only
+            owners.discard(handler)  # the sets hold live connections only
+            since.pop(handler, None)
             lost(handler, exc)
 
         server.connection_made = connection_made  # type: ignore[method-assign]
