@@ -45,8 +45,7 @@ HEADER_TIMEOUT = 10.0
 also closes a connection whose first request never completes)."""
 MAX_CONNECTIONS = 64
 GRACE = 2.0
-"""Seconds a connection may wait before its first request with the token (a browser
-asks at once) before, at the cap, it counts as a slow client's."""
+"""Seconds without a token request after which a connection is a slow client's, at the cap."""
 """Connections served at once. Past them the oldest connection that has not yet made a
 request with the token is closed (the newcomer, if every other one has): a flood of
 half-sent requests churns, and can neither use up the server's open files nor lock its
@@ -330,8 +329,7 @@ class _CappedRunner(web.AppRunner):
             strangers = [c for c in open_ if c not in owners]
             slow = (c for c in strangers if now - since.get(c, now) >= GRACE)
             idle = (c for c in open_ if c in owners and not _busy(c))
-            oldest = strangers[0] if strangers else None  # at worst the newcomer
-            victim = next(slow, None) or next(idle, None) or oldest
+            victim = next(slow, None) or next(idle, None) or next(iter(strangers), None)
             if victim is not None and victim.transport is not None:
                 victim.transport.close()
 
@@ -346,8 +344,7 @@ class _CappedRunner(web.AppRunner):
 
 
 def _busy(handler: Any) -> bool:
-    """Whether a connection is serving a request (a page's WebSocket, for as long as it
-    lasts), not waiting idle for the next one; unknown counts as busy."""
+    """Whether a connection is serving a request (a page's WebSocket), not idle."""
     return bool(getattr(handler, "_request_in_progress", True))
 
 
