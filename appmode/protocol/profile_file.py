@@ -9,6 +9,7 @@ shipped `sheet` and `minibalance` files: one source of truth.
 
 from __future__ import annotations
 
+import contextlib
 import marshal
 import os
 import sys
@@ -141,14 +142,15 @@ def _read_through(folder: str, name: str, text: str, where: str) -> dict[str, An
     except (OSError, EOFError, ValueError, TypeError):
         pass  # none yet, or one another Python wrote: read the file
     data = _toml(text, where)
+    partial = f"{cached}.{os.getpid()}"
     try:
         os.makedirs(os.path.dirname(cached), exist_ok=True)
-        partial = f"{cached}.{os.getpid()}"
         with open(partial, "wb") as file:
             marshal.dump((text, data), file)
         os.replace(partial, cached)  # whole or not at all, as Python writes bytecode
-    except (OSError, ValueError):
-        pass  # a folder nobody may write, or a value marshal cannot keep: read it each time
+    except (OSError, ValueError):  # a folder nobody may write, a full disk, a value marshal
+        with contextlib.suppress(OSError):  # cannot keep: read it each time, leave nothing
+            os.remove(partial)
     return data
 
 

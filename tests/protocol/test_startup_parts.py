@@ -161,3 +161,11 @@ def test_help_keeps_to_the_terminal_width_it_is_given() -> None:
         check=True,
     )
     assert max(len(line) for line in done.stdout.splitlines() if " $ " not in line) <= 50
+
+
+def test_a_value_the_cache_cannot_keep_leaves_nothing_behind(tmp_path: Path) -> None:
+    """TOML's dates are no marshal value: read each time, no half-written cache left."""
+    text = "x = 1979-05-27T07:32:00Z\n"
+    for _ in range(2):
+        assert profile_file._read_through(str(tmp_path), "t", text, "t")["x"].year == 1979
+    assert list((tmp_path / "__pycache__").iterdir()) == []
