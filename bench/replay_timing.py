@@ -6,10 +6,12 @@ without waking together; then again in the other order. Each event's lateness is
 measured the same way for both: against start + its time, with the start that makes
 none early (each player's start is its own; a process scheduled late once at its
 start would otherwise shift that player's whole run). Prints median, p99 and max
-lateness, and the drift: the slope of lateness over a run (ms per minute, a
-least-squares fit, not one sample). `play` keeps its deadlines with exact wake-ups (no
-timer slack; on Linux 6.12+ a short slice, appmode/ports/wakeups.py); MessageSync runs
-as python-can ships it.
+lateness, and the drift: the slope of each second's least lateness over a run (ms per
+minute, a least-squares fit). A player whose schedule slips moves every event's
+lateness, its best ones too; a machine that gets busier during a run moves only the
+events it delays (the slope of all of them, the trend, shows the load). `play` keeps its
+deadlines with exact wake-ups (no timer slack; on Linux 6.12+ a short slice,
+appmode/ports/wakeups.py); MessageSync runs as python-can ships it.
 
 `--load busy` runs two busy processes beside them, `--load pytest` the test suite.
 Needs python-can for the comparison: pip install python-can.
@@ -116,10 +118,18 @@ def paired(events: int, spacing: float) -> dict[str, list[float]]:
     return late
 
 
-def drift_ms_per_min(lateness: list[float], spacing: float) -> float:
+def trend_ms_per_min(lateness: list[float], spacing: float) -> float:
     """The least-squares slope of one run's lateness over its time, in ms a minute."""
     xs = [k * spacing for k in range(len(lateness))]
     return statistics.linear_regression(xs, lateness).slope * 1000 * 60
+
+
+def drift_ms_per_min(lateness: list[float], spacing: float) -> float:
+    """The least-squares slope of each second's least lateness in one run, in ms a
+    minute: the schedule's own slip, which load above it does not bend."""
+    per = max(1, round(1 / spacing))
+    lows = [min(lateness[k : k + per]) for k in range(0, len(lateness), per)]
+    return trend_ms_per_min(lows, spacing * per)
 
 
 LOADS: dict[str, list[list[str]]] = {
@@ -152,17 +162,16 @@ def load(kind: str) -> Iterator[None]:
 
 
 def summary(lateness: list[float], spacing: float) -> dict[str, float]:
-    """median, p99, max (ms); drift (ms/min, the worse of the two runs)."""
+    """median, p99, max (ms); drift and trend (ms/min, the worse of the two runs)."""
     ms = [x * 1000 for x in lateness]
     half = len(lateness) // 2
+    runs = (lateness[:half], lateness[half:])
     return {
         "median": statistics.median(ms),
         "p99": percentile(ms, 99),
         "max": max(ms),
-        "drift": max(
-            (drift_ms_per_min(run, spacing) for run in (lateness[:half], lateness[half:])),
-            key=abs,
-        ),
+        "drift": max((drift_ms_per_min(run, spacing) for run in runs), key=abs),
+        "trend": max((trend_ms_per_min(run, spacing) for run in runs), key=abs),
     }
 
 
@@ -194,10 +203,11 @@ def main() -> None:
         f"replay of {args.events} events at {args.spacing * 1000:g} ms, each player twice "
         f"({os.cpu_count()} cores, load: {args.load}); lateness in ms"
     )
-    print(f"{'':<24} {'median':>8} {'p99':>8} {'max':>8} {'drift/min':>10}")
+    print(f"{'':<24} {'median':>8} {'p99':>8} {'max':>8} {'drift/min':>10} {'trend/min':>10}")
     for name, s in result.items():
         print(
-            f"{name:<24} {s['median']:>8.3f} {s['p99']:>8.3f} {s['max']:>8.3f} {s['drift']:>10.4f}"
+            f"{name:<24} {s['median']:>8.3f} {s['p99']:>8.3f} {s['max']:>8.3f} "
+            f"{s['drift']:>10.4f} {s['trend']:>10.4f}"
         )
 
 

@@ -171,7 +171,7 @@ def bench_replay(events: int) -> list[Row]:
                 Row(
                     f"{name}, {events} events at 10 ms, {kind}",
                     f"median {s['median']:.3f} ms, p99 {s['p99']:.3f} ms, "
-                    f"drift {s['drift']:+.4f} ms/min",
+                    f"drift {s['drift']:+.4f} ms/min (trend {s['trend']:+.3f})",
                     f"p99 <= MessageSync's, drift < {DRIFT} ms/min" if ours else "",
                     s["p99"] <= theirs["p99"] and abs(s["drift"]) < DRIFT if ours else None,
                 )
