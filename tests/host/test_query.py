@@ -136,3 +136,42 @@ def test_a_set_garbled_on_its_way_is_not_reported_as_taken() -> None:
     for i, kp in enumerate([42422, 4242, 42422, 4242, 42422, 42422, 42422]):
         events = outcomes(state.feed(c_record(velocity_kp=kp), 0.1 * (i + 1)))
         assert not any(isinstance(e, QueryDone) for e in events), f"record {i}"
+
+
+def test_a_set_damaged_then_lost_once_is_sent_again_not_called_refused() -> None:
+    """CI, tests/line/test_faults.py under moderate faults: `{7:123456}` reached the board
+    as 12456, and the frame sent again was lost, so two rounds read 12456 and the set was
+    called refused. A third frame is sent; it takes."""
+    state = HostState()
+    state.feed(c_record(), 0.0)
+    state.start_query(ParamQuery((5, 4242), tries=10), 0.0)
+    assert state.take_outbox() == b"{5:4242}{Q:P}"
+    t = 0.0
+    for _ in range(2):  # the damaged value; then the frame sent again is lost
+        for _ in range(2):
+            t += 0.1
+            assert outcomes(state.feed(c_record(velocity_kp=424), t)) == []
+        assert state.take_outbox().endswith(b"{5:4242}{Q:P}"), "the set is sent again"
+    t += 0.1
+    assert outcomes(state.feed(c_record(velocity_kp=4242), t)) == []
+    [done] = outcomes(state.feed(c_record(velocity_kp=4242), t + 0.1))
+    assert isinstance(done, QueryDone) and done.text == "velocity_kp = 4242 (verified)"
+
+
+def test_a_reply_to_a_read_sent_before_the_set_was_sent_again_is_not_a_vote() -> None:
+    """A late reply made the host send the set again while a read was still on its way;
+    once the set is sent again after a mismatch, that read's answer shows the board
+    before it: not a vote (it would make the link look noisy and the set need 4 more)."""
+    state = HostState()
+    state.feed(c_record(), 0.0)
+    state.start_query(ParamQuery((5, 4242), tries=10), 0.0)
+    assert state.take_outbox() == b"{5:4242}{Q:P}"  # read 1
+    state.tick(0.6)  # no reply in time: sent again (read 2)
+    assert state.take_outbox() == b"{5:4242}{Q:P}"
+    state.feed(c_record(velocity_kp=424), 0.65)  # read 1's reply, late: vote 1, read 3
+    state.feed(c_record(velocity_kp=424), 0.7)  # read 2's: vote 2, the set is sent again
+    assert state.take_outbox() == b"{Q:P}{5:4242}{Q:P}"
+    assert outcomes(state.feed(c_record(velocity_kp=424), 0.75)) == []  # read 3's: old
+    assert outcomes(state.feed(c_record(velocity_kp=4242), 0.8)) == []
+    [done] = outcomes(state.feed(c_record(velocity_kp=4242), 0.9))
+    assert isinstance(done, QueryDone) and done.text == "velocity_kp = 4242 (verified)"

@@ -36,9 +36,12 @@ class QueryDone:
 Outcome = QueryDone | QueryFailed
 
 
-MISMATCHES = 2
+MISMATCHES = 3
 """Rounds of agreeing C records showing another value after which a set has failed: the
-set frame was sent again in between, so the board decided, not the link."""
+set frame was sent again before each later round, so the board decided, not the link
+(a frame lost on its way leaves the board's value as it was: with one re-sent frame, a
+link that damages one frame in 20 made a board that took a damaged set look as if it
+had refused, once in 20 such sets; with two, once in 400)."""
 
 
 class ParamQuery:
@@ -68,6 +71,11 @@ class ParamQuery:
         self._noisy = False
         self._mismatch: int | None = None
         self._mismatches = 0
+        self._replies = 0
+        """C records received, garbled ones too: requests are answered in order."""
+        self._stale = 0
+        """C records still to come in answer to requests sent before the set was sent
+        again: they show the board before it, and are not votes."""
         self.known: tuple[int, ...] | None = None
         """The parameters the host read last, before this query (set by HostState)."""
 
@@ -90,6 +98,10 @@ class ParamQuery:
 
     def on_params(self, values: tuple[int, ...], now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived: (bytes to send, outcome or None)."""
+        self._replies += 1
+        if self._stale:
+            self._stale -= 1
+            return b"", None
         votes = self._votes
         if self.change is not None and self.known is not None:
             index, value = self.change
@@ -114,8 +126,9 @@ class ParamQuery:
         self._mismatch = values[index]
         self._mismatches = self._mismatches + 1 if same else 1
         self._votes.clear()  # the set is sent again: the board may change
-        if self._mismatches >= MISMATCHES:  # the board has decided, twice: say what it did
+        if self._mismatches >= MISMATCHES:  # the board has decided: say what it did
             return b"", self._refused(index, value)
+        self._stale = max(0, self.sent - self._replies)  # reads already on their way
         return self._retry(now)
 
     def _refused(self, index: int, value: int) -> QueryFailed:
@@ -136,6 +149,8 @@ class ParamQuery:
     def on_garbled(self, now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived garbled: the link is noisy; ask again at once rather than
         wait for the timeout."""
+        self._replies += 1
+        self._stale = max(0, self._stale - 1)
         self._noisy = True
         return self._retry(now)
 
