@@ -4,10 +4,6 @@ caught whatever the load; a load that grows during a run is not called drift."""
 from __future__ import annotations
 
 import random
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from bench.replay_timing import drift_ms_per_min, trend_ms_per_min
 
