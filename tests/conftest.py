@@ -17,6 +17,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.support.load import busy_cores
+
 
 def pytest_configure(config: pytest.Config) -> None:
     """The package's bytecode, brought up to date once before the run (by the controller,
@@ -53,29 +55,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
         others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
     except OSError:  # another user's folder: the load average alone tells
         others = []
-    return cores if others or _busy_cores() >= 0.9 * cores else cores + cores // 2
-
-
-def _busy_cores(seconds: float = 0.25) -> float:
-    """Cores' worth of CPU in use now: on Linux measured over `seconds` (/proc/stat),
-    elsewhere the one-minute load average. The load average alone still counted a run
-    that had just ended: the next, started within a minute or so on an idle machine,
-    took two workers, not three, and ran 6 min 15 s, not 4 min 30."""
-    try:
-        before = _cpu_times()
-        time.sleep(seconds)
-        after = _cpu_times()
-    except (OSError, ValueError):
-        return os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
-    total = sum(after) - sum(before)
-    idle = after[3] + after[4] - before[3] - before[4]  # idle, iowait
-    return (os.cpu_count() or 1) * (total - idle) / total if total > 0 else 0.0
-
-
-def _cpu_times() -> list[int]:
-    """The machine's CPU time by kind (user, nice, system, idle, iowait, …): /proc/stat."""
-    with open("/proc/stat") as stat:
-        return [int(field) for field in stat.readline().split()[1:]]
+    return cores if others or busy_cores() >= 0.9 * cores else cores + cores // 2
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
