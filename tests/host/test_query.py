@@ -175,3 +175,54 @@ def test_a_reply_to_a_read_sent_before_the_set_was_sent_again_is_not_a_vote() ->
     assert outcomes(state.feed(c_record(velocity_kp=4242), 0.8)) == []
     [done] = outcomes(state.feed(c_record(velocity_kp=4242), 0.9))
     assert isinstance(done, QueryDone) and done.text == "velocity_kp = 4242 (verified)"
+
+
+A_RECORD = b"{A1:2:3:4}$"
+GARBLED_A = b"{A1:2\r:3:4}$"  # an A record a noisy link damaged
+
+
+def test_a_garbled_record_of_any_kind_during_a_read_makes_two_votes_not_enough() -> None:
+    """The first two C records of a read can lose the same digit (§3.3) before any C
+    record comes garbled, while the A and B records around them already show the noise.
+    The same link carries the C records: a garbled record of any kind means a value
+    needs NOISY_LEAD."""
+    state = HostState()
+    state.start_query(ParamQuery(), 0.0)
+    wrong = c_record(max_position=1000)  # 10000 with a zero lost
+    assert outcomes(state.feed(wrong, 0.1)) == []
+    state.feed(GARBLED_A, 0.15)
+    assert outcomes(state.feed(wrong, 0.2)) == [], "two agreeing votes on a noisy link"
+    for i in range(NOISY_LEAD + 1):
+        assert outcomes(state.feed(c_record(), 0.3 + 0.1 * i)) == []
+    [done] = outcomes(state.feed(c_record(), 1.0))  # leads 1000 by NOISY_LEAD
+    assert isinstance(done, QueryDone) and done.values[1] == 10000
+
+
+def test_a_read_begun_on_a_link_that_garbled_a_record_lately_needs_the_noisy_lead() -> None:
+    state = HostState()
+    state.feed(A_RECORD + GARBLED_A, 0.0)
+    state.start_query(ParamQuery(), 1.0)
+    for t in (1.1, 1.2):
+        assert outcomes(state.feed(c_record(max_position=1000), t)) == []
+
+
+def test_what_a_port_that_is_no_board_sends_does_not_make_a_read_wait_longer() -> None:
+    """Garbage before any record (an echo of `{Q:P}`, another program's port) is not a
+    noisy board: the read fails after `tries` × 2 requests, not × NOISY_LEAD."""
+    state = HostState()
+    state.start_query(ParamQuery(tries=2, timeout=0.2), 0.0)
+    t, failed = 0.0, None
+    while failed is None:
+        state.feed(state.take_outbox(), t)  # a loop: what is sent comes back
+        t += 0.25
+        failed = state.tick(t)
+    assert isinstance(failed, QueryFailed) and "sent {Q:P} 4 times" in failed.text
+
+
+def test_a_read_on_a_link_clean_for_a_while_still_settles_on_two_votes() -> None:
+    state = HostState()
+    state.feed(A_RECORD + GARBLED_A, 0.0)
+    state.start_query(ParamQuery(), 10.0)  # the garbled record is past DEGRADED_WINDOW
+    assert outcomes(state.feed(c_record(), 10.1)) == []
+    [done] = outcomes(state.feed(c_record(), 10.2))
+    assert isinstance(done, QueryDone) and done.values == params.DEFAULTS

@@ -5,10 +5,12 @@ protocol has no checksum, so a lost or doubled digit can still make a well-forme
 record — and the same wrong one often: `10000` losing any of its four zeros reads
 `1000`. So the C records of a query, each asked for separately, are votes: a value is
 reported when it has AGREE votes and leads every other value by AGREE — or, once the
-query has seen a garbled or a differing C record (a noisy link), by NOISY_LEAD
-(docs/protocol.md §3.3). A set is done when the agreed values show it; records that
-still show the value read before it stop counting once one shows the new value. On a timeout the
-request is sent again; after `tries × agree` requests the query ends in QueryFailed.
+link has shown noise (two C records that differ, or, once the link has carried a
+record, a garbled record of any kind during the query or in the DEGRADED_WINDOW before
+it), by NOISY_LEAD (docs/protocol.md §3.3).
+A set is done when the agreed values show it; records that still show the value read
+before it stop counting once one shows the new value. On a timeout the request is sent
+again; after `tries × agree` requests the query ends in QueryFailed.
 """
 
 from __future__ import annotations
@@ -145,6 +147,11 @@ class ParamQuery:
         return QueryFailed(
             f"set {name} = {param_values.to_user(spec, value)} was not taken: {what}"
         )
+
+    def link_noisy(self) -> None:
+        """The link has garbled a record (any record, not only this query's): its C
+        records may be wrong in the same way, so a value needs NOISY_LEAD."""
+        self._noisy = True
 
     def on_garbled(self, now: float) -> tuple[bytes, Outcome | None]:
         """A C record arrived garbled: the link is noisy; ask again at once rather than

@@ -148,6 +148,8 @@ class HostState:
         """Begin a parameter read or set; its bytes wait in the outbox."""
         self.query = query
         query.known = None if self.params is None else self.params.values
+        if self.stats.records and self.stats.recent_errors(now):
+            query.link_noisy()  # a board's link that garbles records: not a non-board
         self._errors_at_start = self.stats.errors
         self._outbox += query.start(now)
 
@@ -202,6 +204,8 @@ class HostState:
                 self.stats.skipped += len(event.raw)
             else:
                 self.stats.count_error(now, len(event.raw))
+                if self.query is not None and self.stats.records:
+                    self.query.link_noisy()
             if self.query is not None and event.raw.startswith(b"{C"):
                 return self._step(*self.query.on_garbled(now))
             return None
