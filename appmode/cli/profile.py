@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
             profile = load(args.path)
         except ProfileError as exc:
             print(exc, file=sys.stderr)
-            return 1
+            return 2  # as every error: one line a mistake
         fields = len(profile.a) + len(profile.b)
         print(f"{args.path}: profile {profile.name}: {fields} record fields, "
               f"{len(profile.params)} parameters: fine")  # fmt: skip
@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
         profile = load(args.name)
     except ProfileError as exc:
         print(exc, file=sys.stderr)
-        return 1
+        return 2
     if args.toml:
         sys.stdout.write(profile.text)
         return 0

@@ -128,7 +128,7 @@ def test_a_broken_profile_is_one_line_a_mistake(tmp_path: Path, text: str, said:
         load(str(path))
     assert any(said in problem for problem in caught.value.problems), caught.value.problems
     done = run("profile", "check", str(path))
-    assert done.returncode == 1 and done.stdout == ""
+    assert done.returncode == 2 and done.stdout == ""
     lines = done.stderr.splitlines()
     assert lines and all(line.startswith(f"{path}: ") for line in lines), done.stderr
     assert "Traceback" not in done.stderr and any(said in line for line in lines)
@@ -145,6 +145,6 @@ def test_a_missing_file_a_fifo_and_a_huge_file_are_one_line_each(tmp_path: Path)
     )
     for path, why in cases:
         done = run("profile", "check", str(path), timeout=10)
-        assert done.returncode == 1, done.stderr
+        assert done.returncode == 2, done.stderr
         assert done.stderr.count("\n") == 1 and f"cannot read it ({why}" in done.stderr
         assert "give a file or one of sheet, minibalance, balance" in done.stderr

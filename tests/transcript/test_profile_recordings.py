@@ -68,5 +68,5 @@ def test_a_file_may_not_take_a_shipped_profile_s_name(tmp_path: Path) -> None:
     sheet = tmp_path / "sheet.toml"
     sheet.write_text('name = "sheet"\nlike = "balance"\n')
     done = run("profile", "check", str(sheet))
-    assert done.returncode == 1
+    assert done.returncode == 2
     assert "name = 'sheet': a shipped profile's name" in done.stderr
