@@ -7,6 +7,7 @@ hold one `Core` each and no state of each other's.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass
 
@@ -62,7 +63,7 @@ class Core:
         self.boot = now
         self.tick_ms = 0
         """The next control tick, in ms from boot."""
-        self.vehicle = Vehicle()
+        self.vehicle = Vehicle(yaw_gain=math.degrees(profile.velocity_si[1]))
         self.page = Page.DIRECTION
         self.direction = 0
         self.turn = 0

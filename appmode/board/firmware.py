@@ -34,7 +34,7 @@ from appmode.board.core import UART3, Core, Note
 from appmode.board.profiles import SHEET, Profile
 from appmode.board.store import MemoryStore, Store
 from appmode.board.telemetry import Telemetry
-from appmode.board.vehicle import YAW_GAIN, Vehicle
+from appmode.board.vehicle import Vehicle
 from appmode.protocol import control, params
 from appmode.protocol.directions import Page, motion_for, target_velocity
 from appmode.protocol.params import DriveType
@@ -349,7 +349,7 @@ class Board:
                 return
             vehicle.step(target, TICK)
             if core.pending_angle:
-                left = core.pending_angle - vehicle.vz * YAW_GAIN * TICK * 10
+                left = core.pending_angle - vehicle.vz * vehicle.yaw_gain * TICK * 10
                 core.pending_angle = left if left * core.pending_angle > 0 else 0.0
 
     def _uart2_target(self, speed: float) -> tuple[float, float, float]:

@@ -128,6 +128,11 @@ class Profile:
         return SETTINGS in self.control_modes
 
     @property
+    def velocity_si(self) -> tuple[float, float]:
+        """What one velocity unit is: m/s of x and y, rad/s of z (its profile file's)."""
+        return self.a_layout.profile.velocity_si
+
+    @property
     def fixed_drive(self) -> DriveType | None:
         """The drive type a host need not read: omni on a board without drive types."""
         return None if self.drive_types else DriveType.OMNI

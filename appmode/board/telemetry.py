@@ -8,7 +8,7 @@ import math
 
 from appmode.board.chip import c_int, times_float32
 from appmode.board.core import Core
-from appmode.board.vehicle import YAW_GAIN, battery_percent, wrap_degrees
+from appmode.board.vehicle import battery_percent, wrap_degrees
 from appmode.protocol import app, control
 from appmode.protocol.profile_file import Field
 
@@ -79,7 +79,7 @@ class Telemetry:
     def send_burst(self) -> None:
         """What reaches the host of the status the reference loop writes to UART2 after
         each APP record (§13.1): `FF FE` and the gyro z rate's low byte."""
-        rate = self.core.vehicle.vz * YAW_GAIN * GYRO_PER_DEGREE
+        rate = self.core.vehicle.vz * self.core.vehicle.yaw_gain * GYRO_PER_DEGREE
         self.core.out2 += control.HEADER + bytes([(int(rate) + 0x8000) & 0xFF])
         self.burst_ms = math.inf
 

@@ -4,7 +4,9 @@ Documented model (all constants here):
 
 - velocity follows its target as a first-order lag with time constant RESPONSE_TAU
   (63 % of a step in 0.1 s, 95 % in 0.3 s), and snaps to the target within SNAP units;
-- yaw turns at YAW_GAIN degrees a second per unit of z (z = 500 turns 90 °/s), clockwise +;
+- yaw turns at `yaw_gain` degrees a second per unit of z, clockwise +: the profile's
+  `velocity_si` of z in degrees, so that the gyro and the velocity agree (the sheet's
+  π mrad/s: 0.18 °/s, z = 500 turns 90 °/s);
 - pitch and roll lean with acceleration: TILT_GAIN degrees per unit/s² (nose up while
   speeding up forward, right side down while speeding up to the right);
 - or, on a board whose profile ramps (§13, §13.1), velocity is set by `ramp` each tick;
@@ -22,6 +24,7 @@ from dataclasses import dataclass
 RESPONSE_TAU = 0.1
 SNAP = 0.5
 YAW_GAIN = 0.18
+"""°/s of yaw per unit of z on the sheet's board."""
 TILT_GAIN = 0.002
 FULL_CV = 1260.0
 EMPTY_CV = 1110.0
@@ -60,6 +63,8 @@ class Vehicle:
     travel_y: float = 0.0
     travel_z: float = 0.0
     """The body's own x, y, z integrated over time: what the wheel encoders count."""
+    yaw_gain: float = YAW_GAIN
+    """°/s of yaw per unit of z."""
 
     def step(self, target: tuple[float, float, float], dt: float, ticks: int = 1) -> None:
         """Advance `ticks` steps of `dt` seconds toward the target velocity (x, y, z),
@@ -127,7 +132,7 @@ class Vehicle:
         vx, vy, vz = self.vx, self.vy, self.vz
         self.pitch = (vy - old_y) / dt * TILT_GAIN
         self.roll = (vx - old_x) / dt * TILT_GAIN
-        turn = vz * YAW_GAIN * dt
+        turn = vz * self.yaw_gain * dt
         drain = (IDLE_DRAIN + LOAD_DRAIN * (abs(vx) + abs(vy) + abs(vz))) * dt
         heading, east, north = self.heading, self.east, self.north
         travel_x, travel_y, travel_z = self.travel_x, self.travel_y, self.travel_z

@@ -18,6 +18,7 @@ from appmode.protocol.control_view import view
 from appmode.protocol.layouts import Layout
 from appmode.protocol.odometry import Odometry, Pose2D
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2
+from appmode.protocol.velocity import Twist
 
 POSE_FRAME = "odom"
 """The frame the dead-reckoned pose is in (its origin: where the session began)."""
@@ -112,7 +113,8 @@ class Decoded:
 
     def __init__(self, layout: Layout) -> None:
         self.layout = layout
-        self.odometry = Odometry(*layout.profile.velocity_si)
+        self.odometry = Odometry()
+        self.si = layout.profile.velocity_si
         motion = {f.name: f for f in layout.a_fields}
         self._dead_reckons = all(k in motion and motion[k].signed for k in ("x", "y", "z"))
 
@@ -154,7 +156,8 @@ class Decoded:
 
     def _pose(self, time: float, values: tuple[int, ...]) -> Pose2D:
         by_name = {f.name: v / f.scale for f, v in zip(self.layout.a_fields, values, strict=False)}
-        return self.odometry.step(time, by_name["x"], by_name["y"], by_name["z"])
+        twist = Twist.from_units(by_name["x"], by_name["y"], by_name["z"], self.si)
+        return self.odometry.step(time, twist)
 
 
 def _stamp(time: float) -> dict[str, int]:

@@ -1,13 +1,14 @@
-"""Dead reckoning from the board's reported velocity, with no I/O: each A record's body
-velocity (x right, y forward, z clockwise, in the profile's velocity unit) turned into
-REP 103's (forward, left, counter-clockwise; m/s, rad/s) and integrated from record to
-record. Its error grows with the distance driven: the pose's variance is stated as
-(DRIFT × distance)² plus a floor, for a consumer that fuses it."""
+"""Dead reckoning from the board's reported velocity, with no I/O: each velocity the car
+reports (REP 103's forward, left, counter-clockwise; m/s, rad/s: `velocity.Twist`)
+integrated from report to report. Its error grows with the distance driven: the pose's
+variance is stated as (DRIFT × distance)² plus a floor, for a consumer that fuses it."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from appmode.protocol.velocity import Twist
 
 
 @dataclass(frozen=True, slots=True)
@@ -35,19 +36,15 @@ next record starts a new step (the pose is not pushed across a gap in the teleme
 class Odometry:
     """The car's pose in `odom`, integrated from the velocities reported."""
 
-    def __init__(self, metres: float, radians: float) -> None:
-        self.metres = metres
-        """Metres a second one velocity unit of x and y is."""
-        self.radians = radians
-        """Radians a second one unit of z is."""
+    def __init__(self) -> None:
         self.pose = Pose2D(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
         self.distance = 0.0
         self._at: float | None = None
 
-    def step(self, at: float, x: float, y: float, z: float) -> Pose2D:
+    def step(self, at: float, velocity: Twist) -> Pose2D:
         """A velocity reported at `at` (seconds): the pose after it, moved by the mean of
         this velocity and the last over the time between them."""
-        forward, left, turn = y * self.metres, -x * self.metres, -z * self.radians
+        forward, left, turn = velocity.forward, velocity.left, velocity.turn
         last = self.pose
         dt = 0.0 if self._at is None or not 0 < at - self._at <= GAP else at - self._at
         self._at = at

@@ -17,11 +17,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from appmode.protocol import app, params
+from appmode.protocol import app
 from appmode.protocol.odometry import Odometry
-from appmode.protocol.params import DriveType
 from appmode.protocol.render import to_json
-from appmode.ros import command
+from appmode.protocol.velocity import BadTwist, Twist
 from appmode.ros.graph import Node, Qos
 from appmode.ros.messages import (
     BATTERY,
@@ -34,8 +33,6 @@ from appmode.ros.messages import (
     Messages,
 )
 from appmode.ros.wire import attachment, gid
-from appmode.session.app.session import AppSession
-from appmode.session.control.session import ControlSession
 
 if TYPE_CHECKING:
     import zenoh
@@ -47,9 +44,6 @@ TICK = 0.01
 """Seconds between two turns of the node's loop (the session's reads, the queue)."""
 QUEUE = 8
 """cmd_vel samples kept waiting at most (the newest count: a twist replaces the last)."""
-SPEED_CHANGE = 0.1
-"""On the APP port, how far (a share of it) the speed asked must be from max_speed for
-a new `{0:N}` to be sent."""
 Log = Callable[[str], None]
 
 
@@ -92,11 +86,9 @@ class RosNode:
         self.options = options
         self.log = log
         self.messages = Messages(graph.distro)
-        state = session.telemetry_state()
-        profile = (state.layout.profile if state is not None else None) or None
-        si = profile.velocity_si if profile is not None else (0.001, 0.001)
-        self.si = si
-        self.odometry = Odometry(*si)
+        self.odometry = Odometry()
+        self._sensed_at = -math.inf
+        """The time of the last A record whose twist was published."""
         self._queue: deque[bytes] = deque(maxlen=QUEUE)
         self._woken = threading.Event()
         """Set by a cmd_vel: the loop takes it at once, not at its next turn."""
@@ -176,52 +168,17 @@ class RosNode:
                 self.refused += 1
                 self._say_once("refused", "a cmd_vel that is no Twist was ignored")
                 continue
+            try:
+                twist = Twist.checked(forward, left, turn)
+            except BadTwist as exc:
+                self.refused += 1
+                self._say_once("nan", f"a cmd_vel was ignored: {exc}")
+                continue
             self.received += 1
             self.session.keepalive()
             if ignored:
                 self._say_once("3d", "cmd_vel's angular x and y are ignored: a car turns in z")
-            self._drive(forward, left, turn)
-
-    def _drive(self, forward: float, left: float, turn: float) -> None:
-        session = self.session
-        if isinstance(session, ControlSession):
-            self._drive_control(session, forward, left, turn)
-        elif isinstance(session, AppSession):
-            self._drive_app(session, forward, left, turn)
-
-    def _drive_control(
-        self, session: ControlSession, forward: float, left: float, turn: float
-    ) -> None:
-        drive = session.drive
-        if drive is None:
-            return  # the session is reading system_mode; the next cmd_vel drives
-        if max(abs(forward), abs(left), abs(turn)) < command.STILL:
-            if session.moving:
-                session.stop()
-            return
-        max_speed = session.host.state.values.get("max_speed")
-        try:
-            fields = command.frame_fields(forward, left, turn, drive, self.si, max_speed)
-        except ValueError as exc:
-            self._say_once("duty", f"cmd_vel not driven: {exc}")
-            return
-        shown = f"cmd_vel {forward:+.2f} m/s, {left:+.2f} m/s, {turn:+.2f} rad/s"
-        session.hold_velocity(shown, **fields)
-
-    def _drive_app(self, session: AppSession, forward: float, left: float, turn: float) -> None:
-        speed, drive = _params(session.host.state)
-        letter = command.letter_for(forward, left, turn, drive, self.si)
-        if letter is None:
-            if session.moving:
-                session.stop()
-            return
-        if session.page_letter != letter.page:
-            session.switch_page(letter.page)
-        busy = session.host.state.query is not None
-        wanted = speed is None or abs(letter.speed - speed) > SPEED_CHANGE * max(speed, 1)
-        if not busy and wanted and session.host.state.layout.speed_index is not None:
-            session.speed_command([str(letter.speed)])
-        session.press(letter.letter)
+            self.session.move(twist)
 
     # ------------------------------------------------------------ the records
 
@@ -231,10 +188,16 @@ class RosNode:
             self._say_once("no app", "no APP port beside: odom, battery and imu are not sent")
             return
         now_ns, now = time.time_ns(), self.session.now()
+        sensed = self.session.sensed(self._sensed_at)
+        for at, twist in sensed:
+            self._sensed_at = at
+            self._odometry(twist, at, now_ns - int((now - at) * 1e9))
         for at, event in self._new(state, "A"):
             stamp = now_ns - int((now - at) * 1e9)
             self._raw(event, state, stamp)
-            self._odometry(event, state, at, stamp)
+            self._battery(self._fields(event, state, "A"), stamp)
+            if not sensed and (gap := self.session.odometry_gap()) is not None:
+                self._say_once("odom", f"{gap}: odom and tf are not sent")
         for at, event in self._new(state, "B"):
             stamp = now_ns - int((now - at) * 1e9)
             self._raw(event, state, stamp)
@@ -254,28 +217,12 @@ class RosNode:
         values = app.record_fields(event)[1]
         return {f.name: (v / f.scale, f) for f, v in zip(fields, values, strict=False)}
 
-    def _odometry(self, event: Any, state: HostState, at: float, stamp: int) -> None:
-        fields = self._fields(event, state, "A")
-        if not all(k in fields and fields[k][1].signed for k in ("x", "y", "z")):
-            self._say_once(
-                "odom",
-                f"the {state.layout.profile.name} profile's A record carries no signed x, y "
-                "and z: odom and tf are not sent",
-            )
-            self._battery(fields, stamp)
-            return
-        pose = self.odometry.step(at, fields["x"][0], fields["y"][0], fields["z"][0])
-        options = self.options
-        self._put(
-            "odom",
-            self.messages.odometry(
-                pose, stamp, options.odom_frame, options.base_frame, self.odometry.variance
-            ),
-        )
-        self._put(
-            "/tf", self.messages.transform(pose, stamp, options.odom_frame, options.base_frame)
-        )
-        self._battery(fields, stamp)
+    def _odometry(self, twist: Twist, at: float, stamp: int) -> None:
+        pose = self.odometry.step(at, twist)
+        odom, base = self.options.odom_frame, self.options.base_frame
+        variance = self.odometry.variance
+        self._put("odom", self.messages.odometry(pose, stamp, odom, base, variance))
+        self._put("/tf", self.messages.transform(pose, stamp, odom, base))
 
     def _attitude(self, event: Any, state: HostState, stamp: int) -> None:
         fields = self._fields(event, state, "B")
@@ -307,17 +254,3 @@ class RosNode:
             self._said.add(kind)
             self.log(text)
 
-
-def _params(state: HostState) -> tuple[int | None, DriveType]:
-    """The APP port's speed parameter and drive type, as its last C record gave them
-    (no record yet, or no system_mode: an omni car, whose letters every drive takes)."""
-    layout = state.layout
-    if state.params is None:
-        return None, DriveType.OMNI
-    values = app.record_fields(state.params)[1]
-    speed = None if layout.speed_index is None else int(values[layout.speed_index])
-    names = [param.name for param in layout.params]
-    if "system_mode" not in names:
-        return speed, DriveType.OMNI
-    drive = params.drive_type(int(values[names.index("system_mode")]))
-    return speed, drive or DriveType.OMNI

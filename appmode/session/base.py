@@ -1,7 +1,8 @@
 """What every driving session shares, whatever port it drives: messages, recording,
-hold-to-drive, the stop authority and the command line (`commands`).
-`app_session.Session` drives the APP port, `control_session.ControlSession` the control
-port.
+hold-to-drive, the stop authority, the twist (`move`: the one motion interface in SI
+units, which each port translates), the twist the records show (`sensed`) and the
+command line (`commands`). `app.session.AppSession` drives the APP port,
+`control.session.ControlSession` the control port.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from appmode.ports.recording import open_recorder
 from appmode.ports.target import Target
 from appmode.protocol.channels import Viewer
 from appmode.protocol.recorder import Recorder
+from appmode.protocol.velocity import Twist
+from appmode.session import sensing
 from appmode.session.authority import LAPSE, StopGuard
 from appmode.session.command_line import (
     COMMON,
@@ -30,7 +33,7 @@ from appmode.session.command_line import (
     CommandSpec,
     Step,
 )
-from appmode.session.hold import HoldToDrive
+from appmode.session.hold import TWIST, HoldToDrive
 from appmode.text import wrapped
 from appmode.writer import CLOSE_WAIT
 
@@ -99,6 +102,7 @@ class BaseSession(ABC):
         """What proves the motion alive, as messages name it (`cmd_vel` for a ROS node)."""
         self._alive_at = 0.0
         self._quiet_said = False
+        self._said: set[str] = set()
         self.guard = StopGuard(self._stoppable, self._guard_stop, self._lapsed)
         """The stop authority's thread: stops the car when the ticks stall."""
 
@@ -150,6 +154,30 @@ class BaseSession(ABC):
     def moving(self) -> bool:
         """Whether motion is in force, whatever started it (a key, a command, a stick,
         raw bytes, a turn)."""
+
+    def move(self, twist: Twist) -> None:
+        """Drive `twist` (SI units, REP 103) for as long as its source repeats it: each
+        call keeps it alive as a held key's repeats do (and `keepalive`, where a lease
+        is set, must come too); a still twist stops the car. Every port takes it: the
+        APP port as its nearest direction and speed, the control port as frames."""
+        if twist.still:
+            if self.moving:
+                self.stop()
+            return
+        if self.link_down():
+            return
+        self.driving.press(TWIST, self.now())
+        self._move(twist)
+
+    @abstractmethod
+    def _move(self, twist: Twist) -> None:
+        """Send what drives `twist` on this port (it is held: `move`)."""
+
+    def _say_once(self, text: str) -> None:
+        """Say `text` the first time only (for what a stream of twists would repeat)."""
+        if text not in self._said:
+            self._said.add(text)
+            self.say(text)
 
     @abstractmethod
     def _guard_stop(self) -> None:
@@ -246,6 +274,23 @@ class BaseSession(ABC):
 
     def telemetry_state(self) -> HostState | None:
         """The APP port's state, whose A and B records a view may draw as waveforms."""
+        return None
+
+    # ------------------------------------------------------------ the twist sensed
+
+    def odometry_gap(self) -> str | None:
+        """Why `sensed` gives nothing on this session (None: it gives the car's twist)."""
+        return sensing.gap(self.telemetry_state(), self._signs() is not None)
+
+    def sensed(self, after: float) -> list[tuple[float, Twist]]:
+        """The car's twist as each A record since `after` (session seconds) shows it,
+        in time order (`session.sensing`)."""
+        state = self.telemetry_state()
+        return [] if state is None else sensing.twists(state, self._signs, after)
+
+    def _signs(self) -> tuple[float, float, float] | None:
+        """The signs of x, y and z the motion in force drives, where the port knows them
+        as the board applies them (the control port's frames); None elsewhere."""
         return None
 
     @abstractmethod

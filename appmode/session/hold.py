@@ -4,7 +4,8 @@ Terminals report key presses (and the OS repeats them while a key is held) but n
 release. A press of a new direction sends its letter; presses of the same one keep it
 alive; when they stop coming the car is stopped with `Z`. The first timeout is longer
 than the OS delay before auto-repeat starts, the second short, for once repeats arrive.
-In latched mode a direction stays until stop or another direction.
+In latched mode a direction stays until stop or another direction; a twist (`TWIST`, a
+velocity a program keeps sending) never latches: it lasts while it is repeated.
 """
 
 from __future__ import annotations
@@ -13,6 +14,9 @@ from dataclasses import dataclass, field
 
 from appmode.protocol.directions import STOP_LETTER
 from appmode.session.timeouts import FIRST_TIMEOUT, REPEAT_TIMEOUT
+
+TWIST = "twist"
+"""What is held while a program's twists keep coming (`BaseSession.move`)."""
 
 
 @dataclass(slots=True)
@@ -37,8 +41,8 @@ class HoldToDrive:
 
     def late(self, now: float) -> float | None:
         """Seconds a held direction is past its deadline (below 0: not yet); None when
-        none is held, or it is latched."""
-        if self.latched or self.current is None:
+        none is held, or it is latched (a twist never is)."""
+        if self.current is None or (self.latched and self.current != TWIST):
             return None
         return now - self.deadline
 

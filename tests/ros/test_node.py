@@ -72,7 +72,8 @@ def car(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[Car]:
     endpoint = free_endpoint()
     router = peer.router(endpoint)
     record = tmp_path / "board.transcript"
-    board = BoardProcess("--pty", "--quiet", "--record", str(record))
+    at = extra.index("--profile") if "--profile" in extra else len(extra)
+    board = BoardProcess("--pty", "--quiet", "--record", str(record), *extra[at : at + 2])
     node, line = serving(
         "ros",
         board.url,
@@ -181,3 +182,56 @@ def test_on_the_app_port_cmd_vel_is_the_nearest_direction_and_silence_stops(car:
     assert car.board_sent()[-1] == "Z" and stopped - silent < 0.8
     err = stop_process(car.node)  # type: ignore[arg-type]
     assert "a cmd_vel that is no Twist was ignored" in err and "Traceback" not in err
+
+
+def _odometry_while(car: Car, cmd_vel: peer.Entity, forward: float, turn: float) -> list[float]:
+    """Publish cmd_vel (forward m/s, turn rad/s) at 20 Hz for 3 s: the mean twist of the
+    odom messages of its last 1.5 s, as (forward, left, turn)."""
+    odom = next(e for e in car.entities(7) if e.topic == "/odom")
+    odometry = peer.Received()
+    subscriber = car.ros.declare_subscriber(odom.data_key, odometry.on_sample)
+    twist = peer.TwistPublisher(car.ros, cmd_vel)
+    start = time.monotonic()
+    settled = 0
+    while time.monotonic() - start < 3.0:
+        twist.publish(forward, turn)
+        if time.monotonic() - start < 1.5:
+            settled = len(odometry.payloads)
+        time.sleep(0.05)
+    subscriber.undeclare()
+    kept = odometry.messages("nav_msgs/msg/Odometry")[settled:]
+    assert len(kept) >= 5, f"{len(kept)} odom messages in 1.5 s"
+    twists = [m.twist.twist for m in kept]
+    return [
+        sum(t.linear.x for t in twists) / len(twists),
+        sum(t.linear.y for t in twists) / len(twists),
+        sum(t.angular.z for t in twists) / len(twists),
+    ]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "car",
+    [(False,), (True,), (True, "--profile", "minibalance")],
+    ids=["sheet-app-port", "sheet-control-port", "minibalance-control-port"],
+    indirect=True,
+)
+def test_cmd_vel_gives_the_odometry_it_asked_for_on_every_port(car: Car) -> None:
+    cmd_vel = next(e for e in car.entities(7) if e.topic == "/cmd_vel")
+    forward, left, turn = _odometry_while(car, cmd_vel, 0.3, 0.0)
+    assert forward == pytest.approx(0.3, abs=0.09) and abs(left) < 0.05 and abs(turn) < 0.1
+    forward, left, turn = _odometry_while(car, cmd_vel, 0.0, 0.5)
+    assert turn == pytest.approx(0.5, abs=0.2) and abs(forward) < 0.05 and abs(left) < 0.05
+    silent = time.monotonic()
+    end = silent + 5
+    while time.monotonic() < end and not _stopped(car):
+        time.sleep(0.02)
+    assert _stopped(car), "the car was not stopped after cmd_vel went silent"
+    err = stop_process(car.node)  # type: ignore[arg-type]
+    assert "Traceback" not in err and "not sent" not in err, err
+
+
+def _stopped(car: Car) -> bool:
+    """The last thing the board took stops it: Z on the APP port, or the zero frame."""
+    last = max([*car.board_timed(), *car.frames()], default=(0.0, ""), key=lambda u: u[0])[1]
+    return last in ("Z", ZERO)

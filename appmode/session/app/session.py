@@ -27,8 +27,10 @@ from appmode.protocol.directions import (
     grid_for,
 )
 from appmode.protocol.layouts import VELOCITY
+from appmode.protocol.velocity import Twist
 from appmode.session.app import status
 from appmode.session.app.commands import COMMANDS, KEYS, KEYS_HELP
+from appmode.session.app.velocity import letter_for, speed_and_drive
 from appmode.session.base import BaseSession
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
@@ -36,6 +38,10 @@ from appmode.session.rows import (
     Row,
     hold_mode,
 )
+
+SPEED_CHANGE = 0.1
+"""How far (a share of it) the speed a twist asks must be from max_speed for a new
+`{0:N}` to be sent."""
 
 
 class AppSession(BaseSession):
@@ -119,6 +125,31 @@ class AppSession(BaseSession):
 
     def grid_key(self, row: int, col: int) -> str:
         return grid_for(self.page)[row][col]
+
+    def _move(self, twist: Twist) -> None:
+        """The nearest direction to `twist` on its page, at the speed asked: max_speed
+        is set (verified) when it is over SPEED_CHANGE from the speed asked."""
+        speed, drive = speed_and_drive(self.host.state)
+        letter = letter_for(twist, drive, self.host.profile.velocity_si)
+        if letter is None:
+            return
+        if self.page_letter != letter.page and not self._send(letter.page.encode()):
+            return
+        self._ask_speed(letter.speed, speed)
+        if self.in_force != letter.letter:
+            self._send_letter(letter.letter)
+
+    def _ask_speed(self, wanted: int, speed: int | None) -> None:
+        """Set max_speed to `wanted` (within its range) unless it is near it already."""
+        index = self.host.state.layout.speed_index
+        if index is None or self.busy:
+            return
+        spec = self.specs[index]
+        value = min(spec.maximum, max(spec.minimum, wanted))
+        if value != wanted:
+            self._say_once(f"a speed over {spec.name}'s range is driven at {value}")
+        if speed is None or abs(value - speed) > SPEED_CHANGE * max(speed, 1):
+            self.set_param(index, value)
 
     def stop(self) -> None:
         self.driving.stop()

@@ -27,6 +27,7 @@ from appmode.ports.choice import BoardChoice
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.params import DriveType
+from appmode.protocol.velocity import Twist
 from appmode.session.base import BaseSession
 from appmode.session.control.commands import COMMANDS, KEYS, KEYS_HELP, SETTING_NAMES
 from appmode.session.control.motion import velocity_for
@@ -38,6 +39,7 @@ from appmode.session.control.status import (
     control_lit,
     control_rows,
 )
+from appmode.session.control.velocity import frame_fields, frame_signs
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
 from appmode.session.rows import Row, hold_mode
@@ -270,15 +272,34 @@ class ControlSession(BaseSession):
         """The APP port's state beside, when it is open (its records drawn as waves)."""
         return None if self.app is None else self.app.state
 
-    def hold_velocity(self, shown: str, **fields: int) -> None:
-        """A velocity frame of the given fields (`ControlHost.velocity`'s) that lasts
-        while it is repeated, as a stick's does (a ROS node's `cmd_vel`)."""
-        if self.link_down():
+    def _move(self, twist: Twist) -> None:
+        """A velocity frame of `twist` in the board's units (duties of max_speed on a
+        differential car); while the drive type is unknown, it is read first."""
+        drive = self.drive
+        if drive is None:
+            self._say_once("the drive type is not known yet: reading system_mode")
+            if not self.busy and self.reads:
+                self.query(["system_mode"], quiet=True)
             return
-        self.driving.press("velocity", self.now())
+        max_speed = self.host.state.values.get("max_speed")
+        try:
+            fields = frame_fields(twist, drive, self.host.profile.velocity_si, max_speed)
+        except ValueError as exc:
+            self._say_once(f"not driven: {exc}")
+            return
         if self._send(lambda: self.host.velocity(**fields)):
-            self.in_force = shown
+            self.in_force = str(twist)
             self.rotation = None
+
+    def _signs(self) -> tuple[float, float, float] | None:
+        """The signs of the velocity frame in force, which the firmware applies as sent
+        (no ramp: §13.1); None while the drive type is unknown or a turn is pending."""
+        frame, drive = self.host.state.in_force, self.drive
+        if drive is None or self.rotation is not None:
+            return None
+        if frame is None:
+            return (0.0, 0.0, 0.0)
+        return frame_signs(frame, drive) if isinstance(frame, control.VelocityFrame) else None
 
     def _drive_motion(self, motion: Motion, shown: str, drive: DriveType) -> None:
         fields = velocity_for(motion, self.speed, drive)
