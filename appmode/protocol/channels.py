@@ -18,7 +18,7 @@ from appmode.protocol.control_view import view
 from appmode.protocol.layouts import Layout
 from appmode.protocol.odometry import Odometry, Pose2D
 from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 
 POSE_FRAME = "odom"
 """The frame the dead-reckoned pose is in (its origin: where the session began)."""

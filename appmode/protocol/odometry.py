@@ -1,5 +1,5 @@
 """Dead reckoning from the board's reported velocity, with no I/O: each velocity the car
-reports (REP 103's forward, left, counter-clockwise; m/s, rad/s: `velocity.Twist`)
+reports (REP 103's forward, left, counter-clockwise; m/s, rad/s: `twist.Twist`)
 integrated from report to report. Its error grows with the distance driven: the pose's
 variance is stated as (DRIFT × distance)² plus a floor, for a consumer that fuses it."""
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 from appmode.protocol.layouts import Layout
 from appmode.protocol.profile_file import Field
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 
 YAW_WINDOW = 0.5
 """Seconds of B records a turn rate is taken over (their yaw is in whole degrees)."""

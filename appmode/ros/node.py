@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from appmode.protocol import app
 from appmode.protocol.odometry import Odometry
 from appmode.protocol.render import to_json
-from appmode.protocol.velocity import BadTwist, Twist
+from appmode.protocol.twist import BadTwist, Twist
 from appmode.ros.graph import Node, Qos
 from appmode.ros.messages import (
     BATTERY,

@@ -22,7 +22,7 @@ from appmode.ports.recording import open_recorder
 from appmode.ports.target import Target
 from appmode.protocol.channels import Viewer
 from appmode.protocol.recorder import Recorder
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 from appmode.session import sensing
 from appmode.session.authority import LAPSE, StopGuard
 from appmode.session.command_line import (

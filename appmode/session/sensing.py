@@ -10,7 +10,7 @@ from collections.abc import Callable
 from appmode.host.app.state import HostState
 from appmode.protocol.app import record_fields
 from appmode.protocol.sensed import Sensing, yaw_rate
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 
 Signs = Callable[[], tuple[float, float, float] | None]
 YAW_HISTORY = 1.0

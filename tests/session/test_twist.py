@@ -16,7 +16,7 @@ from appmode.protocol.odometry import Odometry
 from appmode.protocol.params import DriveType
 from appmode.protocol.profile_file import shipped
 from appmode.protocol.sensed import Sensing, yaw_rate
-from appmode.protocol.velocity import LIMIT, BadTwist, Twist
+from appmode.protocol.twist import LIMIT, BadTwist, Twist
 from appmode.session.app.velocity import letter_for
 from appmode.session.base import BaseSession
 from appmode.session.control.velocity import frame_fields

@@ -27,7 +27,7 @@ from appmode.protocol.directions import (
     grid_for,
 )
 from appmode.protocol.layouts import VELOCITY
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 from appmode.session.app import status
 from appmode.session.app.commands import COMMANDS, KEYS, KEYS_HELP
 from appmode.session.app.velocity import letter_for, speed_and_drive

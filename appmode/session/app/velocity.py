@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from appmode.host.app.state import HostState
 from appmode.protocol import app, params
 from appmode.protocol.params import DriveType
-from appmode.protocol.velocity import STILL, Twist
+from appmode.protocol.twist import STILL, Twist
 
 SECTORS = "AHGFEDCB"
 """The direction page's letters by the direction of motion, every 45° counter-clockwise

@@ -27,7 +27,7 @@ from appmode.ports.choice import BoardChoice
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
 from appmode.protocol.params import DriveType
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 from appmode.session.base import BaseSession
 from appmode.session.control.commands import COMMANDS, KEYS, KEYS_HELP, SETTING_NAMES
 from appmode.session.control.motion import velocity_for
@@ -39,7 +39,7 @@ from appmode.session.control.status import (
     control_lit,
     control_rows,
 )
-from appmode.session.control.velocity import frame_fields, frame_signs
+from appmode.session.control.velocity import frame_fields, signs_in_force
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
 from appmode.session.rows import Row, hold_mode
@@ -48,7 +48,6 @@ DEFAULT_SPEED = 300
 """Velocity units (omni, mecanum) or tenths of a percent of duty (diff types)."""
 DEFAULT_ANGLE = 90.0
 REPORT_BIT = params.MODE_BIT["encoder_report"]
-
 
 NO_READS = (
     "this board answers no reads (the reference firmware; see appmode protocol 13): its "
@@ -253,7 +252,7 @@ class ControlSession(BaseSession):
             if not self.busy:
                 self.query(["system_mode"])
             return
-        self._drive_motion(MOTIONS[name], name, drive)
+        self._drive_fields(velocity_for(MOTIONS[name], self.speed, drive), name)
 
     def steer(self, x: float, y: float) -> None:
         """An analog stick (x right, y forward, each −1…1): a velocity frame of the
@@ -266,15 +265,14 @@ class ControlSession(BaseSession):
             self._drive("forward")  # says the drive type is being read, and reads it
             return
         motion = Motion("stick", (x, y, 0.0), (y, x))
-        self._drive_motion(motion, f"stick x {x:+.2f} y {y:+.2f}", drive)
+        self._drive_fields(velocity_for(motion, self.speed, drive), f"stick x {x:+.2f} y {y:+.2f}")
 
     def telemetry_state(self) -> HostState | None:
         """The APP port's state beside, when it is open (its records drawn as waves)."""
         return None if self.app is None else self.app.state
 
     def _move(self, twist: Twist) -> None:
-        """A velocity frame of `twist` in the board's units (duties of max_speed on a
-        differential car); while the drive type is unknown, it is read first."""
+        """A velocity frame of `twist`; while the drive type is unknown, it is read."""
         drive = self.drive
         if drive is None:
             self._say_once("the drive type is not known yet: reading system_mode")
@@ -287,22 +285,15 @@ class ControlSession(BaseSession):
         except ValueError as exc:
             self._say_once(f"not driven: {exc}")
             return
-        if self._send(lambda: self.host.velocity(**fields)):
-            self.in_force = str(twist)
-            self.rotation = None
+        self._drive_fields(fields, str(twist))
 
     def _signs(self) -> tuple[float, float, float] | None:
-        """The signs of the velocity frame in force, which the firmware applies as sent
-        (no ramp: §13.1); None while the drive type is unknown or a turn is pending."""
-        frame, drive = self.host.state.in_force, self.drive
-        if drive is None or self.rotation is not None:
-            return None
-        if frame is None:
-            return (0.0, 0.0, 0.0)
-        return frame_signs(frame, drive) if isinstance(frame, control.VelocityFrame) else None
+        """The signs of the frame in force, which the firmware applies as sent (§13.1)."""
+        turning = self.rotation is not None
+        return None if turning else signs_in_force(self.host.state.in_force, self.drive)
 
-    def _drive_motion(self, motion: Motion, shown: str, drive: DriveType) -> None:
-        fields = velocity_for(motion, self.speed, drive)
+    def _drive_fields(self, fields: dict[str, int], shown: str) -> None:
+        """A velocity frame of `fields` (`ControlHost.velocity`'s), shown as `shown`."""
         if self._send(lambda: self.host.velocity(**fields)):
             self.in_force = shown
             self.rotation = None

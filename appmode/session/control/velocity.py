@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from appmode.protocol import control
 from appmode.protocol.params import DriveType
-from appmode.protocol.velocity import Twist
+from appmode.protocol.twist import Twist
 
 
 def frame_fields(
@@ -34,8 +34,18 @@ def _within(value: float, limit: int) -> int:
     return round(max(-limit, min(limit, value)))
 
 
-def frame_signs(frame: control.VelocityFrame, drive: DriveType) -> tuple[float, float, float]:
-    """The signs (−1, 0, 1) of x, y and z that a velocity frame in force drives."""
+Frame = control.VelocityFrame | control.MotorFrame | control.PositionFrame
+
+
+def signs_in_force(
+    frame: Frame | None, drive: DriveType | None
+) -> tuple[float, float, float] | None:
+    """The signs (−1, 0, 1) of x, y and z that the frame in force drives (None: not
+    known: the drive type is not, or the frame is no velocity frame)."""
+    if frame is None:
+        return (0.0, 0.0, 0.0)
+    if drive is None or not isinstance(frame, control.VelocityFrame):
+        return None
     a, b, c = frame.values
     if drive is DriveType.DIFF_GYRO:  # left and right duties
         b, c = a + b, a - b
