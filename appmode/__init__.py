@@ -14,18 +14,14 @@ The public API (docs/api.md):
 
 Each name is imported when first used, so `import appmode` (and the pytest plugin that
 pytest loads wherever appmode is installed) costs only pyserial's import; the `appmode`
-program imports pyserial only for a command that opens a port (start-up).
+program imports pyserial only for a command that opens a port (`ports.urls` registers
+the URLs then), so that its start-up stays within that of pyserial's own miniterm.
 """
 
 from __future__ import annotations
 
-# isort: off
-# First, before anything else loads: started as the `appmode` program, a Ctrl-C from now
-# on ends it quietly (appmode.cli.entry), never with a traceback.
-import appmode.cli.entry
-# isort: on
-
 import importlib
+import sys
 
 from appmode.errors import AppmodeError
 
@@ -40,7 +36,16 @@ def register_urls() -> None:
             serial.protocol_handler_packages.append(package)
 
 
-if not appmode.cli.entry.AS_PROGRAM:  # the program's ports.urls registers them itself
+def _started_as_program() -> bool:
+    """This interpreter runs `appmode` or `python -m appmode` (not a program that imports
+    appmode)."""
+    argv = getattr(sys, "argv", None) or [""]  # an embedding interpreter may have none
+    if argv[0] == "-m":  # `python -m NAME` while NAME's package loads
+        return sys.orig_argv[sys.orig_argv.index("-m") + 1 :][:1] == ["appmode"]
+    return argv[0].replace("\\", "/").rsplit("/", 1)[-1] in ("appmode", "appmode.exe")
+
+
+if not _started_as_program():
     register_urls()
 
 TYPE_CHECKING = False

@@ -131,10 +131,6 @@ class Board:
         return self.core.uart2_control
 
     @property
-    def uart2_received(self) -> int:
-        return self.control_port.received
-
-    @property
     def uart2_errors(self) -> int:
         return self.core.uart2_errors
 

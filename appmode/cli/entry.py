@@ -29,19 +29,5 @@ def main() -> int:
             signal.signal(signum, signal.SIG_IGN)  # the command is over: its exit stands
 
 
-def started_as_program() -> bool:
-    """This interpreter runs `appmode` or `python -m appmode` (not a program that imports
-    appmode, whose signals are its own)."""
-    argv = getattr(sys, "argv", None) or [""]  # an embedding interpreter may have none
-    if argv[0] == "-m":  # `python -m NAME` while NAME's package loads
-        return sys.orig_argv[sys.orig_argv.index("-m") + 1 :][:1] == ["appmode"]
-    return argv[0].replace("\\", "/").rsplit("/", 1)[-1] in ("appmode", "appmode.exe")
-
-
-AS_PROGRAM = started_as_program()
-"""This process is the `appmode` program (its commands open ports through ports.urls)."""
-if AS_PROGRAM:
-    quit_while_loading()
-
 if __name__ == "__main__":
     sys.exit(main())

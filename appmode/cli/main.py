@@ -37,8 +37,9 @@ SHOW_TRACEBACK = "APPMODE_TRACEBACK"
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The parser, with `command`'s arguments (its module loaded) and every other
-    command named with its help; with no command, every command's arguments."""
+    """The parser: with a `command`, its arguments (its module loaded); with "", none
+    built, the commands listed from COMMANDS (the table, not a parser each: each
+    ArgumentParser costs start-up); with None, every command's arguments."""
     parser = Parser(
         prog="appmode",
         description="Drive, emulate and test robot-car boards that speak the APP protocol "
@@ -51,27 +52,20 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         nargs=0,
         help="print the version (and, run from a git checkout, its commit) and exit",
     )
+    if command == "":
+        parser.usage = "appmode [-h] [-V] COMMAND ..."
+        parser.add_argument("command", metavar="COMMAND", help=argparse.SUPPRESS)
+        parser.commands = COMMANDS
+        return parser
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
-    for name, help in COMMANDS.items():
-        if command is None or name == command:
-            module: ModuleType = importlib.import_module(f"appmode.cli.{name}")
-            command_parser = module.register(sub)
-            command_parser.set_defaults(handler=module.run)
-            if isinstance(command_parser, Parser):
-                command_parser.examples = EXAMPLES[name]
-        else:
-            _listed(sub, name, help, parser)  # its arguments are loaded when it runs
+    for name in COMMANDS if command is None else (command,):
+        module: ModuleType = importlib.import_module(f"appmode.cli.{name}")
+        command_parser = module.register(sub)
+        command_parser.set_defaults(handler=module.run)
+        if isinstance(command_parser, Parser):
+            command_parser.examples = EXAMPLES[name]
     return parser
-
-
-def _listed(sub: argparse._SubParsersAction[Parser], name: str, help: str, top: Parser) -> None:
-    """`name` in the list of commands, with its help, and no parser of its own: only the
-    command that runs is built (each ArgumentParser costs start-up, its gettext lookups
-    most). The command line that names it builds it; in argparse's table of choices the
-    top parser stands for it, never parsed with."""
-    sub._choices_actions.append(sub._ChoicesPseudoAction(name, (), help))
-    sub._name_parser_map[name] = top
 
 
 class _Version(argparse.Action):

@@ -5,7 +5,11 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from argparse import HelpFormatter
 from collections.abc import Callable
+from functools import partial
+
+from appmode.text import wrapped
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:  # the rest is imported where it is used
@@ -188,23 +192,28 @@ class Parser(argparse.ArgumentParser):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("allow_abbrev", False)
+        # told the terminal's width: argparse would ask shutil, whose import (bz2, lzma,
+        # zlib) was a twentieth of a command's start-up
+        kwargs.setdefault("formatter_class", partial(HelpFormatter, width=terminal_columns() - 2))
         super().__init__(*args, **kwargs)
         self.examples: tuple[str, ...] = ()
         """Command lines shown at the end of the help."""
-
-    def _get_formatter(self) -> argparse.HelpFormatter:
-        """argparse's, told the terminal's width: argparse asks shutil for it, whose
-        import (bz2, lzma, zlib) was a twentieth of a command's start-up."""
-        width = terminal_columns() - 2  # every HelpFormatter takes it; typeshed names prog
-        formatter = self.formatter_class(prog=self.prog, width=width)  # type: ignore[call-arg]
-        if hasattr(formatter, "_set_color"):  # Python 3.14: colour, as argparse sets it
-            formatter._set_color(getattr(self, "color", False))
-        return formatter
+        self.commands: dict[str, str] = {}
+        """Commands listed in the help by name and help (the top parser's: none built)."""
 
     def format_help(self) -> str:
-        """argparse's help, then the examples as they are typed."""
+        """argparse's help, with the commands listed, then the examples as typed."""
+        help = super().format_help()
+        if self.commands:  # as argparse lists a subparser's choices
+            indent = " " * (max(map(len, self.commands)) + 7)
+            listed = "".join(
+                wrapped(f"    {name:<{len(indent) - 4}}{text}", terminal_columns() - 2, indent)
+                + "\n"
+                for name, text in self.commands.items()
+            )
+            help = help.replace("\noptions:", f"\ncommands:\n{listed}\noptions:", 1)
         shown = "".join(f"  $ {example}\n" for example in self.examples)
-        return super().format_help() + (f"\nexamples:\n{shown}" if shown else "")
+        return help + (f"\nexamples:\n{shown}" if shown else "")
 
     def error(self, message: str) -> NoReturn:
         """argparse's, with a long word of the message (a 10 kB URL) cut short."""
@@ -212,11 +221,18 @@ class Parser(argparse.ArgumentParser):
 
         super().error(shortened(message))
 
-    def _print_message(self, message: str, file: SupportsWrite[str] | None = None) -> None:
+    def print_help(self, file: SupportsWrite[str] | None = None) -> None:
         """As argparse's, but a write that fails (a full disk, a closed pipe) is not passed
-        over: the command line reports it (help and usage are output too)."""
+        over: the command line reports it (help is output too)."""
+        (file or sys.stdout).write(self.format_help())
+
+    def print_usage(self, file: SupportsWrite[str] | None = None) -> None:
+        (file or sys.stdout).write(self.format_usage())
+
+    def exit(self, status: int = 0, message: str | None = None) -> NoReturn:
         if message:
-            (file or sys.stderr).write(message)
+            sys.stderr.write(message)
+        sys.exit(status)
 
 
 if TYPE_CHECKING:

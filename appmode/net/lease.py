@@ -61,10 +61,6 @@ class Lease:
         if self.driver is not None and self.driver.client == client:
             self._heard = now
 
-    def drives(self, client: str, now: float) -> bool:
-        """Whether `client` holds a live lease."""
-        return self.driver is not None and self.driver.client == client and not self.lapsed_at(now)
-
     def lapsed_at(self, now: float) -> bool:
         return self.driver is not None and now - self._heard > LAPSE
 

@@ -69,7 +69,6 @@ class Keys:
 
 ANY_INFO = f"{ROOT}/*/info"
 ANY_STOP = f"{ROOT}/*/stop"
-ANY_PRESENCE = f"{ROOT}/*/presence"
 
 
 def name_of(key: str) -> str:

@@ -30,7 +30,6 @@ if TYPE_CHECKING:
 
 NO_PTY = "this system has no pseudo-terminals (Windows)"
 
-register_urls()  # sim://, ble://, …, for serial.serial_for_url below
 
 BAUD = 9600
 OWN_PORTS = {
@@ -42,6 +41,7 @@ OWN_PORTS = {
 }
 """appmode's own port classes (pyserial's handlers for these schemes): they take the
 Target itself, and say themselves what went wrong and what to do."""
+register_urls()  # in the `appmode` program, here: it imports pyserial only to open a port
 
 
 class LinkLeft(ConnectionError):

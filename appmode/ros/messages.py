@@ -171,13 +171,6 @@ class Messages:
             raise ValueError(f"a Twist of {values}: not finite")
         return (*values, abs(twist.angular.x) + abs(twist.angular.y))
 
-    def make_twist(self, forward: float, left: float, turn: float) -> bytes:
-        """A Twist's CDR (what a ROS side sends; for the benchmark and the docs' check)."""
-        message = self._make(
-            TWIST, linear=self._vector(forward, left, 0.0), angular=self._vector(0.0, 0.0, turn)
-        )
-        return self._cdr(message, TWIST)
-
 
 @cache
 def _store(distro: str) -> Any:

@@ -129,7 +129,6 @@ class RosNode:
         entity_id = len(topics) + 1
         token = self.graph.entity_token(entity_id, "MS", "cmd_vel", twist, type_hash, Qos())
         key = self.graph.topic_key("cmd_vel", twist, type_hash)
-        self.cmd_vel_key = key
         self._declared += [
             self.zenoh.declare_subscriber(key, self._on_cmd_vel),
             liveliness.declare_token(token),
