@@ -113,3 +113,60 @@ def test_outside_cli_two_modules_share_a_name_only_in_sibling_folders() -> None:
         if len(folders) > 1 and len({f.parent for f in folders}) > 1
     ]
     assert clashes == [], "\n".join(clashes)
+
+
+FILE_CALLS = {"open", "read_text", "read_bytes", "write_text", "write_bytes", "mkdir", "makedirs"}
+"""Calls that open, read or write a file, or make a folder."""
+FILE_MODULES = {"os", "pathlib", "io", "marshal", "shutil", "tempfile", "importlib.resources"}
+
+
+def test_protocol_opens_no_file() -> None:
+    """protocol/ is the grammars, with no I/O: it parses what it is given and writes to
+    streams it is handed; the shipped profiles are its data (`protocol.profiles`)."""
+    found = []
+    for path in (PACKAGE / "protocol").rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call):
+                func = node.func
+                name = func.id if isinstance(func, ast.Name) else getattr(func, "attr", "")
+                if name in FILE_CALLS:
+                    found.append(f"{name_of(path)}:{node.lineno}: {name}()")
+            elif isinstance(node, ast.Import):
+                found += [
+                    f"{name_of(path)}:{node.lineno}: import {a.name}"
+                    for a in node.names
+                    if a.name in FILE_MODULES
+                ]
+            elif isinstance(node, ast.ImportFrom) and node.module in FILE_MODULES:
+                found.append(f"{name_of(path)}:{node.lineno}: from {node.module} import …")
+    assert not found, "\n".join(found)
+
+
+def test_the_package_imports_nothing_of_the_command_line() -> None:
+    """`import appmode` (a program's, the pytest plugin's) loads no part of cli/."""
+    imports = [module for _, module in imported(PACKAGE / "__init__.py")]
+    assert not [module for module in imports if module.startswith("appmode.cli")], imports
+
+
+def test_the_command_line_uses_no_argparse_internals() -> None:
+    """No private name of argparse's classes is read, set or overridden (the lazy list of
+    commands is the COMMANDS table; the width goes in by formatter_class)."""
+    import argparse
+
+    private = {
+        name
+        for cls in vars(argparse).values()
+        if isinstance(cls, type)
+        for name in vars(cls)
+        if name.startswith("_") and not name.startswith("__")
+    }
+    found = []
+    for path in modules():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        methods = [n for c in ast.walk(tree) if isinstance(c, ast.ClassDef) for n in c.body]
+        for node in [*ast.walk(tree), *methods]:
+            if isinstance(node, ast.Attribute) and node.attr in private:
+                found.append(f"{name_of(path)}:{node.lineno}: .{node.attr}")
+            elif node in methods and getattr(node, "name", "") in private:
+                found.append(f"{name_of(path)}:{node.lineno}: def {getattr(node, 'name', '')}")
+    assert not found, "\n".join(found)

@@ -10,6 +10,7 @@ import shutil
 import subprocess
 import sys
 import sysconfig
+import tempfile
 import time
 import zipfile
 from pathlib import Path
@@ -158,3 +159,63 @@ def test_compiled_modules_beside_the_sources_are_as_new_as_them() -> None:
 def source_of(compiled: Path) -> Path:
     """The source a compiled module was built from: firmware.cpython-311-….so, firmware.py."""
     return compiled.with_name(compiled.name.split(".")[0] + ".py")
+
+
+def test_an_installed_appmode_writes_nothing_into_its_folder(wheel: Path, tmp_path: Path) -> None:
+    """Installed, the program drives, decodes and shows profiles, and its folder gains no
+    file (Python's own bytecode apart); installed read-only (for root, whom no file mode
+    stops, a read-only mount of it), it does the same."""
+    site = Path(tempfile.mkdtemp(prefix="appmode-ro-"))  # under /tmp: nobody can reach it
+    home = Path(tempfile.mkdtemp(prefix="appmode-home-"))
+    try:
+        subprocess.run(
+            [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", site, wheel],
+            check=True,
+            capture_output=True,
+            timeout=300,
+        )
+        home.chmod(0o777)
+        before = sorted(site.rglob("*"))
+        _run_installed(site, home, {"PYTHONDONTWRITEBYTECODE": "1"})
+        assert sorted(site.rglob("*")) == before, "written into the installed package"
+        for path in (site, *site.rglob("*")):
+            path.chmod(0o555 if path.is_dir() else 0o444)
+        _run_installed(site, home, {}, read_only=os.geteuid() == 0)
+        assert sorted(site.rglob("*")) == before
+    finally:
+        for path in (site, *site.rglob("*")):
+            if path.is_dir():
+                path.chmod(0o755)
+        shutil.rmtree(site, ignore_errors=True)
+        shutil.rmtree(home, ignore_errors=True)
+
+
+def _run_installed(site: Path, home: Path, env: dict[str, str], read_only: bool = False) -> None:
+    """Commands of the program installed in `site`, and a program that imports appmode
+    and opens `sim://` with pyserial, each of which must succeed (`read_only`: with
+    `site` mounted read-only, in a mount namespace of their own: util-linux's unshare)."""
+    program = "import sys; from appmode.cli.entry import main; sys.exit(main())"
+    opens = "import appmode, serial; print(serial.serial_for_url('sim://'))"
+    runs = [
+        [program, "decode"],
+        [program, "profile", "show", "minibalance", "--toml"],
+        [program, "send", "sim://?profile=minibalance", "J", "A", "wait:0.3"],
+        [program, "params", "sim://", "--set", "max_speed=800"],
+        [opens],
+    ]
+    for args in runs:
+        command = [sys.executable, "-c", *args]
+        if read_only:
+            mount = f"mount --bind {site} {site} && mount -o remount,ro,bind {site}"
+            command = ["unshare", "--mount", "sh", "-c", f'{mount} && exec "$@"', "-", *command]
+        done = subprocess.run(
+            command,
+            cwd=home,
+            env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin", "HOME": str(home), **env},
+            stdin=subprocess.DEVNULL,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+        )
+        assert done.returncode == 0, (args[1:], done.stderr)

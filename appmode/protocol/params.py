@@ -45,7 +45,7 @@ SPECS: tuple[profile_file.ParamSpec, ...] = profile_file.shipped("sheet").params
 PARAMS: tuple[Param, ...] = tuple(
     Param(i, p.name, p.label, p.maximum, p.default, p.minimum) for i, p in enumerate(SPECS)
 )
-"""The sheet's nine, read from its profile file (`protocol/profiles/sheet.toml`)."""
+"""The sheet's nine, from its profile (`protocol/profiles/sheet.toml`)."""
 PARAM_COUNT = len(PARAMS)
 BY_NAME: dict[str, Param] = {p.name: p for p in PARAMS}
 DEFAULTS: tuple[int, ...] = tuple(p.default for p in PARAMS)

@@ -1,6 +1,7 @@
 """Profiles as data files: what a firmware of the family sends and takes on its APP port,
 for a host — its records' fields, its parameters and their scales, its pages — in TOML
-(`appmode/protocol/profiles/*.toml` ship; `--profile PATH` reads a user's own).
+(`appmode/protocol/profiles/*.toml` ship, as the package's data `profiles`; `--profile
+PATH` is a user's own, read by `board.profiles.load`). No file is opened here.
 
 What a simulated board *does* is code (`board/profiles.py`); this is what a host shows.
 The tables appmode's codec reads (`params.PARAMS`, the A record layouts) come from the
@@ -9,9 +10,6 @@ shipped `sheet` and `minibalance` files: one source of truth.
 
 from __future__ import annotations
 
-import contextlib
-import marshal
-import os
 import sys
 from collections.abc import Callable, Mapping
 from functools import cache
@@ -118,40 +116,13 @@ class ProfileFile(NamedTuple):
 
 @cache
 def shipped(name: str) -> ProfileFile:
-    """A profile appmode ships, from the package's own data (`profiles/NAME.toml`)."""
+    """A profile appmode ships, from the package's own data (`profiles`: each file's text
+    and its TOML as read, made from `profiles/NAME.toml`)."""
+    from appmode.protocol import profiles
+
     if name not in SHIPPED:
         raise ProfileError(name, [f"no shipped profile: choose one of {', '.join(SHIPPED)}"])
-    folder = os.path.join(os.path.dirname(__file__), "profiles")
-    with open(os.path.join(folder, f"{name}.toml"), encoding="utf-8") as file:
-        text = file.read()  # beside this module, in the package
-    where = f"{name} (shipped)"
-    return parse(text, where, ours=True, data=_read_through(folder, name, text, where))
-
-
-def _read_through(folder: str, name: str, text: str, where: str) -> dict[str, Any]:
-    """A shipped file's TOML read, kept as Python keeps bytecode: in `__pycache__`
-    beside it (marshal), holding the text it was read from, used only while the file
-    still holds that text. Start-up: tomllib's import and parse were a fifth of
-    `appmode decode`'s. Where the folder cannot be written, the file is read each time."""
-    cached = os.path.join(folder, "__pycache__", f"{name}.{sys.implementation.cache_tag}.toml")
-    try:
-        with open(cached, "rb") as file:
-            kept_text, data = marshal.load(file)
-        if kept_text == text and isinstance(data, dict):
-            return data
-    except (OSError, EOFError, ValueError, TypeError):
-        pass  # none yet, or one another Python wrote: read the file
-    data = _toml(text, where)
-    partial = f"{cached}.{os.getpid()}"
-    try:
-        os.makedirs(os.path.dirname(cached), exist_ok=True)
-        with open(partial, "wb") as file:
-            marshal.dump((text, data), file)
-        os.replace(partial, cached)  # whole or not at all, as Python writes bytecode
-    except (OSError, ValueError):  # a folder nobody may write, a full disk, a value marshal
-        with contextlib.suppress(OSError):  # cannot keep: read it each time, leave nothing
-            os.remove(partial)
-    return data
+    return parse(profiles.TEXTS[name], f"{name} (shipped)", ours=True, data=profiles.DATA[name])
 
 
 def _toml(text: str, where: str) -> dict[str, Any]:

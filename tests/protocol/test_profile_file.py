@@ -148,3 +148,11 @@ def test_a_missing_file_a_fifo_and_a_huge_file_are_one_line_each(tmp_path: Path)
         assert done.returncode == 2, done.stderr
         assert done.stderr.count("\n") == 1 and f"cannot read it ({why}" in done.stderr
         assert "give a file or one of sheet, minibalance, balance" in done.stderr
+
+
+def test_the_shipped_profiles_module_is_made_from_the_files() -> None:
+    """`protocol.profiles` holds each shipped file's text and TOML as the files now are
+    (after editing one: python -m tests.support.shipped_profiles)."""
+    from tests.support import shipped_profiles
+
+    assert shipped_profiles.MODULE.read_text(encoding="utf-8") == shipped_profiles.render()
