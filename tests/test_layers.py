@@ -170,3 +170,55 @@ def test_the_command_line_uses_no_argparse_internals() -> None:
             elif node in methods and getattr(node, "name", "") in private:
                 found.append(f"{name_of(path)}:{node.lineno}: def {getattr(node, 'name', '')}")
     assert not found, "\n".join(found)
+
+
+PORT_CLASSES = {"Host", "ControlHost", "AppSession", "ControlSession", "HostState", "ControlState"}
+"""The classes of one port's side: an isinstance on one asks which port a thing has."""
+PORT_NAMES = {"app", "uart2"}
+CHOOSE_PORTS = ("ports/", "session/", "host/app/", "host/control/", "net/remote_port.py")
+"""Where a board's port is chosen and each port's side is opened (`ports.choice`,
+`session.opener`), each port's own side (its host checks that it is given its port), and
+a URL scheme's port class (`zenoh://` opens one side of a shared car): the only places
+that may ask which port is driven."""
+
+
+def port_questions(path: Path) -> list[str]:
+    """Where `path` asks which port a host or session has: an isinstance on one port's
+    class, a board choice's `control`, a comparison with a port's name or with a choice's
+    `port` (a probe's `finding.kind`, what a port was heard to be, is no such question)."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "isinstance":
+            classes = node.args[1]
+            names = classes.elts if isinstance(classes, ast.Tuple) else [classes]
+            asked = {getattr(n, "id", getattr(n, "attr", "")) for n in names} & PORT_CLASSES
+            found += [f"isinstance(…, {name})" for name in sorted(asked)]
+        elif isinstance(node, ast.Attribute) and node.attr == "control":
+            owner = getattr(node.value, "id", getattr(node.value, "attr", ""))
+            if owner.endswith("choice"):
+                found.append(f"{owner}.control")
+        elif isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            kinds = [s for s in sides if isinstance(s, ast.Attribute) and s.attr == "kind"]
+            named = [s for s in sides if isinstance(s, ast.Constant) and s.value in PORT_NAMES]
+            ports = [
+                s
+                for s in sides
+                if isinstance(s, ast.Attribute)
+                and s.attr == "port"
+                and getattr(s.value, "id", getattr(s.value, "attr", "")).endswith("choice")
+            ]
+            if (named and not kinds) or ports:
+                found.append(f"a comparison with {ast.unparse(node)}")
+    return [f"{name_of(path)}:{question}" for question in found]
+
+
+def test_nothing_outside_ports_and_session_asks_which_port_is_driven() -> None:
+    """The board is chosen once (`ports.choice`); sessions (`session.opener.SESSIONS`),
+    a share's hosts (`host.kinds.HOSTS`) and the commands that differ by port (a table
+    each, keyed by `BoardChoice.port`) are looked up, never branched on."""
+    found = []
+    for path in modules():
+        if not path.relative_to(PACKAGE).as_posix().startswith(CHOOSE_PORTS):
+            found += port_questions(path)
+    assert not found, "\n".join(found)

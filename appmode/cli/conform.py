@@ -28,10 +28,15 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "shipped with appmode)",
     )
     conform.add_argument(
-        "--board", metavar="URL", type=target, help="run in real time against this board instead"
+        "--board",
+        dest="url",
+        metavar="URL",
+        type=target,
+        help="run in real time against this board instead",
     )
     conform.add_argument(
         "--board2",
+        dest="url2",
         metavar="URL",
         type=target,
         help="with --board: the same board's control port (UART2), for transcripts with "
@@ -65,16 +70,16 @@ WARNING = (
 
 def run(args: argparse.Namespace) -> int:
     from appmode.board.profiles import profile_named
-    from appmode.ports.choice import choose
+    from appmode.cli.options import board_choice
     from appmode.transcript.runner import run_conform
 
-    if args.board2 and not args.board:
+    if args.url2 and not args.url:
         raise AppmodeError("--board2 names the control port of the --board: give --board too")
     board = board2 = None
     profile = profile_named(args.profile or "sheet").name
-    if args.board:
-        choice = choose(args.board, args.board2, profile=args.profile)
-        board, board2 = (choice.app, choice.target) if choice.app else (choice.target, None)
+    if args.url:
+        choice = board_choice(args)
+        board, board2 = choice.app_port, choice.control_port
         profile = choice.profile.name
     if board and not board.simulated and not args.yes:
         warning = WARNING.format(url=board)

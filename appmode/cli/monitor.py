@@ -75,22 +75,30 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    choice = board_choice(args)
-    if choice.control:
-        from appmode.cli import uart2  # here: start-up stays short
+    from appmode.line.wire import APP, UART2
 
-        if args.filter is not None:
-            raise AppmodeError("--filter picks APP records: not with --uart2")
-        return uart2.run_monitor(
-            choice,
-            as_json=args.json,
-            duration=args.duration,
-            count=args.count,
-            record=args.record,
-            out=sys.stdout,
-            stop_on_exit=args.stop_on_exit,
-            foxglove=args.foxglove,
-        )
+    choice = board_choice(args)
+    return {APP: _on_app, UART2: _on_control}[choice.port](choice, args)
+
+
+def _on_control(choice: BoardChoice, args: argparse.Namespace) -> int:
+    from appmode.cli import uart2
+
+    if args.filter is not None:
+        raise AppmodeError("--filter picks APP records: not with --uart2")
+    return uart2.run_monitor(
+        choice,
+        as_json=args.json,
+        duration=args.duration,
+        count=args.count,
+        record=args.record,
+        out=sys.stdout,
+        stop_on_exit=args.stop_on_exit,
+        foxglove=args.foxglove,
+    )
+
+
+def _on_app(choice: BoardChoice, args: argparse.Namespace) -> int:
     return run_monitor(
         choice,
         as_json=args.json,

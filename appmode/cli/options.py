@@ -148,10 +148,13 @@ def profile_name(text: str) -> str:
     return text
 
 
-def board_choice(args: argparse.Namespace) -> BoardChoice:
-    """The board a command's arguments name, decided once (`ports.choice.choose`): its
-    URL; the same board's control port (a second URL, `--uart2-url`, or `--uart2` for
-    the URL's own); `--profile`; `--drive`."""
+def board_choice(
+    args: argparse.Namespace, *, url: Target | None = None, both: bool = False
+) -> BoardChoice:
+    """The board a command's arguments name, decided once (`ports.choice.choose`, the one
+    way in): its URL (or `url`, a car the user chose another way); the same board's
+    control port (a second URL, `--uart2-url`, or `--uart2` for the URL's own);
+    `--profile`; `--drive`; `both` of its ports where one URL reaches them."""
     from appmode.errors import AppmodeError
     from appmode.ports.choice import choose
 
@@ -159,11 +162,12 @@ def board_choice(args: argparse.Namespace) -> BoardChoice:
     if url2 is not None and uart2_url is not None:
         raise AppmodeError("give the control port once: a second URL or --uart2-url")
     return choose(
-        args.url,
+        url or args.url,
         url2 or uart2_url,
         uart2=getattr(args, "uart2", False),
         profile=getattr(args, "profile", None),
         drive=getattr(args, "drive_type", None),
+        both=both,
     )
 
 

@@ -85,19 +85,27 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    choice = board_choice(args)
-    if choice.control:
-        if args.verify_saved:
-            raise AppmodeError(
-                "--verify-saved is for the APP port: over --uart2, restart the board and "
-                "read the settings again"
-            )
-        from appmode.cli import uart2  # here: start-up stays short
+    from appmode.line.wire import APP, UART2
 
-        store = next((op for op in ("load", "defaults", "save") if getattr(args, op)), None)
-        return uart2.run_params(
-            choice, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
+    choice = board_choice(args)
+    return {APP: _on_app, UART2: _on_control}[choice.port](choice, args)
+
+
+def _on_control(choice: BoardChoice, args: argparse.Namespace) -> int:
+    if args.verify_saved:
+        raise AppmodeError(
+            "--verify-saved is for the APP port: over --uart2, restart the board and "
+            "read the settings again"
         )
+    from appmode.cli import uart2
+
+    store = next((op for op in ("load", "defaults", "save") if getattr(args, op)), None)
+    return uart2.run_params(
+        choice, args.set, store=store, as_json=args.json, record=args.record, out=sys.stdout
+    )
+
+
+def _on_app(choice: BoardChoice, args: argparse.Namespace) -> int:
     if args.load or args.defaults:
         raise AppmodeError("--load and --defaults are frames of the control port: add --uart2")
     return run_params(

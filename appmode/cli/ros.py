@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.live_view import add_foxglove, live_view
-from appmode.cli.options import HOLDS, Subparsers, add_profile, add_uart2, target
+from appmode.cli.options import HOLDS, Subparsers, add_profile, add_uart2, board_choice, target
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
-    from appmode.ports.target import Target
+    pass
 
 ROUTER = "tcp/localhost:7447"
 """Where rmw_zenoh's sessions find their router (docs/design.md: the default config)."""
@@ -114,7 +114,6 @@ def run(args: argparse.Namespace) -> int:
 def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
     from appmode.host import signals
     from appmode.net.config import close_session, open_session
-    from appmode.ports.choice import choose
     from appmode.ports.remote import BadRemote, check_endpoint
     from appmode.ros.graph import Node
     from appmode.ros.node import Options, RosNode
@@ -136,8 +135,7 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
                 f"no Zenoh router at {', '.join(connect)}: start one (ros2 run rmw_zenoh_cpp "
                 "rmw_zenohd), or add --router to run it here"
             )
-        url, url2 = _ports(args)
-        choice = choose(url, url2, uart2=args.uart2 and url2 is None, profile=args.profile)
+        choice = board_choice(args, both=True)  # a sim:// board's records give odom
         timeout = args.cmd_vel_timeout
         view = stack.enter_context(live_view(args.foxglove, choice.profile.a_layout))
         session = open_car(choice, HoldToDrive(first_timeout=timeout, repeat_timeout=timeout))
@@ -168,15 +166,6 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
             close_session(zenoh)
         if router is not None:
             close_session(router)
-
-
-def _ports(args: argparse.Namespace) -> tuple[Target, Target | None]:
-    """The car's ports: URL and URL2; both ports of a sim:// board (its records give
-    odom), and of a zenoh:// car with --uart2."""
-    url, url2 = args.url, args.url2
-    if url2 is None and (url.simulated or (args.uart2 and url.remote is not None)):
-        url2 = url.for_uart2()
-    return url, url2
 
 
 def _env_domain() -> int:

@@ -59,24 +59,32 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    choice = board_choice(args)
-    if choice.control:
-        from appmode.cli import uart2  # here: start-up stays short
+    from appmode.line.wire import APP, UART2
 
-        return uart2.run_send(
-            choice,
-            args.tokens,
-            listen=args.listen,
-            report=not args.no_report,
-            as_json=args.json,
-            record=args.record,
-            out=sys.stdout,
-        )
+    choice = board_choice(args)
+    return {APP: _on_app, UART2: _on_control}[choice.port](choice, args)
+
+
+def _on_app(choice: BoardChoice, args: argparse.Namespace) -> int:
     return run_send(
         choice,
         args.tokens,
         listen=args.listen,
         raw=args.raw,
+        as_json=args.json,
+        record=args.record,
+        out=sys.stdout,
+    )
+
+
+def _on_control(choice: BoardChoice, args: argparse.Namespace) -> int:
+    from appmode.cli import uart2
+
+    return uart2.run_send(
+        choice,
+        args.tokens,
+        listen=args.listen,
+        report=not args.no_report,
         as_json=args.json,
         record=args.record,
         out=sys.stdout,

@@ -13,13 +13,12 @@ from typing import TYPE_CHECKING
 from urllib.parse import quote
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import HOLDS, Subparsers, add_profile, target
+from appmode.cli.options import HOLDS, Subparsers, add_profile, board_choice, target
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
     from appmode.net.config import Tls
     from appmode.ports.choice import BoardChoice
-    from appmode.ports.target import Target
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7450"
 KEY_FILE = "share.key"
@@ -91,7 +90,6 @@ def car_name(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from appmode.net.config import free_port, zenoh_module
     from appmode.net.zenoh_log import zenoh_refusals
-    from appmode.ports.choice import choose
     from appmode.ports.remote import BadRemote, check_endpoint
 
     zenoh_module()
@@ -104,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
     except BadRemote as exc:
         raise AppmodeError(f"--listen/--connect: {exc}") from None
     listen = free_port(listen)
-    choice = choose(args.url, args.url2, profile=args.profile)
+    choice = board_choice(args, both=True)
     key = args.key if args.key is not None else kept_key()
     if not key or not key.isprintable():
         raise AppmodeError("--key: give printable text (a key is what a client pastes)")
@@ -133,7 +131,7 @@ def _serve(
     )
     shared: Share | None = None
     try:
-        shared = Share(session, args.name, _ports(choice), choice, _log)
+        shared = Share(session, args.name, choice, _log)
         print(remote_url(args.name, listen, key, everywhere), flush=True)
         _announce(host, listen, everywhere)
         ended = _Ended()
@@ -157,20 +155,6 @@ class _Ended:
 
     def is_set(self) -> bool:
         return self._set
-
-
-def _ports(choice: BoardChoice) -> dict[str, Target]:
-    """The car's ports to share: its APP port, and its control port when given (both of
-    a simulated board)."""
-    from appmode.ports.target import both_ports
-
-    if choice.control:
-        assert choice.app is not None
-        return {"app": choice.app, "uart2": choice.target}
-    if choice.target.simulated:
-        app, uart2 = both_ports(choice.target)
-        return {"app": app, "uart2": uart2}
-    return {"app": choice.target}
 
 
 def remote_url(name: str, listen: str, key: str, everywhere: bool) -> str:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
 from appmode.cli.live_view import live_view
-from appmode.cli.options import Subparsers, target
+from appmode.cli.options import Subparsers, board_choice, target
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
@@ -64,7 +64,6 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from appmode.cli.options import board_choice
     from appmode.ports.endpoints import parse_listen
     from appmode.session.opener import open_session
     from appmode.web.access import is_loopback
@@ -112,7 +111,6 @@ def _serve_fleet(
     """The fleet page: the cars the key opens; a car chosen there driven as URL is."""
     from appmode.cli.share import kept_key
     from appmode.net.config import close_session, open_session, zenoh_module
-    from appmode.ports.choice import choose
     from appmode.ports.remote import BadRemote, check_endpoint
     from appmode.ports.target import shared_car
     from appmode.session.base import BaseSession
@@ -134,7 +132,7 @@ def _serve_fleet(
     zenoh = open_session("client", key, connect=connect, scout=not connect)
 
     def open_car(name: str) -> BaseSession:
-        choice = choose(shared_car(name, connect, key), profile=args.profile)
+        choice = board_choice(args, url=shared_car(name, connect, key))
         session = open_car_session(choice, driving())
         session.start()
         return session

@@ -17,24 +17,20 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from appmode.errors import AppmodeError
-from appmode.host.app.client import Host
-from appmode.host.app.state import STILL
+from appmode.host.app.state import STILL, HostState
 from appmode.host.app.stop_check import SETTLE
-from appmode.host.control.client import ControlHost
 from appmode.host.events import LinkStatus
-from appmode.host.link import Link, LinkLost
+from appmode.host.kinds import AnyHost, open_hosts
+from appmode.host.link import LinkLost
 from appmode.net.lease import Driver, Granted, Lease, Refused
 from appmode.net.names import Keys
 from appmode.protocol import app
-from appmode.protocol.control_view import describe
-from appmode.protocol.directions import PAGE_LETTERS, letter_name
 from appmode.protocol.render import to_json
 
 if TYPE_CHECKING:
     import zenoh
 
     from appmode.ports.choice import BoardChoice
-    from appmode.ports.target import Target
 
 TICK = 0.02
 """Seconds between the share's looks at the car and at the lease."""
@@ -61,20 +57,13 @@ class Port:
 
     name: str
     """`app` or `uart2`."""
-    host: Host | ControlHost
+    host: AnyHost
 
 
 class Share:
     """The car of `choice`'s ports shared as `name` on `session` until `close`."""
 
-    def __init__(
-        self,
-        session: zenoh.Session,
-        name: str,
-        ports: dict[str, Target],
-        choice: BoardChoice,
-        log: Log,
-    ) -> None:
+    def __init__(self, session: zenoh.Session, name: str, choice: BoardChoice, log: Log) -> None:
         self.session = session
         self.keys = Keys(name)
         self.choice = choice
@@ -84,28 +73,21 @@ class Share:
         self._origin = time.monotonic()
         self.ports: dict[str, Port] = {}
         self._written: dict[str, float | None] = {}
+        """When each port's last bytes were written (the tap's time of them)."""
         self._used: set[str] = set()
         """The ports clients have written to: the ones a stop is for (a zero frame on an
         unused control port would take the motion over from the APP port, §8.3)."""
-        """When each port's last bytes were written (the tap's time of them)."""
         self._velocity: app.Velocity | None = None
         self._battery: int | None = None
         self._closed = threading.Event()
+        for port, host in open_hosts(choice, self._tap).items():
+            host.stop_on_close = not self.ports  # the first port's, until another is used
+            self.ports[port] = Port(port, host)
         try:
-            for port, target in ports.items():
-                host = self._host(port, target)
-                host.stop_on_close = not self.ports  # the first port's, until another is used
-                self.ports[port] = Port(port, host)
             self._declare()
         except BaseException:
             self.close()
             raise
-
-    def _host(self, port: str, target: Target) -> Host | ControlHost:
-        tap = self._tap(port)
-        if port == "app":
-            return Host(target, tap=tap, profile=self.choice.profile)
-        return ControlHost(target, tap=tap, profile=self.choice.profile, drive=self.choice.drive)
 
     def now(self) -> float:
         """The car's time: seconds since the share began (every sample carries it)."""
@@ -261,16 +243,22 @@ class Share:
 
     def _stopping(self) -> set[str]:
         """The ports a stop goes to: those written to, or in motion, else the first."""
-        moving = {name for name, port in self.ports.items() if in_force(port.host)}
+        moving = {name for name, port in self.ports.items() if port.host.in_force_text()}
         return (self._used | moving) or {next(iter(self.ports))}
+
+    def _telemetry(self) -> HostState | None:
+        """The state of the APP records one of the car's ports carries, if one does."""
+        return next(
+            (p.host.telemetry for p in self.ports.values() if p.host.telemetry is not None), None
+        )
 
     def _confirmed(self) -> bool | None:
         """Whether an A record of the APP port showed the car at rest within SETTLE s of
         the stop, as the local host judges it (None: it sends none here)."""
-        port = self.ports.get("app")
-        if port is None or not isinstance(port.host, Host):
+        state = self._telemetry()
+        if state is None:
             return None
-        layout = port.host.state.layout
+        layout = state.layout
         end = time.monotonic() + SETTLE
         self._velocity = None
         while time.monotonic() < end:
@@ -292,7 +280,7 @@ class Share:
         """The car as `fleet` shows it."""
         driver = self.lease.driver
         links = {name: port.host.connected for name, port in self.ports.items()}
-        motions = [in_force(port.host) for port in self.ports.values()]
+        motions = [port.host.in_force_text() for port in self.ports.values()]
         return {
             "name": self.keys.name,
             "profile": self.choice.profile.name,
@@ -310,10 +298,10 @@ class Share:
 
     def _params(self) -> dict[str, Any] | None:
         """The parameters as the car last sent them (its C record), when it has."""
-        port = self.ports.get("app")
-        if port is None or not isinstance(port.host, Host) or port.host.state.params is None:
+        state = self._telemetry()
+        if state is None or state.params is None:
             return None
-        body = to_json(port.host.state.params, port.host.state.layout)
+        body = to_json(state.params, state.layout)
         return {k: v for k, v in body.items() if k not in ("kind", "raw")}
 
     # ------------------------------------------------------------ running
@@ -348,8 +336,9 @@ class Share:
             self._velocity = event
         if isinstance(event, app.Attitude):
             self._battery = event.battery
-        if isinstance(event, app.RECORDS) and isinstance(port.host, Host):
-            body = to_json(event, port.host.state.layout)
+        state = port.host.telemetry
+        if isinstance(event, app.RECORDS) and state is not None:
+            body = to_json(event, state.layout)
             self._records.put(json.dumps({"t": round(self.now(), 3), **body}))
 
     def close(self) -> None:
@@ -362,25 +351,6 @@ class Share:
             port.host.close()
         for declared in getattr(self, "_declared", []):
             declared.undeclare()
-
-
-def in_force(host: Link[Any]) -> str | None:
-    """What the car was last told to do on this port, in words (None: stop)."""
-    if isinstance(host, Host):
-        end = host.state.end
-        return (
-            f"{end.letter} {letter_name(PAGE_LETTERS[end.page_letter], end.letter)}"
-            if (end.moving and end.letter)
-            else None
-        )
-    if isinstance(host, ControlHost):
-        state = host.state
-        if state.in_force is not None:
-            return describe(state.in_force)
-        if state.letter is not None:
-            page = PAGE_LETTERS[state.app_end.page_letter]
-            return f"{state.letter} {letter_name(page, state.letter)} (APP letter)"
-    return None
 
 
 def _driver(driver: Driver) -> dict[str, object]:

@@ -1,7 +1,8 @@
 """Which board a command opens, decided once: the port it drives (the APP port, or the
 control port with the APP port of the same board beside it), the board's profile and,
 where it matters, its drive type. `choose` holds every rule of how URLs, `--uart2`,
-`--profile` and `--drive` combine; hosts and sessions read the `BoardChoice`."""
+`--profile` and `--drive` combine; hosts and sessions read the `BoardChoice`, and every
+command its ports (`ports()`, `app_port`, `control_port`): none chooses again."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from dataclasses import dataclass
 
 from appmode.board.profiles import Profile, profile_named
 from appmode.errors import AppmodeError
+from appmode.line.wire import APP, UART2
 from appmode.ports.target import Target, board_ports
 from appmode.protocol.params import DriveType
 
@@ -28,6 +30,27 @@ class BoardChoice:
     drive: DriveType | None = None
     """The car's drive type when given or fixed by the profile (else read from the board)."""
 
+    @property
+    def port(self) -> str:
+        """The port driven, by name (`app`, `uart2`): the key of a command's table of
+        what it does on each port."""
+        return UART2 if self.control else APP
+
+    @property
+    def app_port(self) -> Target | None:
+        """The board's APP port, when it is opened (driven, or beside the control port)."""
+        return self.app if self.control else self.target
+
+    @property
+    def control_port(self) -> Target | None:
+        """The board's control port, when it is driven."""
+        return self.target if self.control else None
+
+    def ports(self) -> dict[str, Target]:
+        """The board's ports this choice opens, by name, the APP port first."""
+        found = {APP: self.app_port, UART2: self.control_port}
+        return {name: target for name, target in found.items() if target is not None}
+
 
 def choose(
     url: Target,
@@ -36,11 +59,18 @@ def choose(
     uart2: bool = False,
     profile: str | None = None,
     drive: str | None = None,
+    both: bool = False,
 ) -> BoardChoice:
     """The board `url` names — driven over its control port with `uart2`, or at `url2`
     (the same board's control port, `url` then its APP port) — with the `profile` named
     (else a sim:// URL's, else the sheet) and the `drive` type given; AppmodeError says
-    what does not fit together."""
+    what does not fit together. With `both`, a URL that reaches both of a board's ports
+    (a simulated board that has a control port; a shared car with `uart2`) opens both,
+    its control port driven."""
+    if both and url2 is None and (url.simulated or (uart2 and url.remote is not None)):
+        named = profile_named(profile or url.profile or "sheet")
+        if named.file is None or named.file.control_port:
+            url2, uart2 = url.for_uart2(), False
     driven, beside, control = board_ports(url, url2, uart2=uart2, profile=profile, drive=drive)
     chosen = profile_named(profile or driven.profile or "sheet")
     if not control:

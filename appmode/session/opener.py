@@ -5,11 +5,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from appmode.line.wire import APP, UART2
 from appmode.ports.choice import BoardChoice
 from appmode.session.app.session import AppSession
 from appmode.session.base import BaseSession
 from appmode.session.control.session import ControlSession
 from appmode.session.hold import HoldToDrive
+
+SESSIONS: dict[str, type[AppSession] | type[ControlSession]] = {
+    APP: AppSession,
+    UART2: ControlSession,
+}
+"""The session of each port a board choice drives (`BoardChoice.port`)."""
 
 
 def open_session(
@@ -20,5 +27,4 @@ def open_session(
 ) -> BaseSession:
     """The session `choice` asks for: the APP port's, or the control port's (with the APP
     port of the same board beside it); `record` names its recording."""
-    kind = ControlSession if choice.control else AppSession
-    return kind(choice, driving, record, on_message)
+    return SESSIONS[choice.port](choice, driving, record, on_message)

@@ -12,7 +12,7 @@ import threading
 from appmode.net.config import close_session, open_session
 from appmode.net.share import Share
 from appmode.ports.choice import choose
-from appmode.ports.target import both_ports, parse_target
+from appmode.ports.target import parse_target
 
 
 def main(count: int, listen: str, key: str) -> None:
@@ -22,11 +22,8 @@ def main(count: int, listen: str, key: str) -> None:
     shares: list[Share] = []
     try:
         for n in range(1, count + 1):
-            choice = choose(parse_target("sim://"))
-            app, uart2 = both_ports(choice.target)
-            shares.append(
-                Share(session, f"car-{n:02}", {"app": app, "uart2": uart2}, choice, print)
-            )
+            choice = choose(parse_target("sim://"), both=True)
+            shares.append(Share(session, f"car-{n:02}", choice, print))
         runs = [threading.Thread(target=s.run, args=(ended.is_set,), daemon=True) for s in shares]
         for run in runs:
             run.start()

@@ -21,6 +21,7 @@ from appmode.line.wire import UART2, Tap
 from appmode.ports.target import AnyTarget, as_target
 from appmode.ports.urls import open_link
 from appmode.protocol import app, session_end
+from appmode.protocol.directions import PAGE_LETTERS, letter_name
 from appmode.protocol.escaping import escape
 from appmode.protocol.param_values import Specs
 from appmode.protocol.render import motion_text
@@ -132,6 +133,20 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
     def save(self) -> None:
         """Send `{Q:W}`: the board saves its running parameters to flash."""
         self.send_command(app.SaveParams())
+
+    # ------------------------------------------------------------ what it shows
+
+    @property
+    def telemetry(self) -> HostState:
+        """The state of the APP records this port carries."""
+        return self.state
+
+    def in_force_text(self) -> str | None:
+        """What the car was last told to do on this port, in words (None: stop)."""
+        end = self.state.end
+        if not (end.moving and end.letter):
+            return None
+        return f"{end.letter} {letter_name(PAGE_LETTERS[end.page_letter], end.letter)}"
 
     # ------------------------------------------------------------ end
 

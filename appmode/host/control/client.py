@@ -33,6 +33,8 @@ from appmode.line.wire import UART2_BAUD, Tap
 from appmode.ports.target import AnyTarget, as_target
 from appmode.ports.urls import open_link
 from appmode.protocol import app, control, params, reader, settings
+from appmode.protocol.control_view import describe
+from appmode.protocol.directions import PAGE_LETTERS, letter_name
 from appmode.protocol.params import DriveType
 
 READ_TIMEOUT = 0.1
@@ -178,6 +180,21 @@ class ControlHost(Link[control.BoardEvent | ControlOutcome | PortMode]):
                     "one of 0–3; set it with --set system_mode=N"
                 )
         return self.state.drive
+
+    @property
+    def telemetry(self) -> None:
+        """No APP records come here (APP mode's are the APP port's own, §12)."""
+        return None
+
+    def in_force_text(self) -> str | None:
+        """What the car was last told to do on this port, in words (None: stop)."""
+        state = self.state
+        if state.in_force is not None:
+            return describe(state.in_force)
+        if state.letter is None:
+            return None
+        page = PAGE_LETTERS[state.app_end.page_letter]
+        return f"{state.letter} {letter_name(page, state.letter)} (APP letter)"
 
     @property
     def known_drive(self) -> DriveType | None:
