@@ -26,8 +26,6 @@ HEAD = '''"""The profiles appmode ships, as data: each file's text (`TEXTS`, wha
 `python -m tests.support.shipped_profiles`: edit those, then run it."""
 # ruff: noqa: E501
 
-from typing import Any
-
 '''
 
 
@@ -38,7 +36,7 @@ def render() -> str:
     return (
         HEAD
         + f"TEXTS: dict[str, str] = {pprint.pformat(texts, width=100, sort_dicts=False)}\n\n"
-        + f"DATA: dict[str, dict[str, Any]] = {pprint.pformat(data, width=100, sort_dicts=False)}\n"
+        + f"DATA: dict[str, dict[str, object]] = {pprint.pformat(data, width=100, sort_dicts=False)}\n"
     )
 
 

@@ -3,8 +3,6 @@
 `python -m tests.support.shipped_profiles`: edit those, then run it."""
 # ruff: noqa: E501
 
-from typing import Any
-
 TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1–§12 reads it: a mecanum/omni car whose A "
           'record\n'
           "# carries its velocity. appmode's tables of the nine parameters and of the A record's\n"
@@ -238,7 +236,7 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1�
             'maximum = 0\n'
             'default = 0\n'}
 
-DATA: dict[str, dict[str, Any]] = {'sheet': {'name': 'sheet',
+DATA: dict[str, dict[str, object]] = {'sheet': {'name': 'sheet',
            'description': "the vendor's sheet: a mecanum/omni car, its velocity in the A record",
            'source': "the vendor's protocol sheet (Traditional Chinese), docs/protocol.md §1–§12",
            'baud': 9600,
