@@ -33,8 +33,10 @@ def render() -> str:
     """The module's text, from the files as they are now."""
     texts = {name: (FOLDER / f"{name}.toml").read_text(encoding="utf-8") for name in SHIPPED}
     data = {name: tomllib.loads(text) for name, text in texts.items()}
-    shown = {name: pprint.pformat(value, width=100, sort_dicts=False) for name, value in (
-        ("texts", texts), ("data", data))}
+    shown = {
+        name: pprint.pformat(value, width=100, sort_dicts=False)
+        for name, value in (("texts", texts), ("data", data))
+    }
     return (
         HEAD
         + f"TEXTS: dict[str, str] = {shown['texts']}\n\n"
