@@ -83,7 +83,5 @@ def yaw_rate(points: Sequence[tuple[float, float]], at: float) -> float | None:
     window = [(t, yaw) for t, yaw in points if at - YAW_WINDOW <= t <= at]
     if len(window) < 2 or window[-1][0] - window[0][0] <= 0:
         return None
-    turned = sum(
-        math.remainder(b[1] - a[1], 360.0) for a, b in itertools.pairwise(window)
-    )
+    turned = sum(math.remainder(b[1] - a[1], 360.0) for a, b in itertools.pairwise(window))
     return turned / (window[-1][0] - window[0][0])

@@ -252,4 +252,3 @@ class RosNode:
         if kind not in self._said:
             self._said.add(kind)
             self.log(text)
-

@@ -140,9 +140,7 @@ def settled(sensed: list[tuple[float, Twist]], after: float) -> Twist:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    ("uart2", "profile"), [(False, None), (True, None), (True, "minibalance")]
-)
+@pytest.mark.parametrize(("uart2", "profile"), [(False, None), (True, None), (True, "minibalance")])
 def test_every_port_drives_a_twist_and_senses_it(uart2: bool, profile: str | None) -> None:
     url = "sim://" if profile is None else f"sim://?profile={profile}"
     hold = HoldToDrive(first_timeout=0.3, repeat_timeout=0.3)
