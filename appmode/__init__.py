@@ -45,7 +45,21 @@ def _started_as_program() -> bool:
     return argv[0].replace("\\", "/").rsplit("/", 1)[-1] in ("appmode", "appmode.exe")
 
 
-if not _started_as_program():
+def _quit(signum: int, frame: object) -> None:
+    raise SystemExit(130)
+
+
+def quit_while_loading() -> None:
+    """Ctrl-C ends the program quietly (exit 130, no traceback) until the command's own
+    handling takes over (`cli.entry`)."""
+    import signal
+
+    signal.signal(signal.SIGINT, _quit)
+
+
+if _started_as_program():
+    quit_while_loading()  # first, before anything else of appmode loads
+else:
     register_urls()
 
 TYPE_CHECKING = False

@@ -7,14 +7,7 @@ from __future__ import annotations
 import signal
 import sys
 
-
-def _quit(signum: int, frame: object) -> None:
-    raise SystemExit(130)
-
-
-def quit_while_loading() -> None:
-    """Ctrl-C ends the program quietly until the command's own handling takes over."""
-    signal.signal(signal.SIGINT, _quit)
+from appmode import quit_while_loading
 
 
 def main() -> int:

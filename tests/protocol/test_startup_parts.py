@@ -1,7 +1,7 @@
-"""The pieces that keep the command line's start-up short (issue 64.13): shipped profiles
-read through a cache as Python keeps bytecode, NamedTuple without typing, regular
-expressions compiled when first used, and the program importing neither pyserial nor
-typing for a command that does not use them."""
+"""The pieces that keep the command line's start-up short (issue 64.13): NamedTuple
+without typing, regular expressions compiled when first used, and the program importing
+neither pyserial nor typing for a command that does not use them (the shipped profiles
+are the package's data as a module: tests/protocol/test_profile_file.py)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ import os
 import subprocess
 import sys
 import typing
-from pathlib import Path
 
 import pytest
 
@@ -21,59 +20,9 @@ if typing.TYPE_CHECKING:  # as the modules that use it write it
 else:
     from appmode.protocol.tuples import NamedTuple
 
-SHEET = Path(profile_file.__file__).parent / "profiles" / "sheet.toml"
-
-
-def copy_of_sheet(tmp_path: Path) -> tuple[str, str]:
-    text = SHEET.read_text(encoding="utf-8")
-    (tmp_path / "sheet.toml").write_text(text, encoding="utf-8")
-    return str(tmp_path), text
-
-
-def test_a_shipped_file_is_read_once_then_from_its_cache(tmp_path: Path) -> None:
-    folder, text = copy_of_sheet(tmp_path)
-    first = profile_file._read_through(folder, "sheet", text, "sheet (shipped)")
-    kept = list((tmp_path / "__pycache__").iterdir())
-    assert [p.name for p in kept] == [f"sheet.{sys.implementation.cache_tag}.toml"]
-    assert first == profile_file._toml(text, "sheet")
-    mtime = kept[0].stat().st_mtime_ns
-    again = profile_file._read_through(folder, "sheet", text, "sheet (shipped)")
-    assert again == first and kept[0].stat().st_mtime_ns == mtime, "read, not written"
-
-
-def test_a_cache_of_other_text_is_not_used(tmp_path: Path) -> None:
-    folder, text = copy_of_sheet(tmp_path)
-    profile_file._read_through(folder, "sheet", text, "sheet (shipped)")
-    changed = text.replace("baud = 9600", "baud = 19200", 1)
-    data = profile_file._read_through(folder, "sheet", changed, "sheet (shipped)")
-    assert data["baud"] == 19200, "the file as it is now, not what the cache kept"
-    assert profile_file._read_through(folder, "sheet", changed, "x")["baud"] == 19200
-
-
-@pytest.mark.parametrize("damage", [b"", b"\x00garbage", b"\xfb\x01\x02"])
-def test_a_damaged_cache_is_read_past(tmp_path: Path, damage: bytes) -> None:
-    folder, text = copy_of_sheet(tmp_path)
-    cache = tmp_path / "__pycache__"
-    cache.mkdir()
-    (cache / f"sheet.{sys.implementation.cache_tag}.toml").write_bytes(damage)
-    assert profile_file._read_through(folder, "sheet", text, "s") == profile_file._toml(text, "s")
-
-
-def test_a_folder_that_cannot_hold_a_cache_is_read_each_time(tmp_path: Path) -> None:
-    """As where nobody may write: the cache's folder cannot be made (here a file holds
-    its name, which stops root too)."""
-    folder, text = copy_of_sheet(tmp_path)
-    (tmp_path / "__pycache__").write_bytes(b"")
-    for _ in range(2):
-        data = profile_file._read_through(folder, "sheet", text, "s")
-        assert data == profile_file._toml(text, "s")
-    assert (tmp_path / "__pycache__").read_bytes() == b""
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["__pycache__", "sheet.toml"]
-
-
-def test_a_bad_toml_is_one_error_whichever_way_it_is_read(tmp_path: Path) -> None:
+def test_a_bad_toml_is_one_error() -> None:
     with pytest.raises(profile_file.ProfileError, match="not TOML"):
-        profile_file._read_through(str(tmp_path), "x", "name = ", "x (shipped)")
+        profile_file.parse("name = ", "x")
 
 
 class Row(NamedTuple):
@@ -161,11 +110,3 @@ def test_help_keeps_to_the_terminal_width_it_is_given() -> None:
         check=True,
     )
     assert max(len(line) for line in done.stdout.splitlines() if " $ " not in line) <= 50
-
-
-def test_a_value_the_cache_cannot_keep_leaves_nothing_behind(tmp_path: Path) -> None:
-    """TOML's dates are no marshal value: read each time, no half-written cache left."""
-    text = "x = 1979-05-27T07:32:00Z\n"
-    for _ in range(2):
-        assert profile_file._read_through(str(tmp_path), "t", text, "t")["x"].year == 1979
-    assert list((tmp_path / "__pycache__").iterdir()) == []

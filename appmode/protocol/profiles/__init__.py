@@ -3,13 +3,14 @@
 `python -m tests.support.shipped_profiles`: edit those, then run it."""
 # ruff: noqa: E501
 
-TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1–§12 reads it: a mecanum/omni car whose A "
-          'record\n'
-          "# carries its velocity. appmode's tables of the nine parameters and of the A record's\n"
-          '# fields are read from this file.\n'
+TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as the protocol reference reads it (appmode protocol, sections "
+          '1–12):\n'
+          "# a mecanum/omni car whose A record carries its velocity. appmode's tables of the nine\n"
+          "# parameters and of the A record's fields are read from this file.\n"
           'name = "sheet"\n'
           'description = "the vendor\'s sheet: a mecanum/omni car, its velocity in the A record"\n'
-          'source = "the vendor\'s protocol sheet (Traditional Chinese), docs/protocol.md §1–§12"\n'
+          'source = "the vendor\'s protocol sheet (Traditional Chinese), appmode protocol, '
+          'sections 1–12"\n'
           'baud = 9600\n'
           'period_ms = [50, 50]   # between records, shortest and longest\n'
           'control_port = true    # UART2 takes binary FF FE frames (§8–§12)\n'
@@ -96,7 +97,7 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1�
           'label = "system mode bits"\n'
           'maximum = 65535\n'
           'default = 0\n',
- 'minibalance': '# The reference firmware as measured (docs/protocol.md §13): the mecanum/omni '
+ 'minibalance': '# The reference firmware as measured (appmode protocol 13): the mecanum/omni '
                 'board of the\n'
                 "# MiniBalance lineage. Its parameters are the sheet's, with other defaults; its A "
                 'record\n'
@@ -105,7 +106,7 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1�
                 'description = "the reference mecanum/omni firmware as measured: |0.7x|, |0.7y| '
                 'and the battery in the A record"\n'
                 'source = "a public build of the MiniBalance mecanum/omni firmware (APP_Show, '
-                'usart3 receive), measured byte by byte: docs/protocol.md §13"\n'
+                'usart3 receive), measured byte by byte: appmode protocol 13"\n'
                 'like = "sheet"         # what this file does not say is the sheet\'s\n'
                 'period_ms = [60, 90]   # 5·⌈wire time / 5⌉ + 45 ms: 60 for short records, 80 for '
                 'a C pass\n'
@@ -131,14 +132,14 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1�
                 ']\n',
  'balance': '# The two-wheel self-balancing car that gave the family its name, as its public '
             'STM32\n'
-            '# firmware reads and prints the APP port (docs/protocol.md §14): APP_Show() writes '
+            '# firmware reads and prints the APP port (appmode protocol 14): APP_Show() writes '
             'the\n'
             '# records, the USART3 receive handler takes letters and {…} frames.\n'
             'name = "balance"\n'
             'description = "the two-wheel balance car: encoders and the balance angle in the '
             'records, its PID gains as parameters"\n'
             'source = "the public MiniBalance two-wheel balance car firmware (STM32): show.c '
-            'APP_Show(), usart3.c USART3_IRQHandler; docs/protocol.md §14"\n'
+            'APP_Show(), usart3.c USART3_IRQHandler; appmode protocol 14"\n'
             'baud = 9600\n'
             "period_ms = [50, 150]  # once a pass of the main loop's display step (not measured)\n"
             'control_port = false   # no binary control port\n'
@@ -238,7 +239,8 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as docs/protocol.md §1�
 
 DATA: dict[str, dict[str, object]] = {'sheet': {'name': 'sheet',
            'description': "the vendor's sheet: a mecanum/omni car, its velocity in the A record",
-           'source': "the vendor's protocol sheet (Traditional Chinese), docs/protocol.md §1–§12",
+           'source': "the vendor's protocol sheet (Traditional Chinese), appmode protocol, "
+                     'sections 1–12',
            'baud': 9600,
            'period_ms': [50, 50],
            'control_port': True,
@@ -300,7 +302,7 @@ DATA: dict[str, dict[str, object]] = {'sheet': {'name': 'sheet',
                  'description': 'the reference mecanum/omni firmware as measured: |0.7x|, |0.7y| '
                                 'and the battery in the A record',
                  'source': 'a public build of the MiniBalance mecanum/omni firmware (APP_Show, '
-                           'usart3 receive), measured byte by byte: docs/protocol.md §13',
+                           'usart3 receive), measured byte by byte: appmode protocol 13',
                  'like': 'sheet',
                  'period_ms': [60, 90],
                  'saves': False,
@@ -334,7 +336,7 @@ DATA: dict[str, dict[str, object]] = {'sheet': {'name': 'sheet',
              'description': 'the two-wheel balance car: encoders and the balance angle in the '
                             'records, its PID gains as parameters',
              'source': 'the public MiniBalance two-wheel balance car firmware (STM32): show.c '
-                       'APP_Show(), usart3.c USART3_IRQHandler; docs/protocol.md §14',
+                       'APP_Show(), usart3.c USART3_IRQHandler; appmode protocol 14',
              'baud': 9600,
              'period_ms': [50, 150],
              'control_port': False,
