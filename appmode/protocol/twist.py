@@ -33,7 +33,7 @@ class Twist:
         each clamped to ±LIMIT; raises BadTwist otherwise."""
         parts = (forward, left, turn)
         if not all(math.isfinite(part) for part in parts):
-            raise BadTwist(f"a velocity of {forward}, {left}, {turn}: each must be a number")
+            raise BadTwist(f"a twist of {forward}, {left}, {turn}: each part must be a number")
         return cls(*(max(-LIMIT, min(LIMIT, part)) for part in parts))
 
     @classmethod

@@ -155,18 +155,19 @@ class BaseSession(ABC):
         """Whether motion is in force, whatever started it (a key, a command, a stick,
         raw bytes, a turn)."""
 
-    def move(self, twist: Twist) -> None:
+    def move(self, twist: Twist, source: str = TWIST) -> None:
         """Drive `twist` (SI units, REP 103) for as long as its source repeats it: each
         call keeps it alive as a held key's repeats do (and `keepalive`, where a lease
-        is set, must come too); a still twist stops the car. Every port takes it: the
-        APP port as its nearest direction and speed, the control port as frames."""
+        is set, must come too; a program's twist never latches, a typed one as a key
+        does); a still twist stops the car. Every port takes it: the APP port as its
+        nearest direction and speed, the control port as frames."""
         if twist.still:
             if self.moving:
                 self.stop()
             return
         if self.link_down():
             return
-        self.driving.press(TWIST, self.now())
+        self.driving.press(source, self.now())
         self._move(twist)
 
     @abstractmethod

@@ -12,6 +12,8 @@ from appmode.errors import AppmodeError
 from appmode.files import new_recording, recordings_folder
 from appmode.host.app.tokens import parse_token
 from appmode.host.waits import Wait
+from appmode.protocol.twist import BadTwist, Twist
+from appmode.session.hold import TYPED_TWIST
 
 if TYPE_CHECKING:
     from appmode.session.base import BaseSession
@@ -86,6 +88,31 @@ def _record(session: BaseSession, args: list[str]) -> None:
         )
 
 
+def _twist(session: BaseSession, args: list[str]) -> None:
+    """`twist FORWARD [LEFT [TURN]]`: m/s, m/s, rad/s counter-clockwise."""
+    numbers = [_number(arg) for arg in args]
+    if not 1 <= len(args) <= 3 or None in numbers:
+        raise AppmodeError(
+            "usage: twist FORWARD [LEFT [TURN]]: m/s forward, m/s left, rad/s "
+            "counter-clockwise, e.g. twist 0.3 or twist 0 0 0.5"
+        )
+    try:
+        forward, left, turn = [n or 0.0 for n in numbers] + [0.0] * (3 - len(numbers))
+        twist = Twist.checked(forward, left, turn)
+    except BadTwist as exc:
+        raise AppmodeError(str(exc)) from None
+    session.move(twist, TYPED_TWIST)
+    session.say(f"twist {twist}")
+
+
+def _number(text: str) -> float | None:
+    """`text` as a number written in ASCII (`0.3`, `-1e-1`), or None."""
+    try:
+        return float(text) if text.isascii() and len(text) <= 40 else None
+    except ValueError:
+        return None
+
+
 def _wait(session: BaseSession, args: list[str]) -> Wait:
     step = parse_token(f"wait:{args[0]}" if len(args) == 1 else "wait:")
     assert isinstance(step, Wait)
@@ -100,6 +127,13 @@ COMMON: tuple[CommandSpec[BaseSession], ...] = (
     CommandSpec("latch", "on|off", "latched driving: a direction stays until stop", _latch, ON_OFF),
     CommandSpec(
         "record", "FILE|stop", "start or stop recording a transcript", _record, {"stop": None}
+    ),
+    CommandSpec(
+        "twist",
+        "FWD [LEFT [TURN]]",
+        "drive m/s forward and left, rad/s counter-clockwise, on any port (latched: until "
+        "stop)",
+        _twist,
     ),
     CommandSpec("wait", "SECONDS", "script mode: let time pass", _wait),
     CommandSpec("status", "", "print the status panel (script mode)", lambda s, a: SHOW_STATUS),

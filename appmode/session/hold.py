@@ -17,6 +17,8 @@ from appmode.session.timeouts import FIRST_TIMEOUT, REPEAT_TIMEOUT
 
 TWIST = "twist"
 """What is held while a program's twists keep coming (`BaseSession.move`)."""
+TYPED_TWIST = "typed twist"
+"""A twist typed on the command line: held as a typed `drive` is (latched in a script)."""
 
 
 @dataclass(slots=True)

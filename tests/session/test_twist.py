@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import astuple
+from pathlib import Path
 
 import pytest
 
@@ -21,6 +22,7 @@ from appmode.session.app.velocity import letter_for
 from appmode.session.base import BaseSession
 from appmode.session.control.velocity import frame_fields
 from appmode.session.hold import TWIST, HoldToDrive
+from tests.support.processes import BoardProcess, run, sent_lines
 from tests.support.sessions import session as open_board
 
 SI = (0.001, 0.001)
@@ -49,7 +51,7 @@ def test_a_twist_in_board_units_and_back() -> None:
 
 def test_a_twist_from_outside_is_a_number_and_within_reason() -> None:
     for bad in (math.nan, math.inf, -math.inf):
-        with pytest.raises(BadTwist, match="must be a number"):
+        with pytest.raises(BadTwist, match="each part must be a number"):
             Twist.checked(bad, 0.0, 0.0)
     huge = Twist.checked(1e307, -1e307, 70.0)
     assert (huge.forward, huge.left, huge.turn) == (LIMIT, -LIMIT, 70.0)
@@ -164,3 +166,32 @@ def test_every_port_drives_a_twist_and_senses_it(uart2: bool, profile: str | Non
         assert not session.moving and session.now() - stopped < 0.6
     finally:
         session.close()
+
+
+@pytest.mark.parametrize("uart2", [False, True])
+def test_a_script_s_twist_drives_either_port_and_the_session_ends_with_the_stop(
+    tmp_path: Path, uart2: bool
+) -> None:
+    """`twist` in a script, judged on the board's recording: the APP port's nearest
+    direction at the speed asked, or the control port's velocity frame; the stop last."""
+    record = tmp_path / "board.transcript"
+    board = BoardProcess("--pty", "--quiet", "--record", str(record))
+    script = b"twist 0.3\nwait 0.6\ntwist 0 0 0.5\nwait 0.6\ntwist nan\n"
+    try:
+        args = (board.url, board.uart2) if uart2 else (board.url,)
+        done = run("drive", *args, stdin=script)
+    finally:
+        board.stop()
+    assert done.returncode == 1, done.stderr  # the NaN is refused, the script stops there
+    assert "a twist of nan, 0.0, 0.0: each part must be a number" in done.stderr
+    lines = record.read_text().splitlines()
+    if uart2:
+        frames = [line.split(" 2> ", 1)[1] for line in lines if " 2> " in line]
+        assert "FF FE 01 00 00 01 2C 00 00 00" in frames  # y = 300: 0.3 m/s
+        assert "FF FE 01 00 00 00 00 00 9F 01" in frames  # z = 159 anticlockwise (bit 0)
+        assert frames[-1] == "FF FE 01 00 00 00 00 00 00 00"
+    else:
+        sent = sent_lines(record)
+        assert sent.index("{0:300}") < sent.index("A") < sent.index("K")
+        assert sent.index("K") < sent.index("{0:159}") < sent.index("G")
+        assert sent[-1] == "Z"
