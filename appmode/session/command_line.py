@@ -89,11 +89,11 @@ def _record(session: BaseSession, args: list[str]) -> None:
 
 
 def _twist(session: BaseSession, args: list[str]) -> None:
-    """`twist FORWARD [LEFT [TURN]]`: m/s, m/s, rad/s counter-clockwise."""
+    """`twist F [L [T]]`: m/s forward, m/s to the left, rad/s counter-clockwise."""
     numbers = [_number(arg) for arg in args]
     if not 1 <= len(args) <= 3 or None in numbers:
         raise AppmodeError(
-            "usage: twist FORWARD [LEFT [TURN]]: m/s forward, m/s left, rad/s "
+            "usage: twist F [L [T]]: m/s forward, m/s to the left, rad/s "
             "counter-clockwise, e.g. twist 0.3 or twist 0 0 0.5"
         )
     try:
@@ -128,17 +128,13 @@ COMMON: tuple[CommandSpec[BaseSession], ...] = (
     CommandSpec(
         "record", "FILE|stop", "start or stop recording a transcript", _record, {"stop": None}
     ),
-    CommandSpec(
-        "twist",
-        "FWD [LEFT [TURN]]",
-        "drive m/s forward and left, rad/s counter-clockwise, on any port (latched: until "
-        "stop)",
-        _twist,
-    ),
     CommandSpec("wait", "SECONDS", "script mode: let time pass", _wait),
     CommandSpec("status", "", "print the status panel (script mode)", lambda s, a: SHOW_STATUS),
     CommandSpec("help", "", "list the commands and keys", lambda s, a: SHOW_HELP),
     CommandSpec("quit", "", "stop the car and leave (Ctrl-Q; Ctrl-C at once)", _quit),
+    CommandSpec(
+        "twist", "F [L [T]]", "drive in SI: F, L m/s forward, left; T rad/s to the left", _twist
+    ),
 )
 """The commands every session takes, listed after its own."""
 COMMON_ALIASES = {"?": "help", **{word: "quit" for word in QUIT_WORDS}}

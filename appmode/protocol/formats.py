@@ -1,0 +1,144 @@
+"""The recording formats, in one table each way as python-can keeps its message writers
+and readers: a file's name chooses how it is written (`WRITERS`, by suffix; a
+transcript unless the suffix names another), its first bytes how it is read
+(`READERS`, by magic; a transcript when none fits). No I/O: a format writes the lines a
+recorder or `convert` hands it, and reads from a stream it is handed. A new format is a
+`Format` and a row in each table."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from typing import BinaryIO
+
+from appmode.errors import AppmodeError
+from appmode.protocol.layouts import Layout
+from appmode.protocol.params import DriveType
+from appmode.protocol.reader import PortsReader
+from appmode.protocol.recorder import Lines, TextLines
+from appmode.protocol.transcript import (
+    HEADER,
+    SUFFIX,
+    Entry,
+    Line,
+    format_line,
+    line_items,
+    stream_lines,
+)
+
+Warn = Callable[[str], None]
+PAD = 100
+"""Blank lines at most that put a converted line back at its number (a larger gap is
+closed)."""
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+MAGIC_SIZE = len(MCAP_MAGIC)
+"""Bytes a reader looks at to tell the format."""
+
+
+class Format:
+    """How one format is written and read."""
+
+    name = ""
+    suffix = ""
+
+    def lines(self, layout: Layout) -> Lines:
+        """What a recorder writes: its start, each unit, its end."""
+        raise NotImplementedError
+
+    def convert(
+        self, items: Iterator[Line], layout: Layout, drive: DriveType | None, counted: list[int]
+    ) -> Iterator[bytes]:
+        """The file's bytes for transcript lines (`convert`), each line's number put in
+        `counted` as it goes."""
+        raise NotImplementedError
+
+    def read(self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None) -> Iterator[Line]:
+        """The lines a file holds (`whole`: whether it ends as a file of its format
+        ends; None: not known, a pipe)."""
+        raise NotImplementedError
+
+
+class Text(Format):
+    """A transcript, format v1: UTF-8 text, a line a unit."""
+
+    name, suffix = "transcript", SUFFIX
+
+    def lines(self, layout: Layout) -> Lines:
+        return TextLines()
+
+    def convert(
+        self, items: Iterator[Line], layout: Layout, drive: DriveType | None, counted: list[int]
+    ) -> Iterator[bytes]:
+        yield (HEADER + "\n").encode()
+        at = 1
+        for item in items:
+            counted.append(item.lineno)
+            gap = item.lineno - at - 1
+            if 0 < gap <= PAD:
+                yield b"\n" * gap
+                at += gap
+            at += 1
+            yield (format_line(item) + "\n").encode()
+
+    def read(self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None) -> Iterator[Line]:
+        return line_items(stream_lines(handle, name), name, warn)
+
+
+class Mcap(Format):
+    """MCAP (`mcap_format`): the lines as raw channels, with the decoded channels
+    viewers plot; needs the foxglove extra's mcap package."""
+
+    name, suffix = "MCAP", ".mcap"
+
+    def lines(self, layout: Layout) -> Lines:
+        return _mcap("writing MCAP").McapLines(layout)
+
+    def convert(
+        self, items: Iterator[Line], layout: Layout, drive: DriveType | None, counted: list[int]
+    ) -> Iterator[bytes]:
+        mcap = _mcap("writing MCAP")
+        lines = mcap.McapLines(layout, library="appmode convert")
+        reader = PortsReader(drive=drive, layout=layout)
+        yield lines.start()
+        time = 0.0
+        for item in items:
+            counted.append(item.lineno)
+            if isinstance(item, Entry):
+                time = item.time
+            yield lines.item(item, time)
+            if isinstance(item, Entry) and not mcap.is_pattern(item):
+                for direction, event in reader.feed(item.direction, item.data):
+                    yield lines.decoded(item.time, direction, event)
+        for direction, event in reader.flush():
+            yield lines.decoded(time, direction, event)
+        yield lines.finish()
+
+    def read(self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None) -> Iterator[Line]:
+        return _mcap(f"{name} is MCAP: reading it").read_items(handle, name, warn, whole)
+
+
+def _mcap(doing: str) -> object:
+    try:
+        from appmode.protocol import mcap_format
+    except ImportError:
+        raise AppmodeError(
+            f"{doing} needs the mcap package: pip install 'appmode[foxglove]'"
+        ) from None
+    return mcap_format
+
+
+TEXT, MCAP = Text(), Mcap()
+WRITERS: dict[str, Format] = {TEXT.suffix: TEXT, MCAP.suffix: MCAP}
+"""How a file is written, by its name's suffix (lower case)."""
+READERS: dict[bytes, Format] = {MCAP_MAGIC: MCAP}
+"""How a file is read, by its first bytes (else as a transcript)."""
+
+
+def written_as(name: str) -> Format:
+    """The format a file of this name is written in."""
+    suffix = name[name.rfind(".") :].lower() if "." in name.rsplit("/", 1)[-1] else ""
+    return WRITERS.get(suffix, TEXT)
+
+
+def read_as(first: bytes) -> Format:
+    """The format of a file that begins with `first` (MAGIC_SIZE bytes, or fewer)."""
+    return next((f for magic, f in READERS.items() if first.startswith(magic)), TEXT)
