@@ -73,9 +73,10 @@ def recordings_folder() -> Path:
     return data_folder() / "recordings"
 
 
-def new_recording() -> Path:
+def new_recording(suffix: str) -> Path:
     """A new file in `recordings_folder()` (made if need be, for the user alone), named
-    by the time: the page asks for a recording, never names a file."""
+    by the time, ending in `suffix` (its format's): the page asks for a recording,
+    never names a file."""
     folder = recordings_folder()
     try:
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
@@ -83,7 +84,7 @@ def new_recording() -> Path:
         raise AppmodeError(f"cannot make the folder {folder}: {exc.strerror}") from None
     stamp = time.strftime("%Y%m%d-%H%M%S")
     for n in range(1000):
-        path = folder / f"web-{stamp}{f'-{n}' if n else ''}.transcript"
+        path = folder / f"web-{stamp}{f'-{n}' if n else ''}{suffix}"
         try:
             os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _CLOEXEC, 0o600))
         except FileExistsError:

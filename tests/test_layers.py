@@ -222,3 +222,21 @@ def test_nothing_outside_ports_and_session_asks_which_port_is_driven() -> None:
         if not path.relative_to(PACKAGE).as_posix().startswith(CHOOSE_PORTS):
             found += port_questions(path)
     assert not found, "\n".join(found)
+
+
+def test_the_recording_formats_are_one_table_each_way() -> None:
+    """A file's name chooses how it is written and its first bytes how it is read in one
+    place (`protocol.formats.WRITERS`, `READERS`): no other module names a format's
+    suffix or magic."""
+    from appmode.protocol import formats
+
+    named = {*formats.WRITERS, *(m.decode("latin-1") for m in formats.READERS)}
+    found = []
+    for path in modules():
+        if path.name in ("formats.py", "transcript.py") and path.parent.name == "protocol":
+            continue  # the tables, and the text format's own grammar (its SUFFIX)
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Constant) and isinstance(node.value, (str, bytes)):
+                value = node.value if isinstance(node.value, str) else node.value.decode("latin-1")
+                found += [f"{name_of(path)}:{node.lineno}: {value!r}" for n in named if n == value]
+    assert not found, "\n".join(found)

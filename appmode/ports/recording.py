@@ -1,6 +1,7 @@
 """A recording written to a file the user names (`--record FILE`, a board's own): the
-file opened here, the transcript written by `protocol.recorder.Recorder` — as MCAP when
-the name ends in `.mcap` (the suffix chooses the format, as python-can's logger does)."""
+file opened here, the transcript written by `protocol.recorder.Recorder` in the format
+its name's suffix chooses (`protocol.formats.WRITERS`: MCAP for `.mcap`), as
+python-can's logger does."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ from functools import partial
 
 from appmode.errors import AppmodeError
 from appmode.files import is_fifo, open_fifo
+from appmode.protocol.formats import written_as
 from appmode.protocol.layouts import VELOCITY, Layout
-from appmode.protocol.recorder import Lines, Recorder
+from appmode.protocol.recorder import Recorder
 from appmode.writer import BoundedWriter
 
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)  # Windows has none
@@ -38,7 +40,8 @@ def open_recorder(
     nothing waits for it, and a flood is recorded whole). A `.mcap` file is MCAP, its
     decoded channels in `layout`'s terms (needs the `foxglove` extra's mcap)."""
     shown = os.fspath(path)
-    lines = _format(shown, layout)
+    form = written_as(shown)
+    lines = form.lines(layout)
     if is_fifo(path) and background:  # its open waits for a reader: in the writer
         opener = partial(open_fifo, path, "transcript", "the session goes on meanwhile")
         return Recorder(BoundedWriter(opener, shown), origin, directives, lines=lines)
@@ -52,7 +55,7 @@ def open_recorder(
         raise AppmodeError(f"cannot write transcript {shown}: {exc.strerror}") from None
     try:
         if not background:
-            out = os.fdopen(fd, "w", encoding="utf-8") if lines is None else os.fdopen(fd, "wb")
+            out = os.fdopen(fd, "wb") if form.binary else os.fdopen(fd, "w", encoding="utf-8")
             try:
                 return Recorder(out, origin, directives, shown, closes=True, lines=lines)
             except AppmodeError:  # not even the header fits
@@ -73,15 +76,3 @@ def open_recorder(
         raise
     return recorder
 
-
-def _format(path: str, layout: Layout) -> Lines | None:
-    """MCAP for a `.mcap` name, else None (a transcript)."""
-    if not path.lower().endswith(".mcap"):
-        return None
-    try:
-        from appmode.protocol.mcap_format import McapLines
-    except ImportError:
-        raise AppmodeError(
-            f"cannot write {path}: MCAP needs the mcap package: pip install 'appmode[foxglove]'"
-        ) from None
-    return McapLines(layout)

@@ -39,6 +39,8 @@ class Format:
 
     name = ""
     suffix = ""
+    binary = False
+    """Its files are bytes (else UTF-8 text)."""
 
     def lines(self, layout: Layout) -> Lines:
         """What a recorder writes: its start, each unit, its end."""
@@ -51,9 +53,12 @@ class Format:
         `counted` as it goes."""
         raise NotImplementedError
 
-    def read(self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None) -> Iterator[Line]:
+    def read(
+        self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None, partial: bool
+    ) -> Iterator[Line]:
         """The lines a file holds (`whole`: whether it ends as a file of its format
-        ends; None: not known, a pipe)."""
+        ends, None: not known, a pipe; `partial`: a file cut short gives what it holds,
+        and `warn` says so)."""
         raise NotImplementedError
 
 
@@ -79,7 +84,9 @@ class Text(Format):
             at += 1
             yield (format_line(item) + "\n").encode()
 
-    def read(self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None) -> Iterator[Line]:
+    def read(
+        self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None, partial: bool
+    ) -> Iterator[Line]:
         return line_items(stream_lines(handle, name), name, warn)
 
 
@@ -87,16 +94,23 @@ class Mcap(Format):
     """MCAP (`mcap_format`): the lines as raw channels, with the decoded channels
     viewers plot; needs the foxglove extra's mcap package."""
 
-    name, suffix = "MCAP", ".mcap"
+    name, suffix, binary = "MCAP", ".mcap", True
 
     def lines(self, layout: Layout) -> Lines:
-        return _mcap("writing MCAP").McapLines(layout)
+        try:
+            from appmode.protocol.mcap_format import McapLines
+        except ImportError:
+            raise _missing("writing MCAP") from None
+        return McapLines(layout)
 
     def convert(
         self, items: Iterator[Line], layout: Layout, drive: DriveType | None, counted: list[int]
     ) -> Iterator[bytes]:
-        mcap = _mcap("writing MCAP")
-        lines = mcap.McapLines(layout, library="appmode convert")
+        try:
+            from appmode.protocol.mcap_format import McapLines, is_pattern
+        except ImportError:
+            raise _missing("writing MCAP") from None
+        lines = McapLines(layout, library="appmode convert")
         reader = PortsReader(drive=drive, layout=layout)
         yield lines.start()
         time = 0.0
@@ -105,25 +119,26 @@ class Mcap(Format):
             if isinstance(item, Entry):
                 time = item.time
             yield lines.item(item, time)
-            if isinstance(item, Entry) and not mcap.is_pattern(item):
+            if isinstance(item, Entry) and not is_pattern(item):
                 for direction, event in reader.feed(item.direction, item.data):
                     yield lines.decoded(item.time, direction, event)
         for direction, event in reader.flush():
             yield lines.decoded(time, direction, event)
         yield lines.finish()
 
-    def read(self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None) -> Iterator[Line]:
-        return _mcap(f"{name} is MCAP: reading it").read_items(handle, name, warn, whole)
+    def read(
+        self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None, partial: bool
+    ) -> Iterator[Line]:
+        try:
+            from appmode.protocol.mcap_format import read_items
+        except ImportError:
+            raise _missing(f"{name} is MCAP: reading it") from None
+        return read_items(handle, name, warn, whole, partial)
 
 
-def _mcap(doing: str) -> object:
-    try:
-        from appmode.protocol import mcap_format
-    except ImportError:
-        raise AppmodeError(
-            f"{doing} needs the mcap package: pip install 'appmode[foxglove]'"
-        ) from None
-    return mcap_format
+def _missing(doing: str) -> AppmodeError:
+    """What to install to do what needs the mcap package."""
+    return AppmodeError(f"{doing} needs the mcap package: pip install 'appmode[foxglove]'")
 
 
 TEXT, MCAP = Text(), Mcap()
@@ -135,8 +150,8 @@ READERS: dict[bytes, Format] = {MCAP_MAGIC: MCAP}
 
 def written_as(name: str) -> Format:
     """The format a file of this name is written in."""
-    suffix = name[name.rfind(".") :].lower() if "." in name.rsplit("/", 1)[-1] else ""
-    return WRITERS.get(suffix, TEXT)
+    base = name.replace("\\", "/").rsplit("/", 1)[-1]
+    return WRITERS.get(base[base.rfind(".") :].lower() if "." in base else "", TEXT)
 
 
 def read_as(first: bytes) -> Format:

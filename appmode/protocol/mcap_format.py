@@ -42,7 +42,6 @@ from appmode.protocol.transcript import (
     uart2_payload,
 )
 
-SUFFIX = ".mcap"
 PROFILE = "appmode"
 """The MCAP header's profile: a file of appmode's (a transcript and its views)."""
 AS_TEXT = "/as_text"

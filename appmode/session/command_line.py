@@ -12,6 +12,7 @@ from appmode.errors import AppmodeError
 from appmode.files import new_recording, recordings_folder
 from appmode.host.app.tokens import parse_token
 from appmode.host.waits import Wait
+from appmode.protocol.formats import TEXT
 from appmode.protocol.twist import BadTwist, Twist
 from appmode.session.hold import TYPED_TWIST
 
@@ -80,7 +81,7 @@ def _record(session: BaseSession, args: list[str]) -> None:
             raise AppmodeError("usage: record FILE, or record stop")
         session.start_recording(args[0])
     elif args in ([], ["start"]):
-        session.start_recording(str(new_recording()))
+        session.start_recording(str(new_recording(TEXT.suffix)))
     else:
         raise AppmodeError(
             f"the page names no file: 'record' starts a recording in {recordings_folder()} "

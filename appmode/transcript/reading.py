@@ -1,6 +1,7 @@
 """Transcript files read from disk: whole (`read_transcript`) or a line at a time in
-constant memory (`iter_transcript`), as text (the grammar of `protocol.transcript`) or
-MCAP (`protocol.mcap_format`: told by its first bytes, whatever the file's name)."""
+constant memory (`iter_transcript`), in the format their first bytes tell, whatever
+the file's name (`protocol.formats.READERS`: text, the grammar of
+`protocol.transcript`, or MCAP)."""
 
 from __future__ import annotations
 
@@ -9,17 +10,14 @@ import os
 from collections.abc import Callable, Iterator
 
 from appmode.errors import AppmodeError
+from appmode.protocol.formats import MAGIC_SIZE, READERS, Format, read_as
 from appmode.protocol.transcript import (
     Comment,
     Directive,
     Entry,
     Line,
     Transcript,
-    line_items,
-    stream_lines,
 )
-
-MCAP_MAGIC = b"\x89MCAP0\r\n"
 
 
 def read_transcript(path: str | os.PathLike[str], name: str | None = None) -> Transcript:
@@ -75,32 +73,22 @@ def _items(
     directives_only: bool,
     partial: bool,
 ) -> Iterator[Line]:
-    if handle.peek(len(MCAP_MAGIC))[: len(MCAP_MAGIC)] == MCAP_MAGIC:
-        try:
-            from appmode.protocol.mcap_format import read_items
-        except ImportError:
-            raise AppmodeError(
-                f"{name} is MCAP: reading it needs the mcap package: "
-                "pip install 'appmode[foxglove]'"
-            ) from None
-        for item in read_items(handle, name, warn, _ends_as_mcap(handle), partial):
-            if not directives_only or isinstance(item, Directive):
-                yield item
-        return
-    lines = stream_lines(handle, name)
+    form = read_as(handle.peek(MAGIC_SIZE)[:MAGIC_SIZE])
+    items = form.read(handle, name, warn, _ends_whole(handle, form), partial)
     if directives_only:
-        lines = (line for line in lines if line[1].lstrip().startswith(b"@"))
-    yield from line_items(lines, name, warn)
+        return (item for item in items if isinstance(item, Directive))
+    return items
 
 
-def _ends_as_mcap(handle: io.BufferedReader) -> bool | None:
-    """Whether the file ends with MCAP's magic (None: a pipe, which cannot be looked at
-    ahead)."""
+def _ends_whole(handle: io.BufferedReader, form: Format) -> bool | None:
+    """Whether the file ends with its format's magic, as a whole one does (None: a pipe,
+    which cannot be looked at ahead)."""
+    magic = next((m for m, f in READERS.items() if f is form), b"")
     if not handle.seekable():
         return None
     start = handle.tell()
     size = handle.seek(0, os.SEEK_END)
-    handle.seek(max(0, size - len(MCAP_MAGIC)))
-    ends = handle.read(len(MCAP_MAGIC)) == MCAP_MAGIC and size >= 2 * len(MCAP_MAGIC)
+    handle.seek(max(0, size - len(magic)))
+    ends = handle.read(len(magic)) == magic and size >= 2 * len(magic)
     handle.seek(start)
     return ends

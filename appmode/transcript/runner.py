@@ -26,8 +26,9 @@ from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.target import Target, both_ports
 from appmode.ports.urls import open_link
 from appmode.protocol import app, app_decoders, param_values, params
+from appmode.protocol.formats import WRITERS
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
-from appmode.protocol.transcript import SUFFIX, Transcript
+from appmode.protocol.transcript import Transcript
 from appmode.text import escaped, wrapped
 from appmode.transcript.matcher import Check
 from appmode.transcript.reading import read_transcript
@@ -203,13 +204,13 @@ def collect(paths: list[str]) -> list[Path]:
     for name in paths:
         path = Path(name)
         if path.is_dir():
-            found += sorted(p for p in path.rglob("*") if p.suffix in (SUFFIX, ".mcap"))
+            found += sorted(p for p in path.rglob("*") if p.suffix.lower() in WRITERS)
         elif path.exists():
             found.append(path)
         else:
             raise AppmodeError(f"no such transcript or directory: {name}")
     if not found:
-        raise AppmodeError(f"no {SUFFIX} or .mcap files in {', '.join(paths)}")
+        raise AppmodeError(f"no {' or '.join(WRITERS)} files in {', '.join(paths)}")
     return found
 
 
