@@ -113,11 +113,20 @@ def _row(car: Car) -> tuple[str, ...]:
         escaped(car.name),
         escaped(str(info.get("profile", "?"))),
         "—" if battery is None else escaped(f"{battery} %"),
-        escaped(str(info["in_force"])) if info.get("in_force") else "stopped",
+        _motion(info),
         escaped(str(driver.get("machine"))) if isinstance(driver, dict) else "—",
         f"{car.latency_ms:.1f} ms",
         escaped(str(info.get("machine", "?"))),
     )
+
+
+def _motion(info: dict[str, Any]) -> str:
+    """What the car does: what it was told, else what its records show."""
+    if info.get("in_force"):
+        return escaped(str(info["in_force"]))
+    if info.get("records_moving") is True:
+        return "MOVING (its records)"
+    return "stopped" if info.get("records_moving") is False else "stopped (not confirmed)"
 
 
 def _stop(session: Any, as_json: bool) -> int:

@@ -36,6 +36,8 @@ TICK = 0.02
 """Seconds between the share's looks at the car and at the lease."""
 INFO_EVERY = 1.0
 """Seconds between two `info` samples published while nothing changes."""
+FRESH = 1.0
+"""Seconds an A record tells whether the car moves."""
 STAMP = struct.Struct("<d")
 """A byte sample's attachment: the car's time of it (seconds, its host's clock), then
 its direction (`>`, `<`, `2>`, `2<`)."""
@@ -78,12 +80,17 @@ class Share:
         """The ports clients have written to: the ones a stop is for (a zero frame on an
         unused control port would take the motion over from the APP port, §8.3)."""
         self._velocity: app.Velocity | None = None
+        self._velocity_at = 0.0
+        self._events: Any = None
+        """The events' publisher, once declared (after the stop at the start)."""
         self._battery: int | None = None
+
         self._closed = threading.Event()
         for port, host in open_hosts(choice, self._tap).items():
             host.stop_on_close = not self.ports  # the first port's, until another is used
             self.ports[port] = Port(port, host)
         try:
+            self._stop_at_start()
             self._declare()
         except BaseException:
             self.close()
@@ -273,7 +280,7 @@ class Share:
         self._event("dropped", client=driver.client, why=why)
 
     def _event(self, kind: str, **fields: object) -> None:
-        if not self._closed.is_set():
+        if self._events is not None and not self._closed.is_set():
             self._events.put(json.dumps({"t": kind, "at": round(self.now(), 3), **fields}))
 
     def info(self) -> dict[str, object]:
@@ -291,7 +298,8 @@ class Share:
             "driver": None if driver is None else _driver(driver),
             "battery": self._battery,
             "in_force": next(filter(None, motions), None),
-            "moving": any(motions),
+            "moving": any(motions) or self._records_moving() is True,
+            "records_moving": self._records_moving(),
             "params": self._params(),
             "time": round(self.now(), 3),
         }
@@ -327,13 +335,61 @@ class Share:
                 next_info = time.monotonic() + INFO_EVERY
                 self._event("info", **self.info())
 
+    def _stop_at_start(self) -> None:
+        """A share that starts, or restarts (the car its last host left moving), stops the
+        car before any client can reach it — `Z` on the APP port, which takes nothing
+        over — and judges the stop on the car's A records; where they still show it
+        moving after SETTLE s, a frame took the motion over before this share began
+        (§8.3): the control port's zero frame, judged again. Says what they showed."""
+        self._stop_car("the car's host started: the car stops first")
+        state = self._telemetry()
+        if state is None:
+            self.log("the car's stop at the start: no records here to confirm it")
+            return
+        at_rest = self._at_rest(state)
+        others = [name for name in self.ports if name != "app"]
+        if at_rest is False and others:
+            self._used.update(others)
+            self._stop_car("the car's records show it moving: the control port drives it")
+            at_rest = self._at_rest(state)
+        self.log(
+            "the car's stop at the start: "
+            + {
+                True: "confirmed on its records (at rest)",
+                False: "its records show it MOVING: stop it by hand",
+                None: "no record came to confirm it",
+            }[at_rest]
+        )
+
+    def _at_rest(self, state: HostState) -> bool | None:
+        """Read the car's ports for up to SETTLE s: True at the first A record at rest,
+        False when the last showed it moving, None when none came."""
+        end, moving = time.monotonic() + SETTLE, None
+        while time.monotonic() < end:
+            for port in self.ports.values():
+                for event in port.host.poll(TICK / len(self.ports)):
+                    if isinstance(event, app.Velocity):
+                        self._velocity, self._velocity_at = event, self.now()
+                        moving = state.layout.speed(app.record_fields(event)[1]) > STILL
+                        if not moving:
+                            return True
+        return None if moving is None else False
+
+    def _records_moving(self) -> bool | None:
+        """Whether the car's last A record (of the last second) shows it moving; None:
+        none came."""
+        state, velocity = self._telemetry(), self._velocity
+        if state is None or velocity is None or self.now() - self._velocity_at > FRESH:
+            return None
+        return state.layout.speed(app.record_fields(velocity)[1]) > STILL
+
     def _seen(self, port: Port, event: object) -> None:
         if isinstance(event, LinkStatus):
             self.log(f"{port.name}: {event.text}")
             self._event("link", port=port.name, up=event.up, text=event.text)
             return
         if isinstance(event, app.Velocity):
-            self._velocity = event
+            self._velocity, self._velocity_at = event, self.now()
         if isinstance(event, app.Attitude):
             self._battery = event.battery
         state = port.host.telemetry

@@ -205,3 +205,31 @@ def test_the_share_killed_leaves_the_car_moving_and_the_driver_says_so(shared: S
     assert "the final stop was not delivered: the car may still be moving" in err
     assert proc.returncode == 1
     assert shared.sent()[-1] == "A", "the board's own recording: still driving"
+
+
+def test_a_restarted_share_stops_the_car_its_last_host_left_moving(shared: SharedCar) -> None:
+    """Issue 80.1: the share and its driver killed while driving (the car keeps moving),
+    the share restarted as a service manager restarts it: it stops the car first, and
+    `fleet` says what the car's records say."""
+    proc = driving(shared)
+    time.sleep(0.3)
+    shared.share.kill()
+    shared.share.communicate(timeout=10)
+    proc.kill()
+    proc.communicate(timeout=10)
+    time.sleep(0.5)
+    assert shared.sent()[-1] == "A", "the board's own recording: still driving"
+    restarted = time.monotonic()
+    shared.share, _ = start_share(shared.machines["car"], shared.board)
+    stopped = shared.board_time(after="A")
+    assert stopped - restarted < 5.0
+    time.sleep(2.5)  # the stop judged on the records (1.5 s after it)
+    fleet = shared.laptop.run("fleet", "--key", KEY, "--json")
+    cars = json.loads(fleet.stdout)
+    assert [car["name"] for car in cars] == ["car"], fleet.stderr
+    assert cars[0]["moving"] is False and cars[0]["records_moving"] is False, cars
+    last_a = [line for line in shared.record.read_text().splitlines() if " < {A" in line][-1]
+    assert "{A0:0:0:" in last_a, last_a
+    shared.share.terminate()
+    _, err = shared.share.communicate(timeout=10)
+    assert "the car's stop at the start: confirmed on its records (at rest)" in err, err

@@ -15,6 +15,10 @@ from appmode.ports.choice import choose
 from appmode.ports.target import parse_target
 
 
+def _log(text: str) -> None:
+    print(text, file=sys.stderr)
+
+
 def main(count: int, listen: str, key: str) -> None:
     session = open_session("peer", key, listen=(listen,), scout=True)
     ended = threading.Event()
@@ -23,7 +27,7 @@ def main(count: int, listen: str, key: str) -> None:
     try:
         for n in range(1, count + 1):
             choice = choose(parse_target("sim://"), both=True)
-            shares.append(Share(session, f"car-{n:02}", choice, print))
+            shares.append(Share(session, f"car-{n:02}", choice, _log))
         runs = [threading.Thread(target=s.run, args=(ended.is_set,), daemon=True) for s in shares]
         for run in runs:
             run.start()
