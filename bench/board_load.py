@@ -17,6 +17,7 @@ import tempfile
 import threading
 import time
 import tty
+from collections.abc import Callable
 from pathlib import Path
 
 import serial
@@ -190,10 +191,10 @@ def bench_key_latency(keys: int) -> list[Row]:
     session = AppSession(choose(parse_target("sim://?pace=0")), HoldToDrive(latched=True))
     real_send = session.host.send
 
-    def send(data: bytes) -> None:
+    def send(data: bytes, still: Callable[[], bool] | None = None) -> None:
         if data in (b"A", b"Z"):
             sent.append(time.perf_counter())
-        real_send(data)
+        real_send(data, still)
 
     session.host.send = send  # type: ignore[method-assign]
     with create_pipe_input() as pipe:

@@ -71,6 +71,11 @@ class Refused(AppmodeError):
     nothing was sent; the link stays up."""
 
 
+class Cut(AppmodeError):
+    """A stop came while the bytes were going out: the rest was not sent (`send`'s
+    `still`)."""
+
+
 UNHEARD = 256
 """Writes held for the reads to catch up with them at most; past that a host that never
 reads has them told at once (memory stays bounded; its recording's order is the writes')."""
@@ -99,6 +104,8 @@ class Link(Generic[E]):
         self._opener = opener
         self._port: serial.SerialBase | None = opener(self.target)
         self._writing = threading.RLock()  # the stop guard may write from its thread
+        self._stop_wanted = threading.Event()
+        """A stop waits to be written: a write's pacing gives way at once."""
         self._tapping = threading.Lock()
         self._unheard: list[tuple[float, bytes]] = []  # sends told once reads catch up
         # after opening: an in-process sim:// board booted just now, and its clock is ours
@@ -198,20 +205,23 @@ class Link(Generic[E]):
             self._stop_after_outage()
             self._pending.append(LinkStatus(True, f"link to {self.url} is back"))
 
-    def _write(self, data: bytes) -> None:
+    def _write(self, data: bytes, still: Callable[[], bool] | None = None) -> None:
         """Write bytes to the board, CHUNK at a time, each tapped and followed (`_sent`)
-        as it leaves; LinkLost if the link is down. An ending signal waits for the chunk
-        under way: what the session end knows is what really left."""
+        as it leaves; LinkLost if the link is down; Cut when `still()` turns false
+        before a chunk (a stop came: it goes out next). An ending signal waits for the
+        chunk under way: what the session end knows is what really left."""
         with self._writing:
             if self._port is None:
                 self._reconnect()
             if self._port is None:
                 raise LinkLost(f"link to {self.url} is down; not sent: {data!r}")
             for start in range(0, len(data), CHUNK):
+                self._pace(min(CHUNK, len(data) - start))
+                if still is not None and not still():
+                    raise Cut(f"not all sent to {self.url}: a stop came ({start} bytes sent)")
                 self._write_chunk(data[start : start + CHUNK])
 
     def _write_chunk(self, chunk: bytes) -> None:
-        self._pace(len(chunk))
         with signals.atomic():
             port = self._port
             if port is None:  # lost at the last chunk
@@ -291,7 +301,7 @@ class Link(Generic[E]):
             self._ahead = Ahead(baud if isinstance(baud, int) else None, CHUNK)
         wait = self._ahead.delay(self.now())
         if wait:
-            time.sleep(wait)
+            self._stop_wanted.wait(wait)  # a stop waiting cuts the wait short
         self._ahead.wrote(size, self.now())
 
     def _sent(self, data: bytes) -> None:
@@ -360,9 +370,11 @@ class Link(Generic[E]):
         events, self._pending = self._pending, []
         return events
 
-    def send(self, data: bytes) -> None:
-        """Write bytes to the board; LinkLost if the link is down."""
-        self._write(data)
+    def send(self, data: bytes, still: Callable[[], bool] | None = None) -> None:
+        """Write bytes to the board; LinkLost if the link is down. With `still`, a stop
+        pre-empts them: checked before each chunk, it turns false when one is sent
+        (Cut: the rest is not)."""
+        self._write(data, still)
 
     def _stop(self) -> bytes:
         """The bytes that leave the car stopped, sent last when the session closes."""
@@ -371,9 +383,12 @@ class Link(Generic[E]):
     def send_stop(self) -> bytes | None:
         """Send the port's stop now, as `close` ends with it (what was sent decides
         it): the bytes sent, or None when the link is down."""
+        self._stop_wanted.set()  # a write under way gives way after its chunk
         try:
-            stop = self._stop()
-            self.send(stop)
+            with self._writing:
+                self._stop_wanted.clear()
+                stop = self._stop()  # what was sent decides it: after that write
+                self.send(stop)
         except (LinkLost, Refused):
             return None
         return stop

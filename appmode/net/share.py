@@ -21,7 +21,7 @@ from appmode.host.app.state import STILL, HostState
 from appmode.host.app.stop_check import SETTLE
 from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
-from appmode.host.link import LinkLost
+from appmode.host.link import CHUNK, Cut, LinkLost
 from appmode.net.lease import Driver, Granted, Lease, Refused
 from appmode.net.names import Keys
 from appmode.protocol import app
@@ -81,6 +81,8 @@ class Share:
         unused control port would take the motion over from the APP port, §8.3)."""
         self._velocity: app.Velocity | None = None
         self._velocity_at = 0.0
+        self._stops = 0
+        """Stops sent so far: a write lets its rest go only while none came since it began."""
         self._events: Any = None
         """The events' publisher, once declared (after the stop at the start)."""
         self._battery: int | None = None
@@ -139,6 +141,13 @@ class Share:
         def on_write(query: zenoh.Query) -> None:
             client = _text(query.attachment)
             data = b"" if query.payload is None else query.payload.to_bytes()
+            if len(data) > CHUNK:  # a client's link writes a chunk at a time
+                query.reply_err(
+                    json.dumps(
+                        {"refused": f"a write of {len(data)} bytes: at most {CHUNK} at a time"}
+                    )
+                )
+                return
             with self._lock:
                 refused = self._may_drive(client, take=False)
                 if refused is not None:
@@ -148,16 +157,20 @@ class Share:
                 self._used.add(port)
                 host.stop_on_close = True
                 self._written[port] = None
-                try:
-                    host.send(data)
-                except LinkLost as exc:
-                    why = f"the car's {port} link is down at its host ({exc})"
-                    query.reply_err(json.dumps({"down": why}))
-                    return
-                except AppmodeError:
-                    pass  # written: only the share's own recording failed
-                written = self._written.get(port)
-                reply = {"at": self.now() if written is None else written, "driving": True}
+                stops = self._stops
+            try:  # outside the lock: a stop pre-empts it, and none is sent after one
+                host.send(data, still=lambda: self._stops == stops)
+            except Cut as exc:
+                query.reply_err(json.dumps({"refused": f"the car's host stopped the car: {exc}"}))
+                return
+            except LinkLost as exc:
+                why = f"the car's {port} link is down at its host ({exc})"
+                query.reply_err(json.dumps({"down": why}))
+                return
+            except AppmodeError:
+                pass  # written: only the share's own recording failed
+            written = self._written.get(port)
+            reply = {"at": self.now() if written is None else written, "driving": True}
             query.reply(query.key_expr, json.dumps(reply))
 
         return on_write
@@ -241,6 +254,7 @@ class Share:
     def _stop_car(self, why: str) -> bool:
         """Send the stop of every port a client used (the APP port's when none was):
         whether each went out (a port whose link is down cannot be stopped: said)."""
+        self._stops += 1  # a write under way gives way, and none begun before goes out
         ports = [port for name, port in self.ports.items() if name in self._stopping()]
         sent = all(port.host.send_stop() is not None for port in ports)
         text = f"stopped: {why}" if sent else f"{why}: the stop was NOT delivered (link down)"
@@ -401,6 +415,7 @@ class Share:
         """Stop sharing: the car's stop last on every port (its hosts close), then the
         Zenoh declarations."""
         self._closed.set()
+        self._stops += 1
         stopping = self._stopping()
         for name, port in self.ports.items():
             port.host.stop_on_close = name in stopping

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -17,7 +18,7 @@ import pytest
 
 from appmode.testing.process import BoardProcess
 from tests.support.netns import Machine, lan, why_not
-from tests.support.processes import sent_lines, timed_sent, wait_for
+from tests.support.processes import ROOT, sent_lines, timed_sent, wait_for
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
 WHY = why_not()
@@ -233,3 +234,49 @@ def test_a_restarted_share_stops_the_car_its_last_host_left_moving(shared: Share
     shared.share.terminate()
     _, err = shared.share.communicate(timeout=10)
     assert "the car's stop at the start: confirmed on its records (at rest)" in err, err
+
+
+def _raw_writes(car: SharedCar, size: int, count: int) -> subprocess.Popen[str]:
+    """A key holder's raw writes from the laptop (tests/support/raw_writer.py)."""
+    endpoint = f"tcp/{car.machines['car'].address}:7450"
+    return subprocess.Popen(
+        car.laptop.command(
+            sys.executable,
+            "-m",
+            "tests.support.raw_writer",
+            endpoint,
+            KEY,
+            "car",
+            str(size),
+            str(count),
+        ),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+
+
+def test_no_write_holds_the_stop_up(shared: SharedCar) -> None:
+    """Issue 80.3: a 3,000-byte write held the share's lock while it went out at 9600
+    bps, and a fleet stop reached the board 2.6–3.0 s later. A write is at most a chunk,
+    and a stop pre-empts the writes under way: the board takes Z within 0.3 s of
+    `fleet stop`, and no `A` after it."""
+    big = _raw_writes(shared, 3000, 1)
+    out, err = big.communicate(timeout=30)
+    assert out.strip().startswith("error") and "at most 64 at a time" in out, out + err
+    writer = _raw_writes(shared, 64, 60)  # 4 s of letters at 9600 bps
+    assert writer.stdout is not None
+    assert writer.stdout.readline().strip() == "ok"
+    wait_for(lambda: "A" in shared.sent(), 10)
+    time.sleep(0.5)
+    asked = time.monotonic()
+    stopped = shared.laptop.run("fleet", "stop", "--key", KEY)
+    assert stopped.returncode == 0, stopped.stdout + stopped.stderr
+    rest, _ = writer.communicate(timeout=30)
+    z_at = shared.board_time(after="A")
+    assert z_at - asked < 0.3, f"Z reached the board {z_at - asked:.2f} s after fleet stop"
+    timed = timed_sent(shared.record)
+    last_z = max(i for i, (_, unit) in enumerate(timed) if unit == "Z")
+    assert "A" not in [unit for _, unit in timed[last_z:]], "a letter after the stop"
+    assert "error" in rest, "the writes after the stop were refused"

@@ -1,0 +1,45 @@
+"""A key holder's raw writes to a shared car, as no appmode client sends them: `python -m
+tests.support.raw_writer ENDPOINT KEY NAME SIZE COUNT` sends COUNT writes of SIZE bytes
+of `A` to the car's APP port one after another, with the heartbeats that keep its
+lease, and prints each answer as a line (`ok`, or the error) as it comes, until the
+first error."""
+
+from __future__ import annotations
+
+import sys
+import threading
+
+from appmode.net.config import close_session, open_session
+from appmode.net.names import Keys
+
+CLIENT = "raw-writer-1-abc"
+
+
+def main(endpoint: str, key: str, name: str, size: int, count: int) -> None:
+    session = open_session("client", key, connect=(endpoint,))
+    keys = Keys(name)
+    done = threading.Event()
+
+    def beat() -> None:
+        while not done.wait(0.1):
+            session.put(keys.alive, CLIENT)
+
+    threading.Thread(target=beat, daemon=True).start()
+    try:
+        for _ in range(count):
+            replies = list(session.get(keys.write("app"), payload=b"A" * size, attachment=CLIENT))
+            reply = replies[0] if replies else None
+            if reply is None:
+                print("no answer", flush=True)
+            elif reply.ok is not None:
+                print("ok", flush=True)
+            else:
+                print(f"error {reply.err.payload.to_string()}", flush=True)
+                return  # as a client does once its write is refused
+    finally:
+        done.set()
+        close_session(session)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]))
