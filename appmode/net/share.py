@@ -355,13 +355,14 @@ class Share:
         over — and judges the stop on the car's A records; where they still show it
         moving after SETTLE s, a frame took the motion over before this share began
         (§8.3): the control port's zero frame, judged again. Says what they showed."""
+        first = self._stopping()  # the APP port, which a stop takes nothing over on
         self._stop_car("the car's host started: the car stops first")
         state = self._telemetry()
         if state is None:
             self.log("the car's stop at the start: no records here to confirm it")
             return
         at_rest = self._at_rest(state)
-        others = [name for name in self.ports if name != "app"]
+        others = [name for name in self.ports if name not in first]
         if at_rest is False and others:
             self._used.update(others)
             self._stop_car("the car's records show it moving: the control port drives it")
