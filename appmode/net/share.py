@@ -251,14 +251,15 @@ class Share:
 
     # ------------------------------------------------------------ the stop authority
 
-    def _stop_car(self, why: str) -> bool:
+    def _stop_car(self, why: str, say: bool = True) -> bool:
         """Send the stop of every port a client used (the APP port's when none was):
         whether each went out (a port whose link is down cannot be stopped: said)."""
         self._stops += 1  # a write under way gives way, and none begun before goes out
         ports = [port for name, port in self.ports.items() if name in self._stopping()]
         sent = all(port.host.send_stop() is not None for port in ports)
         text = f"stopped: {why}" if sent else f"{why}: the stop was NOT delivered (link down)"
-        self.log(text)
+        if say or not sent:
+            self.log(text)
         self._event("stopped" if sent else "unstopped", text=text)
         return sent
 
@@ -356,10 +357,11 @@ class Share:
         moving after SETTLE s, a frame took the motion over before this share began
         (§8.3): the control port's zero frame, judged again. Says what they showed."""
         first = self._stopping()  # the APP port, which a stop takes nothing over on
-        self._stop_car("the car's host started: the car stops first")
+        if not self._stop_car("the car's host started: the car stops first", say=False):
+            return
         state = self._telemetry()
         if state is None:
-            self.log("the car's stop at the start: no records here to confirm it")
+            self.log("the car stopped first (its host started): no records here confirm it")
             return
         at_rest = self._at_rest(state)
         others = [name for name in self.ports if name not in first]
@@ -368,7 +370,7 @@ class Share:
             self._stop_car("the car's records show it moving: the control port drives it")
             at_rest = self._at_rest(state)
         self.log(
-            "the car's stop at the start: "
+            "the car stopped first (its host started): "
             + {
                 True: "confirmed on its records (at rest)",
                 False: "its records show it MOVING: stop it by hand",

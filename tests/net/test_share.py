@@ -233,7 +233,7 @@ def test_a_restarted_share_stops_the_car_its_last_host_left_moving(shared: Share
     assert "{A0:0:0:" in last_a, last_a
     shared.share.terminate()
     _, err = shared.share.communicate(timeout=10)
-    assert "the car's stop at the start: confirmed on its records (at rest)" in err, err
+    assert "the car stopped first (its host started): confirmed on its records" in err, err
 
 
 def _raw_writes(car: SharedCar, size: int, count: int) -> subprocess.Popen[str]:
