@@ -11,11 +11,11 @@ from dataclasses import dataclass
 STILL = 0.005
 """m/s, and rad/s, below which a velocity asks for no motion."""
 LIMIT = 100.0
-"""m/s, and rad/s, past which a velocity is no car's: a request beyond it is clamped."""
+"""m/s, and rad/s, past which a velocity is no car's: a request beyond it is refused."""
 
 
 class BadTwist(ValueError):
-    """A twist that is no number (NaN, infinite)."""
+    """A twist that is no number (NaN, infinite), or no car's (past LIMIT)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -29,12 +29,18 @@ class Twist:
 
     @classmethod
     def checked(cls, forward: float, left: float, turn: float) -> Twist:
-        """A velocity from outside (a cmd_vel, a script): every part a finite number,
-        each clamped to ±LIMIT; raises BadTwist otherwise."""
+        """A velocity from outside (a cmd_vel, a script): every part a finite number
+        within ±LIMIT; raises BadTwist otherwise (what a port cannot drive of it, each
+        port clamps as it translates it)."""
         parts = (forward, left, turn)
         if not all(math.isfinite(part) for part in parts):
             raise BadTwist(f"a twist of {forward}, {left}, {turn}: each part must be a number")
-        return cls(*(max(-LIMIT, min(LIMIT, part)) for part in parts))
+        if max(map(abs, parts)) > LIMIT:
+            raise BadTwist(
+                f"a twist of {forward:g}, {left:g}, {turn:g}: over {LIMIT:g} m/s or rad/s, "
+                "no car's"
+            )
+        return cls(*parts)
 
     @classmethod
     def from_units(cls, x: float, y: float, z: float, si: tuple[float, float]) -> Twist:

@@ -235,3 +235,29 @@ def _stopped(car: Car) -> bool:
     """The last thing the board took stops it: Z on the APP port, or the zero frame."""
     last = max([*car.board_timed(), *car.frames()], default=(0.0, ""), key=lambda u: u[0])[1]
     return last in ("Z", ZERO)
+
+
+@pytest.mark.parametrize(
+    "car", [(False,), (True,)], ids=["app-port", "control-port"], indirect=True
+)
+def test_out_of_range_cmd_vel_is_refused_or_clamped_and_the_node_keeps_running(car: Car) -> None:
+    """Issue 80.10: linear.x = 1e307 ended the node (OverflowError), 70 m/s on the APP
+    port exited 2. A twist past 100 m/s is no car's: refused, said once; 70 m/s is
+    driven at what the port can; the node runs on and drives the next cmd_vel."""
+    cmd_vel = next(e for e in car.entities(7) if e.topic == "/cmd_vel")
+    twist = peer.TwistPublisher(car.ros, cmd_vel)
+    for forward in (1e307, -1e307, 70.0, 70.0):
+        twist.publish(forward)
+        time.sleep(0.1)
+    end = time.monotonic() + 1.5
+    while time.monotonic() < end:
+        twist.publish(0.2)
+        time.sleep(0.05)
+    assert car.node.poll() is None, "the node ended"  # type: ignore[attr-defined]
+    err = stop_process(car.node)  # type: ignore[arg-type]
+    assert "no car's" in err and "Traceback" not in err and "internal error" not in err, err
+    if car.frames():
+        frames = [f for _, f in car.frames()]
+        assert "FF FE 01 00 00 00 C8 00 00 00" in frames, frames[-5:]  # y = 200: 0.2 m/s
+    else:
+        assert "{0:200}" in car.board_sent(), car.board_sent()[-8:]
