@@ -23,9 +23,10 @@ from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
 from appmode.host.link import CHUNK, Cut, LinkLost
 from appmode.net.lease import Driver, Granted, Lease, Refused
-from appmode.net.names import Keys
+from appmode.net.names import ANY_STOP, Keys
 from appmode.protocol import app
 from appmode.protocol.render import to_json
+from appmode.text import escaped, shortened
 
 if TYPE_CHECKING:
     import zenoh
@@ -38,6 +39,9 @@ INFO_EVERY = 1.0
 """Seconds between two `info` samples published while nothing changes."""
 FRESH = 1.0
 """Seconds an A record tells whether the car moves."""
+MAX_CLIENT = 128
+"""Characters of a client's name at most (appmode's: its machine, process and a token)."""
+NOT_ASKED = "not a query of this car's (its own key, a client's printable name, JSON)"
 STAMP = struct.Struct("<d")
 """A byte sample's attachment: the car's time of it (seconds, its host's clock), then
 its direction (`>`, `<`, `2>`, `2<`)."""
@@ -139,7 +143,10 @@ class Share:
 
     def _writer(self, port: str) -> Callable[[zenoh.Query], None]:
         def on_write(query: zenoh.Query) -> None:
-            client = _text(query.attachment)
+            client = _client(query, self.keys.write(port))
+            if client is None:
+                query.reply_err(json.dumps({"refused": NOT_ASKED}))
+                return
             data = b"" if query.payload is None else query.payload.to_bytes()
             if len(data) > CHUNK:  # a client's link writes a chunk at a time
                 query.reply_err(
@@ -195,8 +202,11 @@ class Share:
         return None
 
     def _on_lease(self, query: zenoh.Query) -> None:
-        client = _text(query.attachment)
+        client = _client(query, self.keys.lease)
         asked = _json(query)
+        if client is None or asked is None:
+            query.reply_err(NOT_ASKED)
+            return
         with self._lock:
             if asked.get("let_go"):
                 driver = self.lease.let_go(client)
@@ -211,8 +221,10 @@ class Share:
             query.reply(query.key_expr, json.dumps({"granted": True}))
 
     def _on_alive(self, sample: zenoh.Sample) -> None:
-        with self._lock:
-            self.lease.beat(sample.payload.to_string(), self.now())
+        client = _text(sample.payload)
+        if client:
+            with self._lock:
+                self.lease.beat(client, self.now())
 
     def _on_driver(self, sample: zenoh.Sample) -> None:
         """A client's Zenoh session ended (its liveliness token went): if it drove, the
@@ -233,7 +245,10 @@ class Share:
     def _on_stop(self, query: zenoh.Query) -> None:
         """`fleet stop`: stop the car and say whether it took (on its A records, when
         they come), in a thread of its own: a confirmation takes up to SETTLE s."""
-        who = _text(query.attachment) or "a client"
+        if str(query.key_expr) not in (self.keys.stop, ANY_STOP):
+            query.reply_err(NOT_ASKED)  # `get appmode/**` is no fleet stop
+            return
+        who = shortened(escaped(_text(query.attachment) or "")) or "a client"
 
         def stop() -> None:
             with self._lock:
@@ -431,13 +446,31 @@ def _driver(driver: Driver) -> dict[str, object]:
     return {"machine": driver.machine, "client": driver.client, "since": round(driver.since, 1)}
 
 
-def _text(data: zenoh.ZBytes | None) -> str:
-    return "" if data is None else data.to_string()
-
-
-def _json(query: zenoh.Query) -> dict[str, Any]:
+def _text(data: zenoh.ZBytes | None) -> str | None:
+    """The bytes as text; None when they are not UTF-8."""
     try:
-        found = json.loads(_text(query.payload))
+        return "" if data is None else data.to_string()
     except ValueError:
-        return {}
-    return found if isinstance(found, dict) else {}
+        return None
+
+
+def _client(query: zenoh.Query, key: str) -> str | None:
+    """Who asks, when the query is for `key` itself (a wildcard, `get appmode/**`, is
+    nobody's write or lease) and names a client as appmode's do: printable text of at
+    most MAX_CLIENT characters; else None."""
+    client = _text(query.attachment)
+    if str(query.key_expr) != key or not client or len(client) > MAX_CLIENT:
+        return None
+    return client if client.isprintable() else None
+
+
+def _json(query: zenoh.Query) -> dict[str, Any] | None:
+    """The query's JSON object ({} for none); None when it is something else."""
+    text = _text(query.payload)
+    if not text:
+        return None if text is None else {}
+    try:
+        found = json.loads(text)
+    except ValueError:
+        return None
+    return found if isinstance(found, dict) else None

@@ -280,3 +280,31 @@ def test_no_write_holds_the_stop_up(shared: SharedCar) -> None:
     last_z = max(i for i, (_, unit) in enumerate(timed) if unit == "Z")
     assert "A" not in [unit for _, unit in timed[last_z:]], "a letter after the stop"
     assert "error" in rest, "the writes after the stop were refused"
+
+
+def test_malformed_and_wildcard_queries_reach_no_handler_that_acts(shared: SharedCar) -> None:
+    """Issue 80.11: non-UTF-8 attachments printed tracebacks on the share's console, a
+    plain `get appmode/**` reached the write, lease and stop handlers, and unparsable
+    JSON was granted a lease. Each is refused; the board gets nothing; nobody drives."""
+    endpoint = f"tcp/{shared.machines['car'].address}:7450"
+    done = subprocess.run(
+        shared.laptop.command(
+            sys.executable, "-m", "tests.support.malformed", endpoint, KEY, "car"
+        ),
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    answers = dict(line.split(" ", 1) for line in done.stdout.splitlines())
+    assert answers["write"] == "error" and answers["lease"] == "error", answers
+    oks = [word for word in answers["wildcard"].split() if word.startswith("ok:")]
+    assert answers["json"] == "error" and oks == ["ok:appmode/car/info"], answers
+    fleet = json.loads(shared.laptop.run("fleet", "--key", KEY, "--json").stdout)
+    assert fleet[0]["driver"] is None, fleet
+    assert shared.sent()[-1] != "A" and "A" not in shared.sent(), shared.sent()
+    shared.share.terminate()
+    _, err = shared.share.communicate(timeout=10)
+    assert "Traceback" not in err and "fleet stop" not in err, err
