@@ -42,6 +42,8 @@ SIM_USAGE = (
 
 NO_OPTIONS: Mapping[str, str] = MappingProxyType({})
 HIDDEN = "…"
+KEY_IN_URL = re.compile(r"([?&]key=)[^&#]*")
+"""A shared car's key in a URL's text (hidden in every message that quotes it)."""
 """What a URL shows of a shared car's key: messages, pages and recordings never hold it."""
 
 
@@ -208,7 +210,13 @@ def parse_target(url: str) -> Target:
         parts = urlsplit(url)
     except ValueError as exc:  # an unclosed [ in a module's address
         raise AppmodeError(f"{url!r} is not a URL ({exc}): {URL_HELP}") from None
-    options = _frozen(dict(parse_qsl(parts.query, keep_blank_values=True)))
+    pairs = parse_qsl(parts.query, keep_blank_values=True)
+    options = _frozen(dict(pairs))
+    if scheme == "zenoh":
+        url = KEY_IN_URL.sub(rf"\1{HIDDEN}", url)  # messages quote it with the key hidden
+        twice = sorted({name for name, _ in pairs if [n for n, _ in pairs].count(name) > 1})
+        if twice:
+            raise AppmodeError(f"{twice[0]}= twice in {url!r}: give each option once")
     if scheme == "sim":
         _check_sim(url, parts.netloc, parts.path, options)
     address = unquote(parts.netloc) + (parts.path if scheme in NETWORK_SCHEMES else "")
