@@ -22,6 +22,7 @@ from appmode.host.app.stop_check import SETTLE
 from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
 from appmode.host.link import CHUNK, Cut, LinkLost
+from appmode.net.asked import NOT_ASKED, asked_by, json_of, text_of
 from appmode.net.lease import Driver, Granted, Lease, Refused
 from appmode.net.names import ANY_STOP, Keys
 from appmode.protocol import app
@@ -39,9 +40,6 @@ INFO_EVERY = 1.0
 """Seconds between two `info` samples published while nothing changes."""
 FRESH = 1.0
 """Seconds an A record tells whether the car moves."""
-MAX_CLIENT = 128
-"""Characters of a client's name at most (appmode's: its machine, process and a token)."""
-NOT_ASKED = "not a query of this car's (its own key, a client's printable name, JSON)"
 STAMP = struct.Struct("<d")
 """A byte sample's attachment: the car's time of it (seconds, its host's clock), then
 its direction (`>`, `<`, `2>`, `2<`)."""
@@ -143,7 +141,7 @@ class Share:
 
     def _writer(self, port: str) -> Callable[[zenoh.Query], None]:
         def on_write(query: zenoh.Query) -> None:
-            client = _client(query, self.keys.write(port))
+            client = asked_by(query, self.keys.write(port))
             if client is None:
                 query.reply_err(json.dumps({"refused": NOT_ASKED}))
                 return
@@ -202,8 +200,8 @@ class Share:
         return None
 
     def _on_lease(self, query: zenoh.Query) -> None:
-        client = _client(query, self.keys.lease)
-        asked = _json(query)
+        client = asked_by(query, self.keys.lease)
+        asked = json_of(query)
         if client is None or asked is None:
             query.reply_err(NOT_ASKED)
             return
@@ -221,7 +219,7 @@ class Share:
             query.reply(query.key_expr, json.dumps({"granted": True}))
 
     def _on_alive(self, sample: zenoh.Sample) -> None:
-        client = _text(sample.payload)
+        client = text_of(sample.payload)
         if client:
             with self._lock:
                 self.lease.beat(client, self.now())
@@ -248,7 +246,7 @@ class Share:
         if str(query.key_expr) not in (self.keys.stop, ANY_STOP):
             query.reply_err(NOT_ASKED)  # `get appmode/**` is no fleet stop
             return
-        who = shortened(escaped(_text(query.attachment) or "")) or "a client"
+        who = shortened(escaped(text_of(query.attachment) or "")) or "a client"
 
         def stop() -> None:
             with self._lock:
@@ -444,33 +442,3 @@ class Share:
 
 def _driver(driver: Driver) -> dict[str, object]:
     return {"machine": driver.machine, "client": driver.client, "since": round(driver.since, 1)}
-
-
-def _text(data: zenoh.ZBytes | None) -> str | None:
-    """The bytes as text; None when they are not UTF-8."""
-    try:
-        return "" if data is None else data.to_string()
-    except ValueError:
-        return None
-
-
-def _client(query: zenoh.Query, key: str) -> str | None:
-    """Who asks, when the query is for `key` itself (a wildcard, `get appmode/**`, is
-    nobody's write or lease) and names a client as appmode's do: printable text of at
-    most MAX_CLIENT characters; else None."""
-    client = _text(query.attachment)
-    if str(query.key_expr) != key or not client or len(client) > MAX_CLIENT:
-        return None
-    return client if client.isprintable() else None
-
-
-def _json(query: zenoh.Query) -> dict[str, Any] | None:
-    """The query's JSON object ({} for none); None when it is something else."""
-    text = _text(query.payload)
-    if not text:
-        return None if text is None else {}
-    try:
-        found = json.loads(text)
-    except ValueError:
-        return None
-    return found if isinstance(found, dict) else None
