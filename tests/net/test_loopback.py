@@ -125,3 +125,12 @@ def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fl
     assert "\x1b" not in listed.stdout and "\x07" not in listed.stdout
     assert "evil\\x1b]52;c;bm9wZQ==\\x07\\x1b[2J" in listed.stdout, listed.stdout
     assert "junk" not in listed.stdout and "Traceback" not in listed.stderr
+
+
+def test_sharing_a_port_that_is_not_there_is_one_line() -> None:
+    """Issue 79.6: `share /dev/ttyUSB0` with no adapter plugged in ended in `internal error:
+    StopIteration` (a second error in Share.close hid the real one)."""
+    done = run("share", "/dev/ttyNOSUCH0", "--key", "k", "--name", "car", timeout=60)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1, done.stderr
+    assert "no such port /dev/ttyNOSUCH0" in lines[0] and "internal error" not in lines[0]
