@@ -52,18 +52,18 @@ class Qos:
     durability: Durability = Durability.VOLATILE
     history: History = History.KEEP_LAST
 
-    def text(self, distro: str) -> str:
+    def text(self) -> str:
         """The QoS as a token writes it: `reliability:durability:history,depth:` then
-        deadline, lifespan and liveliness. Jazzy's rmw_zenoh leaves a field empty where
-        it is its default (KEEP_LAST, depth 42, RELIABLE, VOLATILE, infinite, automatic):
-        `::,10:,:,:,,`; Humble's writes the three kinds out (`1:2:1,10:,:,:,,`), which
-        either reads."""
-        jazzy = distro != "humble"
+        deadline, lifespan and liveliness, each field empty where it is rmw_zenoh's
+        default (RELIABLE, VOLATILE, KEEP_LAST, depth 42, infinite, automatic):
+        `::,10:,:,:,,` for depth 10. Humble's rmw_zenoh (0.1.x) and Jazzy's (0.2.x) write
+        it alike (`qos_to_keyexpr` in liveliness_utils.cpp of each), and rebuild the
+        token from the fields they parse before hashing it into the GID."""
 
         def kind(value: IntEnum, default: IntEnum) -> str:
-            return "" if jazzy and value == default else str(int(value))
+            return "" if value == default else str(int(value))
 
-        depth = "" if jazzy and self.depth == DEFAULT_DEPTH else str(self.depth)
+        depth = "" if self.depth == DEFAULT_DEPTH else str(self.depth)
         return (
             f"{kind(self.reliability, Reliability.RELIABLE)}:"
             f"{kind(self.durability, Durability.VOLATILE)}:"
@@ -168,6 +168,6 @@ class Node:
                 mangle(self.resolve(topic)),
                 dds_type(ros_type),
                 self._hash(type_hash),
-                qos.text(self.distro),
+                qos.text(),
             )
         )

@@ -14,7 +14,7 @@ pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed"
 zenoh_ext = pytest.importorskip("zenoh.ext", reason="the ros extra (eclipse-zenoh) is missing")
 
 from appmode.ros import messages  # noqa: E402
-from appmode.ros.graph import Node, Qos, namespace  # noqa: E402
+from appmode.ros.graph import Durability, Node, Qos, Reliability, namespace  # noqa: E402
 from appmode.ros.wire import attachment, gid, read_attachment  # noqa: E402
 
 STRING_HASH = "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18"
@@ -70,13 +70,21 @@ def test_the_design_doc_s_liveliness_tokens() -> None:
     )
 
 
-def test_humble_writes_no_hash_and_its_qos_kinds_out() -> None:
+def test_humble_writes_no_hash_and_its_qos_as_jazzy_does() -> None:
+    """Issue 77.1: Humble's tokens wrote the QoS kinds out (`1:2:1,10:,:,:,,`) from a
+    stale comment; rmw_zenoh 0.1.9's qos_to_keyexpr (liveliness_utils.cpp), as 0.2.10's,
+    leaves each field empty where it is the default (RELIABLE 1, VOLATILE 2, KEEP_LAST 1,
+    depth 42, infinite, automatic)."""
     node = Node(0, "/", "appmode", "z", distro="humble")
     assert node.topic_key("odom", messages.ODOMETRY, "RIHS01_x").endswith(
         "/nav_msgs::msg::dds_::Odometry_/TypeHashNotSupported"
     )
-    assert Qos(depth=10).text("humble") == "1:2:1,10:,:,:,,"
-    assert Qos(depth=42).text("jazzy") == "::,:,:,:,,"
+    token = node.entity_token(1, "MP", "odom", messages.ODOMETRY, "RIHS01_x", Qos(depth=10))
+    assert token.endswith("/nav_msgs::msg::dds_::Odometry_/TypeHashNotSupported/::,10:,:,:,,")
+    assert Qos(depth=42).text() == "::,:,:,:,,"
+    transient = Qos(depth=1, durability=Durability.TRANSIENT_LOCAL)
+    assert transient.text() == ":1:,1:,:,:,,"
+    assert Qos(depth=5, reliability=Reliability.BEST_EFFORT).text() == "2::,5:,:,:,,"
 
 
 def test_the_attachment_is_zenoh_ext_s_serialization_of_its_three_fields() -> None:
