@@ -13,6 +13,7 @@ import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
 from appmode.protocol.odometry import Pose2D
+from appmode.protocol.sensed import YAW_WINDOW
 
 TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
@@ -111,14 +112,17 @@ class Messages:
         return self._cdr(self._make(TF, transforms=[stamped]), TF)
 
     def battery(self, percent: float, time_ns: int, frame: str) -> bytes:
-        """The battery as the board reports it: a percentage (REP: 0–1), nothing else
-        measured (NaN)."""
+        """The battery as the board reports it: a percentage (REP: 0–1), and the voltage
+        it is made from (§3.2: (cV − 1110) × 2 / 3: 12.60 V at 100 %, where the firmware
+        caps it, and 11.10 V at 0 %, where the sheet's floors it: the voltage is then at
+        least, or at most, that; the reference firmware's −740 % at power-up is 0 V);
+        nothing else measured (NaN)."""
         kind = self.types[BATTERY]
         nan = math.nan
         message = self._make(
             BATTERY,
             header=self._header(time_ns, frame),
-            voltage=nan,
+            voltage=(min(100.0, percent) * 1.5 + 1110) / 100,
             temperature=nan,
             current=nan,
             charge=nan,
@@ -136,19 +140,32 @@ class Messages:
         )
         return self._cdr(message, BATTERY)
 
-    def imu(self, roll: float, pitch: float, yaw: float, time_ns: int, frame: str) -> bytes:
+    def imu(
+        self,
+        roll: float,
+        pitch: float,
+        yaw: float,
+        time_ns: int,
+        frame: str,
+        rates: tuple[float, ...] | None = None,
+    ) -> bytes:
         """The board's attitude (radians, REP 103) as an orientation with whole degrees'
-        variance; angular velocity and acceleration not given (covariance −1)."""
+        variance; its `rates` (rad/s, from the attitude over YAW_WINDOW s) as the angular
+        velocity, with a whole degree's over that window as variance (none: covariance
+        −1); acceleration not given (covariance −1)."""
         degree = math.radians(1.0) ** 2
         unknown = np.zeros(9)
         unknown[0] = UNKNOWN
+        rate = degree / YAW_WINDOW**2
         message = self._make(
             IMU,
             header=self._header(time_ns, frame),
             orientation=self._quaternion(roll, pitch, yaw),
             orientation_covariance=_diagonal(3, (degree, degree, degree)),
-            angular_velocity=self._vector(0.0, 0.0, 0.0),
-            angular_velocity_covariance=unknown,
+            angular_velocity=self._vector(*(rates or (0.0, 0.0, 0.0))),
+            angular_velocity_covariance=(
+                unknown.copy() if rates is None else _diagonal(3, (rate, rate, rate))
+            ),
             linear_acceleration=self._vector(0.0, 0.0, 0.0),
             linear_acceleration_covariance=unknown.copy(),
         )

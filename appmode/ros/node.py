@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from appmode.protocol import app
 from appmode.protocol.odometry import Odometry
 from appmode.protocol.render import to_json
+from appmode.protocol.sensed import YAW_WINDOW, yaw_rate
 from appmode.protocol.twist import BadTwist, Twist
 from appmode.ros.graph import Node, Qos
 from appmode.ros.messages import (
@@ -88,6 +89,8 @@ class RosNode:
         self.messages = Messages(graph.distro)
         self.odometry = Odometry()
         self._sensed_at = -math.inf
+        self._angles: deque[tuple[float, tuple[float, float, float]]] = deque()
+        """The last YAW_WINDOW s of B records' roll, pitch and yaw (degrees, REP 103)."""
         """The time of the last A record whose twist was published."""
         self._queue: deque[bytes] = deque(maxlen=QUEUE)
         self._woken = threading.Event()
@@ -200,7 +203,7 @@ class RosNode:
         for at, event in self._new(state, "B"):
             stamp = now_ns - int((now - at) * 1e9)
             self._raw(event, state, stamp)
-            self._attitude(event, state, stamp)
+            self._attitude(event, state, at, stamp)
 
     def _new(self, state: HostState, letter: str) -> list[tuple[float, Any]]:
         trace = state.velocities if letter == "A" else state.attitudes
@@ -223,12 +226,23 @@ class RosNode:
         self._put("odom", self.messages.odometry(pose, stamp, odom, base, variance))
         self._put("/tf", self.messages.transform(pose, stamp, odom, base))
 
-    def _attitude(self, event: Any, state: HostState, stamp: int) -> None:
+    def _attitude(self, event: Any, state: HostState, at: float, stamp: int) -> None:
+        """The B record's attitude as imu: its orientation, and its rates over the last
+        YAW_WINDOW s of records (whole degrees: what the gyro integrated)."""
         fields = self._fields(event, state, "B")
         if all(k in fields for k in ("pitch", "roll", "yaw")):
-            roll, pitch = math.radians(fields["roll"][0]), math.radians(fields["pitch"][0])
-            yaw = -math.radians(fields["yaw"][0])  # the board's yaw is clockwise
-            self._put("imu", self.messages.imu(roll, pitch, yaw, stamp, self.options.base_frame))
+            # REP 103: the board's yaw is clockwise
+            angles = (fields["roll"][0], fields["pitch"][0], -fields["yaw"][0])
+            self._angles.append((at, angles))
+            while self._angles and self._angles[0][0] < at - YAW_WINDOW:
+                self._angles.popleft()
+            rates = [
+                yaw_rate([(t, a[axis]) for t, a in self._angles], at) for axis in range(3)
+            ]
+            roll, pitch, yaw = (math.radians(angle) for angle in angles)
+            known = None if None in rates else tuple(math.radians(r or 0.0) for r in rates)
+            imu = self.messages.imu(roll, pitch, yaw, stamp, self.options.base_frame, known)
+            self._put("imu", imu)
         self._battery(fields, stamp)
 
     def _battery(self, fields: dict[str, tuple[float, Any]], stamp: int) -> None:

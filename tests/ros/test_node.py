@@ -261,3 +261,27 @@ def test_out_of_range_cmd_vel_is_refused_or_clamped_and_the_node_keeps_running(c
         assert "FF FE 01 00 00 00 C8 00 00 00" in frames, frames[-5:]  # y = 200: 0.2 m/s
     else:
         assert "{0:200}" in car.board_sent(), car.board_sent()[-8:]
+
+
+@pytest.mark.slow
+def test_imu_and_battery_carry_data_consistent_with_odom(car: Car) -> None:
+    """Issue 77.3: imu carried an orientation only, battery_state a percentage with its
+    voltage NaN. Turning at 0.5 rad/s, imu's angular velocity agrees with odom's turn
+    (the simulated gyro turns at the profile's velocity unit), and the battery has a
+    voltage."""
+    entities = car.entities(7)
+    cmd_vel = next(e for e in entities if e.topic == "/cmd_vel")
+    imu, battery = peer.Received(), peer.Received()
+    subscribers = [
+        car.ros.declare_subscriber(next(e for e in entities if e.topic == topic).data_key, got)
+        for topic, got in (("/imu", imu.on_sample), ("/battery_state", battery.on_sample))
+    ]
+    turn = _odometry_while(car, cmd_vel, 0.0, 0.5)[2]
+    for subscriber in subscribers:
+        subscriber.undeclare()
+    rates = [m.angular_velocity.z for m in imu.messages("sensor_msgs/msg/Imu")[-5:]]
+    assert all(rate == pytest.approx(turn, abs=0.2) for rate in rates), (rates, turn)
+    last = imu.messages("sensor_msgs/msg/Imu")[-1]
+    assert last.angular_velocity_covariance[0] > 0, "a rate with its variance"
+    volts = [m.voltage for m in battery.messages("sensor_msgs/msg/BatteryState")]
+    assert volts and all(11.0 <= v <= 12.7 for v in volts), volts[-3:]
