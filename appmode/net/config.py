@@ -53,6 +53,14 @@ def zenoh_module() -> object:
     return zenoh
 
 
+ACCEPT_TIMEOUT_MS = 2000
+"""How long a listening session waits for a new connection's handshake (Zenoh's default:
+10 s): a connection that says nothing, a stranger's, is dropped after it."""
+ACCEPT_PENDING = 2000
+"""Connections in their handshake at once at most (Zenoh's default: 100, which ~300
+idle connections of a stranger without the key filled, keeping `fleet stop` out)."""
+
+
 def open_session(
     mode: Mode,
     key: str | None,
@@ -80,6 +88,9 @@ def open_session(
     config.insert_json5("listen/endpoints", json.dumps(list(listen)))
     config.insert_json5("connect/endpoints", json.dumps(list(connect)))
     config.insert_json5("scouting/multicast/enabled", json.dumps(scout))
+    if listen:  # strangers' idle connections may not keep a key holder out
+        config.insert_json5("transport/unicast/accept_timeout", json.dumps(ACCEPT_TIMEOUT_MS))
+        config.insert_json5("transport/unicast/accept_pending", json.dumps(ACCEPT_PENDING))
     if tls is not None:
         if tls.root_ca is not None and not Path(tls.root_ca).is_file():
             raise AppmodeError(

@@ -308,3 +308,36 @@ def test_malformed_and_wildcard_queries_reach_no_handler_that_acts(shared: Share
     shared.share.terminate()
     _, err = shared.share.communicate(timeout=10)
     assert "Traceback" not in err and "fleet stop" not in err, err
+
+
+def test_a_stranger_s_idle_connections_keep_no_key_holder_out(shared: SharedCar) -> None:
+    """Issue 80.6: ~300 idle TCP connections to the share's port, without the key, made
+    `fleet`, `fleet stop` and new `send`s with the right key fail. A connection that
+    says nothing is dropped after 2 s, and a key holder gets in meanwhile."""
+    stranger = subprocess.Popen(
+        shared.machines["stranger"].command(
+            sys.executable,
+            "-m",
+            "tests.support.idle_connections",
+            shared.machines["car"].address,
+            "7450",
+            "300",
+        ),
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert stranger.stdout is not None
+        assert stranger.stdout.readline().strip() == "ready 300"
+        listed = shared.laptop.run("fleet", "--key", KEY, "--json", timeout=30)
+        assert listed.returncode == 0 and '"car"' in listed.stdout, listed.stderr
+        sent = shared.laptop.run("send", shared.url, "J", "A", "wait:0.3", timeout=30)
+        assert sent.returncode == 0, sent.stderr
+        stopped = shared.laptop.run("fleet", "stop", "--key", KEY, timeout=30)
+        assert stopped.returncode == 0, stopped.stdout + stopped.stderr
+        assert "car: stopped (confirmed)" in stopped.stdout
+    finally:
+        stranger.terminate()
+        stranger.communicate(timeout=10)
+    assert shared.sent()[-1] == "Z"
