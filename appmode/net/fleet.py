@@ -36,7 +36,12 @@ def cars(session: zenoh.Session, wait: float = ASK) -> list[Car]:
 
     sent = time.monotonic()
     found: dict[str, Car] = {}
-    replies = session.get(ANY_INFO, target=zenoh.QueryTarget.ALL, timeout=wait)
+    replies = session.get(
+        ANY_INFO,
+        target=zenoh.QueryTarget.ALL,
+        consolidation=zenoh.ConsolidationMode.NONE,  # two hosts of one name: both heard
+        timeout=wait,
+    )
     for reply in replies:
         if reply.ok is None:
             continue
@@ -53,7 +58,13 @@ def stop_all(session: zenoh.Session, wait: float = STOPPING) -> list[dict[str, A
     import zenoh
 
     who = socket.gethostname()
-    replies = session.get(ANY_STOP, target=zenoh.QueryTarget.ALL, attachment=who, timeout=wait)
+    replies = session.get(
+        ANY_STOP,
+        target=zenoh.QueryTarget.ALL,
+        consolidation=zenoh.ConsolidationMode.NONE,  # each host's answer, whatever its name
+        attachment=who,
+        timeout=wait,
+    )
     answers = [answer for r in replies if r.ok is not None and (answer := _object(r.ok))]
     return sorted(answers, key=lambda answer: str(answer.get("name")))
 

@@ -62,6 +62,10 @@ class Keys:
         """The car's host's liveliness token: the car is shared."""
         return self._key("presence")
 
+    def host(self, zid: str) -> str:
+        """A host's liveliness token for the car: two of them, two cars of one name."""
+        return self._key("host", zid)
+
     def driver(self, client: str) -> str:
         """A driver's liveliness token: its Zenoh session is alive."""
         return self._key("driver", client)

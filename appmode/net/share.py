@@ -23,6 +23,7 @@ from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
 from appmode.host.link import CHUNK, Cut, LinkLost
 from appmode.net.asked import NOT_ASKED, asked_by, json_of, text_of
+from appmode.net.hosts import claim
 from appmode.net.lease import Driver, Granted, Lease, Refused
 from appmode.net.names import ANY_STOP, Keys
 from appmode.protocol import app
@@ -85,6 +86,7 @@ class Share:
         self._velocity_at = 0.0
         self._stops = 0
         """Stops sent so far: a write lets its rest go only while none came since it began."""
+        self._host_token: Any = None
         self._events: Any = None
         """The events' publisher, once declared (after the stop at the start)."""
         self._battery: int | None = None
@@ -94,6 +96,7 @@ class Share:
             host.stop_on_close = not self.ports  # the first port's, until another is used
             self.ports[port] = Port(port, host)
         try:
+            self._host_token = claim(session, self.keys)
             self._stop_at_start()
             self._declare()
         except BaseException:
@@ -436,8 +439,9 @@ class Share:
         for name, port in self.ports.items():
             port.host.stop_on_close = name in stopping
             port.host.close()
-        for declared in getattr(self, "_declared", []):
-            declared.undeclare()
+        for declared in [*getattr(self, "_declared", []), self._host_token]:
+            if declared is not None:
+                declared.undeclare()
 
 
 def _driver(driver: Driver) -> dict[str, object]:

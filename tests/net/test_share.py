@@ -341,3 +341,26 @@ def test_a_stranger_s_idle_connections_keep_no_key_holder_out(shared: SharedCar)
         stranger.terminate()
         stranger.communicate(timeout=10)
     assert shared.sent()[-1] == "Z"
+
+
+def test_a_second_car_of_one_name_on_one_key_is_not_shared(shared: SharedCar) -> None:
+    """Issue 80.2: two Pis with one --name and one key (cloned SD cards): one driver
+    drove both boards. The second share finds the first host's car of that name and
+    does not serve; the first car is driven alone."""
+    record2 = shared.record.with_name("board2.transcript")
+    board2 = BoardProcess("--pty", "--quiet", "--record", str(record2))
+    second = shared.machines["stranger"].popen(
+        "share", board2.url, "--name", "car", "--listen", LISTEN, "--key", KEY
+    )
+    try:
+        out, err = second.communicate(timeout=30)
+        assert second.returncode == 2 and not out.strip(), out + err
+        assert "a car named car is shared already on this key" in err, err
+        sent = shared.laptop.run("send", shared.url, "J", "A", "wait:0.3", timeout=30)
+        assert sent.returncode == 0, sent.stderr
+        assert "A" in shared.sent() and "A" not in sent_lines(record2)
+    finally:
+        if second.poll() is None:
+            second.kill()
+            second.communicate()
+        board2.stop()
