@@ -408,3 +408,36 @@ def test_scan_shows_its_progress_on_a_terminal_and_not_in_a_pipe(
     assert shown.endswith("\r\x1b[K"), "the progress line is cleared"
     piped = run("scan", "--time", "2")
     assert "scanning" not in piped.stderr and "\r" not in piped.stderr
+
+
+@pytest.mark.parametrize("how", ["hangup", "watcher killed"])
+def test_no_dbus_daemon_outlives_its_board_however_it_ends(how: str) -> None:
+    """Issue 80.13: dbus-daemon processes outlived `board --bluetooth` with parent 1: a
+    hangup to the process group (a closed terminal) ended the watcher shell, and the
+    daemon takes SIGHUP as "reload"; a watcher killed alone left it too."""
+    proc = subprocess.Popen(
+        appmode_cmd("board", "--bluetooth"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        cwd=ROOT,
+        start_new_session=True,  # its own process group, as a terminal's job is
+    )
+    try:
+        assert proc.stdout is not None
+        bus = next(
+            line.split(": ", 1)[1].strip() for line in proc.stdout if line.startswith("bus: ")
+        )
+        daemons = bus_processes(bus, watcher=False)
+        watchers = [pid for pid in bus_processes(bus) if pid not in daemons]
+        assert daemons and watchers, (daemons, watchers)
+        if how == "hangup":
+            os.killpg(proc.pid, signal.SIGHUP)
+        else:
+            for pid in watchers:
+                os.kill(pid, signal.SIGKILL)
+        wait_for(lambda: not any(Path(f"/proc/{pid}").exists() for pid in daemons), 5)
+    finally:
+        proc.kill()
+        proc.wait(10)
+    wait_for(lambda: not bus_processes(bus), 5)

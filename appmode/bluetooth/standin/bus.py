@@ -3,8 +3,11 @@ on a socket in a new folder, so the BlueZ stand-in never touches the machine's s
 Programs reach it with DBUS_SYSTEM_BUS_ADDRESS set to `address`.
 
 The daemon dies with us, however we end (SIGKILL too): it runs under a watcher shell
-that waits for the end of a pipe only we hold, then stops it. A folder left by a bus
-whose owner is gone (a machine's power cut) is removed by the next bus started."""
+that waits for the end of a pipe only we hold, then stops it; the shell stops it too
+when it is told to end (a hangup to the process group: dbus-daemon takes SIGHUP for
+"reload" and would outlive it), and the daemon gets SIGTERM when the shell dies however
+it dies (util-linux's `setpriv --pdeathsig`, where the machine has it). A folder left by
+a bus whose owner is gone (a machine's power cut) is removed by the next bus started."""
 
 from __future__ import annotations
 
@@ -38,12 +41,13 @@ CONFIG = """<!DOCTYPE busconfig PUBLIC "-//freedesktop//DTD D-Bus Bus Configurat
 may own a name and call anything: the bus carries one stand-in and its clients."""
 WATCHER = """
 "$0" "$@" & daemon=$!
+trap 'kill "$daemon" 2>/dev/null; exit 1' HUP INT TERM
 read -r _
 kill "$daemon" 2>/dev/null
 wait "$daemon"
 """
 """Runs the daemon (its stdin /dev/null) and stops it once our end of its stdin pipe is
-closed: by `close`, or by the kernel when we die."""
+closed (by `close`, or by the kernel when we die) or the shell is told to end."""
 PREFIX = "appmode-bus-"
 OWNER = "owner"
 """The file in a bus's folder that holds the process id of the program that made it."""
@@ -68,8 +72,10 @@ class PrivateBus:
         config = self._folder / "bus.conf"
         config.write_text(CONFIG.format(socket=self._folder / "bus"), encoding="utf-8")
         arguments = [f"--config-file={config}", "--nofork", "--nopidfile", "--print-address"]
+        setpriv = shutil.which("setpriv")  # the daemon dies with the shell, SIGKILL too
+        command = [setpriv, "--pdeathsig", "TERM", daemon] if setpriv else [daemon]
         self._process = subprocess.Popen(
-            ["/bin/sh", "-c", WATCHER, daemon, *arguments],
+            ["/bin/sh", "-c", WATCHER, *command, *arguments],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
