@@ -111,19 +111,29 @@ def _row(car: Car) -> tuple[str, ...]:
     battery = info.get("battery")
     return (
         escaped(car.name),
-        escaped(str(info.get("profile", "?"))),
-        "—" if battery is None else escaped(f"{battery} %"),
-        _motion(info),
-        escaped(str(driver.get("machine"))) if isinstance(driver, dict) else "—",
+        _cell(info.get("profile", "?")),
+        "—" if battery is None else _cell(f"{battery} %"),
+        _cell(_motion(info)),
+        _cell(driver.get("machine")) if isinstance(driver, dict) else "—",
         f"{car.latency_ms:.1f} ms",
-        escaped(str(info.get("machine", "?"))),
+        _cell(info.get("machine", "?")),
     )
+
+
+CELL = 40
+"""Characters of a cell at most: what a car's host says is data from outside."""
+
+
+def _cell(value: object) -> str:
+    """`value` as a cell: escaped, and cut to CELL characters."""
+    text = escaped(str(value))
+    return text if len(text) <= CELL else text[: CELL - 1] + "…"
 
 
 def _motion(info: dict[str, Any]) -> str:
     """What the car does: what it was told, else what its records show."""
     if info.get("in_force"):
-        return escaped(str(info["in_force"]))
+        return str(info["in_force"])
     if info.get("records_moving") is True:
         return "MOVING (its records)"
     return "stopped" if info.get("records_moving") is False else "stopped (not confirmed)"

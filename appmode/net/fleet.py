@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from appmode.net.names import ANY_INFO, ANY_STOP, name_of
+from appmode.ports.remote import NAME
 
 if TYPE_CHECKING:
     import zenoh
@@ -46,8 +47,8 @@ def cars(session: zenoh.Session, wait: float = ASK) -> list[Car]:
         if reply.ok is None:
             continue
         info = _object(reply.ok)
-        if info is not None:
-            name = name_of(str(reply.ok.key_expr))
+        name = name_of(str(reply.ok.key_expr))
+        if info is not None and NAME.fullmatch(name):  # a forged 20,000-character name: none
             found[name] = Car(name, info, (time.monotonic() - sent) * 1000)
     return [found[name] for name in sorted(found)]
 

@@ -98,7 +98,8 @@ def test_the_pytest_plugin_runs_against_a_shared_car(tmp_path: Path) -> None:
 
 def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fleet() -> None:
     """A key holder's own 'share' answering with terminal escapes, a driver that is not
-    an object, and no JSON at all: `fleet` lists what it can, escaped, in one piece."""
+    an object, and no JSON at all: `fleet` lists what it can, escaped, in one piece; a
+    name no share could take (escapes, 2,000 characters: issue 80.12) is no car."""
     import zenoh
 
     from appmode.net.config import close_session, free_port, open_session
@@ -106,7 +107,9 @@ def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fl
     endpoint = free_port("tcp/127.0.0.1:0")
     evil = "evil\x1b]52;c;bm9wZQ==\x07\x1b[2J"
     answers = {
-        f"appmode/{evil}/info": {"profile": "\x1b[31mred", "battery": "\x1b[8m", "driver": "x"},
+        "appmode/evil-car/info": {"profile": evil, "battery": "\x1b[8m", "driver": "x"},
+        f"appmode/{evil}/info": {"profile": "named with escapes"},
+        f"appmode/{'x' * 2000}/info": {"profile": "named too long"},
         "appmode/junk/info": None,
     }
     session = open_session("peer", KEY, listen=(endpoint,))
@@ -124,6 +127,8 @@ def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fl
     assert listed.returncode == 0, listed.stderr
     assert "\x1b" not in listed.stdout and "\x07" not in listed.stdout
     assert "evil\\x1b]52;c;bm9wZQ==\\x07\\x1b[2J" in listed.stdout, listed.stdout
+    assert "named with escapes" not in listed.stdout and "named too long" not in listed.stdout
+    assert len(listed.stdout) < 1000, "one car's line, and the header"
     assert "junk" not in listed.stdout and "Traceback" not in listed.stderr
 
 
@@ -134,3 +139,14 @@ def test_sharing_a_port_that_is_not_there_is_one_line() -> None:
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and len(lines) == 1, done.stderr
     assert "no such port /dev/ttyNOSUCH0" in lines[0] and "internal error" not in lines[0]
+
+
+def test_a_forged_car_name_or_field_makes_no_long_fleet_table() -> None:
+    """Issue 80.12: a key holder's info reply under a 20,000-character name made a 100 kB
+    `fleet` table. A name no share could take is no car; a cell is cut at 40."""
+    from appmode.cli.fleet import table
+    from appmode.net.fleet import Car
+
+    long = "x" * 20_000
+    shown = table([Car("car-1", {"profile": long, "machine": "\x1b[2J" + long}, 1.0)])
+    assert len(shown) < 500 and "\x1b" not in shown and "…" in shown
