@@ -290,6 +290,24 @@ def bus_processes(bus: str, watcher: bool = True) -> list[int]:
     return found
 
 
+def board_bluetooth(start_new_session: bool = False) -> tuple[subprocess.Popen[str], str]:
+    """`appmode board --bluetooth` started, and the bus it says it serves."""
+    proc = subprocess.Popen(
+        appmode_cmd("board", "--bluetooth"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        cwd=ROOT,
+        start_new_session=start_new_session,
+    )
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        if line.startswith("bus: "):
+            return proc, line.split(": ", 1)[1].strip()
+    proc.kill()
+    raise AssertionError(f"board --bluetooth said no bus: {proc.wait(10)}")
+
+
 def bus_folder(bus: str) -> Path:
     return Path(bus.split("path=", 1)[1].split(",", 1)[0]).parent
 
@@ -299,21 +317,8 @@ def test_board_bluetooth_killed_leaves_no_daemon_and_its_folder_goes_next_time()
     folder behind."""
     from appmode.bluetooth.standin.bus import PrivateBus
 
-    proc = subprocess.Popen(
-        appmode_cmd("board", "--bluetooth"),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        text=True,
-        cwd=ROOT,
-    )
+    proc, bus = board_bluetooth()
     try:
-        assert proc.stdout is not None
-        bus = ""
-        for line in proc.stdout:
-            if line.startswith("bus: "):
-                bus = line.split(": ", 1)[1].strip()
-                break
-        assert bus, "board --bluetooth said its bus"
         assert bus_processes(bus, watcher=False)
     finally:
         proc.kill()
@@ -415,19 +420,8 @@ def test_no_dbus_daemon_outlives_its_board_however_it_ends(how: str) -> None:
     """Issue 80.13: dbus-daemon processes outlived `board --bluetooth` with parent 1: a
     hangup to the process group (a closed terminal) ended the watcher shell, and the
     daemon takes SIGHUP as "reload"; a watcher killed alone left it too."""
-    proc = subprocess.Popen(
-        appmode_cmd("board", "--bluetooth"),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-        text=True,
-        cwd=ROOT,
-        start_new_session=True,  # its own process group, as a terminal's job is
-    )
+    proc, bus = board_bluetooth(start_new_session=True)  # a group, as a terminal's job
     try:
-        assert proc.stdout is not None
-        bus = next(
-            line.split(": ", 1)[1].strip() for line in proc.stdout if line.startswith("bus: ")
-        )
         daemons = bus_processes(bus, watcher=False)
         watchers = [pid for pid in bus_processes(bus) if pid not in daemons]
         assert daemons and watchers, (daemons, watchers)
