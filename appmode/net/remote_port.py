@@ -239,7 +239,8 @@ class RemoteSerial(Modemless):
         if self._remote.take and self._remote.name not in _TOOK:
             self._take()
         sent = time.monotonic()
-        replies = list(self._writer.get(payload=payload, attachment=CLIENT))
+        until = sent - self._origin + WRITE_TIMEOUT  # the car's clock: after it, not written
+        replies = list(self._writer.get(payload=payload, attachment=f"{CLIENT} {until:.3f}"))
         self.latency = (time.monotonic() - sent) * 1000
         if not replies:
             self._lose(f"the car's host did not answer within {WRITE_TIMEOUT:g} s")

@@ -21,8 +21,8 @@ from appmode.host.app.state import STILL, HostState
 from appmode.host.app.stop_check import SETTLE
 from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
-from appmode.host.link import CHUNK, Cut, LinkLost
-from appmode.net.asked import NOT_ASKED, asked_by, json_of, text_of
+from appmode.host.link import Cut, LinkLost
+from appmode.net.asked import NOT_ASKED, asked_by, json_of, text_of, write_refusal
 from appmode.net.hosts import claim
 from appmode.net.lease import Driver, Granted, Lease, Refused
 from appmode.net.names import ANY_STOP, Keys
@@ -144,20 +144,11 @@ class Share:
 
     def _writer(self, port: str) -> Callable[[zenoh.Query], None]:
         def on_write(query: zenoh.Query) -> None:
-            client = asked_by(query, self.keys.write(port))
-            if client is None:
-                query.reply_err(json.dumps({"refused": NOT_ASKED}))
-                return
             data = b"" if query.payload is None else query.payload.to_bytes()
-            if len(data) > CHUNK:  # a client's link writes a chunk at a time
-                query.reply_err(
-                    json.dumps(
-                        {"refused": f"a write of {len(data)} bytes: at most {CHUNK} at a time"}
-                    )
-                )
-                return
+            asker = asked_by(query, self.keys.write(port))
+            client, refused = write_refusal(asker, data, self.now())
             with self._lock:
-                refused = self._may_drive(client, take=False)
+                refused = refused or self._may_drive(client, take=False)
                 if refused is not None:
                     query.reply_err(json.dumps({"refused": refused}))
                     return

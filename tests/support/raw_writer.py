@@ -1,8 +1,8 @@
 """A key holder's raw writes to a shared car, as no appmode client sends them: `python -m
-tests.support.raw_writer ENDPOINT KEY NAME SIZE COUNT` sends COUNT writes of SIZE bytes
-of `A` to the car's APP port one after another, with the heartbeats that keep its
-lease, and prints each answer as a line (`ok`, or the error) as it comes, until the
-first error."""
+tests.support.raw_writer ENDPOINT KEY NAME SIZE COUNT [UNTIL]` sends COUNT writes of
+SIZE bytes of `A` to the car's APP port one after another (each given up at UNTIL on
+the car's clock, if given), with the heartbeats that keep its lease, and prints each
+answer as a line (`ok`, or the error) as it comes, until the first error."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from appmode.net.names import Keys
 CLIENT = "raw-writer-1-abc"
 
 
-def main(endpoint: str, key: str, name: str, size: int, count: int) -> None:
+def main(endpoint: str, key: str, name: str, size: int, count: int, until: str = "") -> None:
     session = open_session("client", key, connect=(endpoint,))
     keys = Keys(name)
     done = threading.Event()
@@ -27,7 +27,8 @@ def main(endpoint: str, key: str, name: str, size: int, count: int) -> None:
     threading.Thread(target=beat, daemon=True).start()
     try:
         for _ in range(count):
-            replies = list(session.get(keys.write("app"), payload=b"A" * size, attachment=CLIENT))
+            asker = f"{CLIENT} {until}" if until else CLIENT
+            replies = list(session.get(keys.write("app"), payload=b"A" * size, attachment=asker))
             reply = replies[0] if replies else None
             if reply is None:
                 print("no answer", flush=True)
@@ -42,4 +43,4 @@ def main(endpoint: str, key: str, name: str, size: int, count: int) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]))
+    main(sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]), *sys.argv[6:])
