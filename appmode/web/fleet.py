@@ -34,7 +34,11 @@ LOOK = 1.0
 """Seconds between two looks at the fleet."""
 SEND = 0.25
 """How often each fleet page's cards are checked, and sent if they changed."""
-CARD_FIELDS = ("name", "profile", "simulated", "links", "driver", "battery", "in_force")
+CARD_FIELDS = (
+    "name", "profile", "simulated", "links", "driver", "battery", "in_force", "moving",
+)  # fmt: skip
+VANISHED = "its host stopped answering: it may still be moving"
+"""What the card of a car that was moving says once its host no longer answers."""
 
 
 class Fleet:
@@ -54,7 +58,7 @@ class Fleet:
     def _look(self) -> None:
         while not self._ended.is_set():
             found = cars(self.session, wait=LOOK)
-            self.cars = [
+            answered = [
                 {
                     **{k: car.info.get(k) for k in CARD_FIELDS[1:]},
                     "name": car.name,
@@ -62,11 +66,20 @@ class Fleet:
                 }
                 for car in found
             ]
+            names = {card["name"] for card in answered}
+            kept = [  # a car last seen moving whose host is gone is no stopped car
+                {**card, "in_force": VANISHED, "vanished": True}
+                for card in self.cars
+                if card["name"] not in names and (card.get("moving") or card.get("vanished"))
+            ]
+            self.cars = sorted([*answered, *kept], key=lambda card: str(card["name"]))
             self._ended.wait(LOOK / 2)
 
     def known(self, name: str) -> bool:
         """Whether `name` is a car that answered (a page names nothing else)."""
-        return NAME.fullmatch(name) is not None and any(c["name"] == name for c in self.cars)
+        return NAME.fullmatch(name) is not None and any(
+            c["name"] == name and not c.get("vanished") for c in self.cars
+        )
 
     def stop_all(self) -> list[dict[str, Any]]:
         """Stop every car; each one's answer (blocks up to a few seconds)."""

@@ -16,7 +16,7 @@ from typing import Any
 import aiohttp
 import pytest
 
-from tests.support.processes import serving, stop_process, wait_for
+from tests.support.processes import appmode_cmd, serving, stop_process, wait_for
 from tests.support.shares import KEY, SharedBoard, shared_board
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
@@ -115,3 +115,48 @@ def test_the_fleet_page_shows_the_cars_drives_one_and_stops_them_all(
     err = stop_process(web)
     assert web.returncode == 0 and "Traceback" not in err, err
     assert second.sent()[-1] == "Z" and "A" not in first.sent()
+
+
+def test_a_moving_car_whose_host_vanished_keeps_its_card(
+    fleet: tuple[SharedBoard, SharedBoard, subprocess.Popen[str], str],
+) -> None:
+    """Issue 80.7: the fleet page dropped the card of a moving car whose share died (no
+    card for ~7 s while the board drove on), and nothing said it might still be moving."""
+    _, second, _, address = fleet
+    origin = address.split("/?", 1)[0]
+    host = origin.split("//", 1)[1]
+    headers = {"Cookie": f"appmode_token={address.rsplit('=', 1)[1]}", "Origin": origin}
+    driver = subprocess.Popen(
+        appmode_cmd("drive", second.url), stdin=subprocess.PIPE, text=True,
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    assert driver.stdin is not None
+    driver.stdin.write("drive A\nwait 60\n")
+    driver.stdin.flush()
+
+    async def scenario() -> list[dict[str, Any]]:
+        async with aiohttp.ClientSession() as client:
+            socket = await client.ws_connect(f"ws://{host}/fleet/ws", headers=headers)
+            deadline = time.monotonic() + 15
+            while time.monotonic() < deadline:
+                shown = await cards(socket, 2)
+                if any(car["name"] == "car-b" and car["in_force"] for car in shown):
+                    break
+            second.share.kill()  # its host dies with the car moving
+            seen = []
+            for _ in range(20):  # five seconds of the page's cards
+                seen.append(await receive(socket, "fleet"))
+                await asyncio.sleep(0.25)
+            await socket.close()
+            return seen
+
+    try:
+        seen = asyncio.run(scenario())
+    finally:
+        driver.kill()
+        driver.communicate()
+    last = {car["name"]: car for car in seen[-1]["cars"]}
+    assert "car-b" in last, "the moving car's card is gone"
+    assert "may still be moving" in last["car-b"]["in_force"], last["car-b"]
+    assert all("car-b" in {car["name"] for car in message["cars"]} for message in seen)
+    assert second.sent()[-1] == "A", "the board's own recording: still driving"

@@ -36,7 +36,7 @@ function card(car, driving) {
   const driver = car.driver ? car.driver.machine : "nobody";
   link.append(
     head,
-    ...cell("in force", car.in_force || "stopped", car.in_force ? "moving" : ""),
+    ...cell("in force", car.in_force || (car.moving ? "moving (its records)" : "stopped"), car.in_force || car.moving ? "moving" : ""),
     ...cell("battery", battery),
     ...cell("link", links || "—", links.includes("DOWN") ? "down" : ""),
     ...cell("driven from", driver),
