@@ -197,3 +197,22 @@ def test_a_script_s_twist_drives_either_port_and_the_session_ends_with_the_stop(
         assert sent.index("{0:300}") < sent.index("A") < sent.index("K")
         assert sent.index("K") < sent.index("{0:159}") < sent.index("G")
         assert sent[-1] == "Z"
+
+
+def test_a_twist_that_changes_speed_on_a_car_every_frame_stops_still_lapses() -> None:
+    """minibalance stops at every frame (§13): a new speed's `{0:N}` stops the car the
+    twist drove. A twist given once (as typed) leaves no motion that outlives its hold."""
+    session = open_board("sim://?profile=minibalance", HoldToDrive(0.3, 0.3))
+    try:
+        session.start()
+        drive(session, Twist(), 1.5)
+        drive(session, Twist(0.3), 1.0)
+        session.move(Twist(0.5))  # once, as a typed twist: its frame stops the car
+        stopped = session.now()
+        end = time.monotonic() + 3.0
+        while time.monotonic() < end and (session.now() - stopped < 0.5 or session.moving):
+            session.tick()
+            time.sleep(0.01)
+        assert not session.moving and session.now() - stopped < 0.9
+    finally:
+        session.close()
