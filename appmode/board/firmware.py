@@ -1,17 +1,15 @@
 """The board's firmware as a deterministic state machine with an injected clock.
 
-`Board.receive(data, now)` applies host bytes at time `now`; `Board.poll(now)` returns
-the telemetry due by `now`. The control port has its own pair, `receive_uart2` and
-`poll_uart2` (docs/protocol.md §8–§12), with the same clock and the same state. Time
-only moves forward (an earlier `now` counts as the board's current time). The control
-loop runs in fixed ticks of TICK seconds from boot; records go out on the profile's
-schedule (§3.4, §13), on a millisecond grid. The same inputs at the same times give the
-same bytes, whatever the pattern of `poll` calls. Every way a profile differs is a
-switch of `profiles.Profile`.
+`Board.receive(data, now)` applies host bytes at `now`; `Board.poll(now)` returns the
+telemetry due by `now`; the control port (§8–§12) and a WHEELTEC board's chassis port
+(§15) have their own pairs, with the same clock and state. Time only moves forward. The
+control loop runs in ticks of TICK seconds from boot; records go out on the profile's
+schedule (§3.4, §13), on a millisecond grid: the same inputs at the same times give the
+same bytes, whatever the pattern of `poll` calls. A profile differs by its switches.
 
 `Board` is the front and the clock, and runs the control loop; its parts share one
-`Core`: `telemetry` (the records' schedule), `app_port` (UART3, and UART2 in APP mode)
-and `control_port` (UART2's frames, replies and reports).
+`Core`: `telemetry` (the records' schedule), `app_port` (UART3, and UART2 in APP mode),
+`control_port` (UART2's frames, replies and reports) and `chassis_port` (§15).
 """
 
 from __future__ import annotations
@@ -21,6 +19,7 @@ from collections import deque
 
 from appmode.board import kinematics
 from appmode.board.app_port import AppPort
+from appmode.board.chassis_port import ChassisPort
 from appmode.board.chip import float32
 from appmode.board.control_port import (
     APP_MODE,
@@ -74,6 +73,7 @@ class Board:
         self.telemetry = Telemetry(core)
         self.app_port = AppPort(core, self.telemetry)
         self.control_port = ControlPort(core, self.app_port)
+        self.chassis_port = ChassisPort(core, profile.chassis)
         self._copy_ms = 0.0 if profile.firmware_uart2 else math.inf  # the next COPY_MS tick
         self._target_for: tuple[object, ...] | None = None  # what _target was worked out for
         self._target_is: tuple[float, float, float] = (0.0, 0.0, 0.0)  # and what it was
@@ -152,10 +152,10 @@ class Board:
         """When the board next sends something: a record, a reply, an encoder report."""
         return min(self.next_sends())
 
-    def next_sends(self) -> tuple[float, float]:
-        """When the board next sends on UART3 and on UART2 (infinity: nothing planned).
-        Records go out on UART3, or on UART2 in APP mode (§12); replies and encoder
-        reports on UART2."""
+    def next_sends(self) -> tuple[float, float, float]:
+        """When the board next sends on UART3, on UART2 and on its chassis port (infinity:
+        nothing planned). Records go out on UART3, or on UART2 in APP mode (§12);
+        replies and encoder reports on UART2; status frames on the chassis port (§15)."""
         core, telemetry = self.core, self.telemetry
         uart3, uart2 = float(telemetry.record_ms), telemetry.burst_ms
         mode = core.system_mode
@@ -165,7 +165,8 @@ class Board:
             uart2 = min(uart2, core.tick_ms)
         elif mode & ENCODER_REPORT and not mode & APP_MODE:
             uart2 = min(uart2, -(-core.tick_ms // REPORT_MS) * REPORT_MS)
-        return core.boot + uart3 / 1000, core.boot + uart2 / 1000
+        status = self.chassis_port.status_ms / 1000
+        return core.boot + uart3 / 1000, core.boot + uart2 / 1000, core.boot + status
 
     def next_reply(self) -> float:
         """When the board next answers a read on UART2 (infinity when none is pending)."""
@@ -186,9 +187,9 @@ class Board:
                 late = core.tick_ms - telemetry.record_ms
                 telemetry.record_ms += -(-late // period) * period
             self._copy_ms = max(self._copy_ms, core.tick_ms)
-        while (
-            at := min(core.tick_ms, telemetry.record_ms, self._copy_ms, telemetry.burst_ms)
-        ) <= due:
+            self.chassis_port.skip(core.tick_ms)
+        chassis = self.chassis_port
+        while (at := self._next_event()) <= due:
             if self._copy_ms == at:  # before the control tick of the same millisecond
                 self.control_port.take_frame(core.boot + at / 1000)
                 self._copy_ms += COPY_MS
@@ -203,8 +204,16 @@ class Board:
                 core.tick_ms += TICK_MS
                 if not self._rest(due):
                     self._steps(due)
+            elif chassis.status_ms == at:
+                chassis.send_status()
             else:
                 telemetry.send_record()
+
+    def _next_event(self) -> float:
+        """When, in ms from boot, the next tick, record, copy, burst or status frame is."""
+        core, telemetry = self.core, self.telemetry
+        times = (core.tick_ms, telemetry.record_ms, self._copy_ms, telemetry.burst_ms)
+        return min(*times, self.chassis_port.status_ms)
 
     def _rest(self, due: int) -> bool:
         """Run at once the control ticks up to the next other event (by `due`) while the
@@ -221,6 +230,7 @@ class Board:
             or core.uart2_control
             or core.reads
             or core.mode("encoder_report")
+            or self.chassis_port.drives()
         ):
             return False
         last = self._last_tick(due)
@@ -236,7 +246,8 @@ class Board:
         event: a record of the same millisecond comes after its tick, a copy or a burst
         before."""
         telemetry = self.telemetry
-        return min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
+        last = min(due, telemetry.record_ms, self._copy_ms - 1, telemetry.burst_ms - 1)
+        return self.chassis_port.last_tick(last)
 
     def _steps(self, due: int) -> bool:
         """Run at once the control ticks up to the next other event (by `due`) on a board
@@ -283,10 +294,16 @@ class Board:
         self.advance(now)
         return _taken(self.core.out2)
 
-    def poll_ports(self, now: float) -> tuple[bytes, bytes]:
-        """What `poll` and `poll_uart2` give, in one run of the board."""
+    def poll_ports(self, now: float) -> tuple[bytes, bytes, bytes]:
+        """What `poll` and `poll_uart2` give, and the chassis port's status frames, in one
+        run of the board."""
         self.advance(now)
-        return _taken(self.core.out3), _taken(self.core.out2)
+        return _taken(self.core.out3), _taken(self.core.out2), _taken(self.chassis_port.out)
+
+    def receive_chassis(self, data: bytes, now: float) -> None:
+        """Apply bytes that arrived on the chassis port at `now` (§15)."""
+        self.advance(now)
+        self.chassis_port.receive(data, now)
 
     def take_notes(self) -> list[Note]:
         notes = list(self.core.notes)
@@ -303,6 +320,8 @@ class Board:
         speed = core.max_speed
         if 0 < speed < profile.stall_speed:
             core.params[params.MAX_SPEED] = speed = float(profile.stall_speed)
+        if self.chassis_port.drive(ticks, TICK, at_once):
+            return
         if core.uart2_control and profile.firmware_uart2:
             self._drive_firmware_uart2(ticks)
             return

@@ -17,6 +17,7 @@ from appmode.board.names import PROFILE_NAMES
 from appmode.errors import AppmodeError
 from appmode.files import read_limited
 from appmode.protocol import layouts, params, profile_file
+from appmode.protocol.chassis_profile import ChassisSpec
 from appmode.protocol.directions import BUTTON_PAGE, MOTIONS, Motion
 from appmode.protocol.layouts import SCALED, VELOCITY, Layout
 from appmode.protocol.params import DriveType
@@ -131,6 +132,11 @@ class Profile:
     def velocity_si(self) -> tuple[float, float]:
         """What one velocity unit is: m/s of x and y, rad/s of z (its profile file's)."""
         return self.a_layout.profile.velocity_si
+
+    @property
+    def chassis(self) -> ChassisSpec | None:
+        """A WHEELTEC board's chassis port, or None: the board has none."""
+        return self.file.chassis if self.file is not None else None
 
     @property
     def fixed_drive(self) -> DriveType | None:

@@ -128,6 +128,17 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         metavar="DEV",
         help="serve UART2 on a real serial port (?baud=N to change 115200)",
     )
+    where3 = board.add_mutually_exclusive_group()
+    where3.add_argument(
+        "--listen-chassis",
+        metavar="HOST:PORT",
+        help="serve a WHEELTEC profile's chassis port on TCP (default: a pseudo-terminal)",
+    )
+    where3.add_argument(
+        "--port-chassis",
+        metavar="DEV",
+        help="serve the chassis port on a real serial port (?baud=N to change 115200)",
+    )
     board.add_argument(
         "--nus",
         action="store_true",
@@ -159,23 +170,32 @@ def run(args: argparse.Namespace) -> int:
         args.record,
         args.listen2,
         args.port2,
+        args.listen_chassis,
+        args.port_chassis,
         args.foxglove,
     )
     if args.count > 1 and any(option is not None for option in alone):
         raise AppmodeError(
             "--count serves several boards on ptys: it cannot be combined "
-            "with --listen, --port, --bluetooth, --advertise, --listen2, --port2, --link, "
-            "--flash, --record or --foxglove"
+            "with --listen, --port, --bluetooth, --advertise, --listen2, --port2, "
+            "--listen-chassis, --port-chassis, --link, --flash, --record or --foxglove"
         )
     if (args.nus or args.allow or args.secure) and args.advertise is None:
         raise AppmodeError(
             "--nus, --allow and --secure are options of --advertise: add --advertise [NAME]"
         )
+    profile = profile_named(args.profile)
+    if profile.chassis is None and (args.listen_chassis or args.port_chassis):
+        raise AppmodeError(
+            f"the {profile.name} profile's board has no chassis port: add --profile "
+            "wheeltec-mec (or wheeltec-akm, wheeltec-diff)"
+        )
     options = ServeOptions(
         app=_app_endpoint(args),
         uart2=_uart2_endpoint(args),
+        chassis=_chassis_endpoint(args) if profile.chassis is not None else None,
         count=args.count,
-        profile=profile_named(args.profile),
+        profile=profile,
         drive=DriveType.from_cli_name(args.drive) if args.drive else None,
         flash=args.flash,
         pace=not args.no_pace,
@@ -247,3 +267,16 @@ def _uart2_endpoint(args: argparse.Namespace) -> MakeEndpoint:
         return partial(endpoints.SerialEndpoint, device=args.port2, baud=UART2_BAUD)
     link = f"{args.link}.uart2" if args.link else None  # the control port's stable name
     return partial(endpoints.PtyEndpoint, link=link, baud=UART2_BAUD if args.baud else None)
+
+
+def _chassis_endpoint(args: argparse.Namespace) -> MakeEndpoint:
+    from appmode.line.wire import CHASSIS_BAUD
+    from appmode.ports import endpoints
+
+    if args.listen_chassis is not None:
+        host, port = endpoints.parse_listen(args.listen_chassis, "--listen-chassis")
+        return partial(endpoints.TcpEndpoint, host=host, port=port, baud=None)
+    if args.port_chassis is not None:
+        return partial(endpoints.SerialEndpoint, device=args.port_chassis, baud=CHASSIS_BAUD)
+    link = f"{args.link}.chassis" if args.link else None  # the chassis port's stable name
+    return partial(endpoints.PtyEndpoint, link=link, baud=CHASSIS_BAUD if args.baud else None)

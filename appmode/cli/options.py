@@ -50,6 +50,15 @@ def add_uart2(parser: argparse.ArgumentParser, what: str) -> None:
     )
 
 
+def add_chassis(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument(
+        "--chassis",
+        action="store_true",
+        help=f"{what}: a WHEELTEC ROS car's chassis port (7B … 7D frames at 115200 bps; "
+        "--profile wheeltec-mec by default); a sim:// URL opens the simulated board's",
+    )
+
+
 def file_name(text: str) -> str:
     """A file argument: an empty one would be taken for none, and nothing written."""
     if not text.strip():
@@ -66,7 +75,14 @@ def add_record(parser: argparse.ArgumentParser) -> None:
     )
 
 
-SHIPPED_PROFILES = ("sheet", "minibalance", "balance")
+SHIPPED_PROFILES = (
+    "sheet",
+    "minibalance",
+    "balance",
+    "wheeltec-mec",
+    "wheeltec-akm",
+    "wheeltec-diff",
+)
 """The profiles appmode ships (profile_file.SHIPPED, which checks it): named here so the
 command line offers them without loading them."""
 HOLDS = (
@@ -168,6 +184,7 @@ def board_choice(
         profile=getattr(args, "profile", None),
         drive=getattr(args, "drive_type", None),
         both=both,
+        chassis=getattr(args, "chassis", False),
     )
 
 

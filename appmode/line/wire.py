@@ -36,13 +36,15 @@ def every(*taps: Tap | None) -> Tap | None:
     return tap
 
 
-APP, UART2 = "app", "uart2"
-PORTS = (APP, UART2)
+APP, UART2, CHASSIS = "app", "uart2", "chassis"
+PORTS = (APP, UART2, CHASSIS)
+"""A board's ports, in the order `Board.next_sends` gives them."""
 APP_BAUD = 9600
 UART2_BAUD = 115200
+CHASSIS_BAUD = 115200
 MAX_LAG = 1.0
 """Seconds behind after which the board catches up in one step instead of slot by slot."""
-MAX_BACKLOG = {APP: APP_BAUD // 10, UART2: UART2_BAUD // 10}
+MAX_BACKLOG = {APP: APP_BAUD // 10, UART2: UART2_BAUD // 10, CHASSIS: CHASSIS_BAUD // 10}
 """Bytes queued to the host (1 s of the line) beyond which new bytes are dropped."""
 
 
@@ -68,9 +70,11 @@ class Wire:
         baud2: int | None = UART2_BAUD,
     ) -> None:
         self.board = board
+        chassis = CHASSIS_BAUD if baud2 is not None else None
         self.ports = {
             APP: Port(Line(baud), Line(baud), ">", "<"),
             UART2: Port(Line(baud2), Line(baud2), "2>", "2<"),
+            CHASSIS: Port(Line(chassis), Line(chassis), "c>", "c<"),
         }
         self.tap = tap
 
@@ -106,11 +110,11 @@ class Wire:
         self.run(now)
         return self.ports[port].to_host.take_timed(now)
 
-    def run(self, now: float) -> tuple[float, float]:
+    def run(self, now: float) -> tuple[float, float, float]:
         """Run the board to `now`: its input delivered, what it sends on the lines. When
         the board next sends on each port (`Board.next_sends`), as it stands after."""
         board = self.board
-        to_app, to_uart2 = self.ports[APP].to_board, self.ports[UART2].to_board
+        inputs = [port.to_board for port in self.ports.values()]
         sends = board.next_sends()
         slot = min(sends)
         if now - slot > MAX_LAG:  # stalled (suspend, debugger): catch up at once
@@ -119,22 +123,20 @@ class Wire:
             sends = board.next_sends()
             slot = min(sends)
         while slot <= now:
-            if to_app.bursts or to_uart2.bursts:
+            if any(line.bursts for line in inputs):
                 self._deliver(slot)
             self._send(slot)
             sends = board.next_sends()
             slot = min(sends)
-        if to_app.bursts or to_uart2.bursts:
+        if any(line.bursts for line in inputs):
             self._deliver(now)
             sends = board.next_sends()  # what came may ask for a reply
         return sends
 
     def _send(self, when: float) -> None:
-        app, uart2 = self.board.poll_ports(when)
-        if app:
-            self._queue(APP, app, when)
-        if uart2:
-            self._queue(UART2, uart2, when)
+        for name, data in zip(PORTS, self.board.poll_ports(when), strict=True):
+            if data:
+                self._queue(name, data, when)
 
     def _queue(self, name: str, data: bytes, when: float) -> None:
         """What the board sent on port `name` at `when` goes on the line to the host."""
@@ -148,22 +150,17 @@ class Wire:
         line.push(data, when)
 
     def _deliver(self, now: float) -> None:
-        to_app, to_uart2 = self.ports[APP].to_board, self.ports[UART2].to_board
-        app = to_app.take_timed(now) if to_app.bursts else []
-        uart2 = to_uart2.take_timed(now) if to_uart2.bursts else []
-        if not uart2:
-            for when, data in app:
-                self.board.receive(data, when)
-            return
-        merged = sorted(
-            [(when, 0, data) for when, data in app] + [(when, 1, data) for when, data in uart2],
-            key=lambda item: (item[0], item[1]),
-        )
-        for when, which, data in merged:
-            if which:
-                self.board.receive_uart2(data, when)
-            else:
-                self.board.receive(data, when)
+        board = self.board
+        takers = (board.receive, board.receive_uart2, board.receive_chassis)
+        arrived = [
+            (when, which, data)
+            for which, port in enumerate(self.ports.values())
+            if port.to_board.bursts
+            for when, data in port.to_board.take_timed(now)
+        ]
+        arrived.sort(key=lambda item: (item[0], item[1]))  # the ports' bytes in time order
+        for when, which, data in arrived:
+            takers[which](data, when)
 
     def next_wakeup(self) -> float:
         """The next time `pump` has something to do."""

@@ -12,10 +12,10 @@ import math
 from dataclasses import dataclass
 
 from appmode.line.faults import Faults
-from appmode.line.wire import APP, PORTS, UART2, Wire
+from appmode.line.wire import APP, CHASSIS, PORTS, UART2, Wire
 from appmode.ports.endpoints import Endpoint
 
-RUN = {APP: 0.004, UART2: 0.002}
+RUN = {APP: 0.004, UART2: 0.002, CHASSIS: 0.002}
 """Seconds of wire time written at most at once to a paced client: bytes trickle in as
 from a real UART (a C record over 32 ms at 9600 bps), not a record at a time. On UART2
 a burst shorter than a run (a read's 6-byte reply, due in its 10 ms tick, §11) is
@@ -41,7 +41,7 @@ class Served:
     board_due: float = -math.inf
     """When the board itself next has something to do, as `wakeup` last found: before
     then a pump only writes what its lines deliver."""
-    sends: tuple[float, float] | None = None
+    sends: tuple[float, float, float] | None = None
     """When the board next sends on each port, as it said since it last ran; None: to
     be asked (`changed`)."""
 
@@ -66,7 +66,7 @@ class Served:
         """(index in `sends`, name, run, the grid's offset, port) of each port served."""
         self._outputs = tuple((ports[name].to_host, e) for name, e in self.endpoints.items())
         """(line to the host, endpoint) of each port served."""
-        self._inputs = ports[APP].to_board, ports[UART2].to_board
+        self._inputs = tuple(port.to_board for port in ports.values())
 
     def wakeup(self) -> float:
         """When this board next has something to do. On a paced line that is a point of a
@@ -77,8 +77,7 @@ class Served:
         sends = self.sends
         if sends is None:  # the board ran: else its plans are as they were
             sends = self.sends = wire.board.next_sends()
-        app, uart2 = sends
-        self.board_due = app if app < uart2 else uart2
+        self.board_due = min(sends)
         due = inf = math.inf
         for index, name, run, offset, port in self._grid:
             to_host, to_board = port.to_host, port.to_board
@@ -110,8 +109,7 @@ class Served:
     def pump(self, now: float) -> bool:
         """Write what the lines deliver by `now`, running the board first when it is due
         or has input; whether it ran (else it made no notes and its input is as it was)."""
-        to_app, to_uart2 = self._inputs
-        ran = now >= self.board_due or bool(to_app.bursts or to_uart2.bursts)
+        ran = now >= self.board_due or any(line.bursts for line in self._inputs)
         if ran:
             self.sends = self.wire.run(now)
         faults = self.faults
@@ -133,10 +131,7 @@ class Served:
 
     def throttle(self) -> None:
         """Read no more while INPUT_BACKLOG bytes wait for the simulated line."""
-        ports = self.wire.ports
-        if not (
-            ports[APP].to_board.bursts or ports[UART2].to_board.bursts or any(self.paused.values())
-        ):
+        if not (any(line.bursts for line in self._inputs) or any(self.paused.values())):
             return  # nothing waits, nothing is paused
         for name, endpoint in self.endpoints.items():
             full = len(self.wire.ports[name].to_board) >= INPUT_BACKLOG

@@ -26,7 +26,7 @@ from appmode.board.profiles import SHEET, Profile, board_line
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import Faults, FaultSpec
-from appmode.line.wire import APP, UART2, UART2_BAUD, Tap, Wire, every
+from appmode.line.wire import APP, CHASSIS, UART2, UART2_BAUD, Tap, Wire, every
 from appmode.ports.endpoints import Endpoint, Log, MakeEndpoint
 from appmode.ports.recording import open_recorder
 from appmode.ports.schedule import INPUT_BACKLOG, Served
@@ -61,6 +61,7 @@ class BoardServer:
         record: str | None = None,
         directives: tuple[str, ...] = (),
         make_uart2: list[MakeEndpoint] | None = None,
+        make_chassis: list[MakeEndpoint] | None = None,
         faults: FaultSpec | None = None,
         view: Tap | None = None,
     ) -> None:
@@ -83,7 +84,8 @@ class BoardServer:
         self._sel.register(self._wake_read, selectors.EVENT_READ, None)
         self._origin = time.monotonic()
         try:
-            self._open(make_endpoints, boards, pace, record, directives, make_uart2, view)
+            seconds = {UART2: make_uart2, CHASSIS: make_chassis}
+            self._open(make_endpoints, boards, pace, record, directives, seconds, view)
         except BaseException:
             self.close()
             raise
@@ -95,16 +97,17 @@ class BoardServer:
         pace: bool,
         record: str | None,
         directives: tuple[str, ...],
-        make_uart2: list[MakeEndpoint] | None,
+        others: dict[str, list[MakeEndpoint] | None],
         view: Tap | None,
     ) -> None:
         pairs: list[dict[str, Endpoint]] = []
         for i, make in enumerate(make_endpoints):
             pair = {APP: make(self._sel, self.log)}
             self._endpoints.append(pair[APP])
-            if make_uart2 is not None:
-                pair[UART2] = make_uart2[i](self._sel, self.log)
-                self._endpoints.append(pair[UART2])
+            for name, makers in others.items():
+                if makers is not None:
+                    pair[name] = makers[i](self._sel, self.log)
+                    self._endpoints.append(pair[name])
             pairs.append(pair)
         self._recorder = (
             open_recorder(
@@ -307,6 +310,8 @@ class ServeOptions:
     """Opens each board's APP port."""
     uart2: MakeEndpoint
     """Opens each board's control port."""
+    chassis: MakeEndpoint | None = None
+    """Opens each board's chassis port (a WHEELTEC profile's board)."""
     count: int = 1
     profile: Profile = SHEET
     drive: DriveType | None = None
@@ -326,6 +331,13 @@ class ServeOptions:
         if profile.file is not None:
             saves = f"flash {self.flash or 'in memory'}" if profile.saves else "saves nothing"
             body = f"{saves}, its records and parameters only: no physics for this profile"
+            if profile.chassis is not None:
+                spec = profile.chassis
+                stops = f"{spec.timeout_ms} ms" if spec.timeout_ms else "never"
+                body = (
+                    f"{saves}, a {spec.kind} chassis (boot {spec.boot_ms / 1000:g} s, "
+                    f"stops without frames after: {stops})"
+                )
         elif profile.drive_types:
             body = f"{drive.cli_name} drive, flash {self.flash or 'in memory'}"
         else:
@@ -365,6 +377,7 @@ def run_board(options: ServeOptions, view: Tap | None = None) -> int:
             record=options.record,
             directives=options.directives,
             make_uart2=[options.uart2] * options.count,
+            make_chassis=[options.chassis] * options.count if options.chassis else None,
             view=view,
         )
         try:

@@ -30,7 +30,7 @@ from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec, FaultyLine
 from appmode.line.pacing import Line
-from appmode.line.wire import APP, UART2, UART2_BAUD, Wire
+from appmode.line.wire import APP, CHASSIS, UART2, UART2_BAUD, Wire
 from appmode.ports.modemless import Modemless
 from appmode.ports.target import SIM_USAGE, Target
 from appmode.ports.urls import port_target
@@ -120,6 +120,11 @@ class SimSerial(Modemless):
             profile.check(drive=drive is not None, flash="flash" in options)
         except AppmodeError as exc:
             raise SerialException(f"sim:// option profile: {exc}") from None
+        if side == CHASSIS and profile.chassis is None:
+            raise SerialException(
+                f"sim:// port=chassis: the {profile.name} profile's board has no chassis "
+                "port (profile=wheeltec-mec, wheeltec-akm or wheeltec-diff has)"
+            )
         if "baud" in options:
             baud = params.whole(options["baud"])
             if baud is None or not MIN_BAUD <= baud <= MAX_BAUD:
@@ -127,7 +132,7 @@ class SimSerial(Modemless):
                     f"sim:// option baud={options['baud']!r}: use a number in {MIN_BAUD}–{MAX_BAUD}"
                 )
             self._baudrate = baud
-        elif side == UART2:
+        elif side in (UART2, CHASSIS):
             self._baudrate = UART2_BAUD
         pace = _flag("pace", options.get("pace", "1"))
         try:

@@ -54,6 +54,7 @@ def text_value(
     problem: Callable[[str], None],
     inherited: str | None = None,
     pattern: bool = False,
+    dashes: bool = False,
 ) -> str | None:
     value = data.get(key, inherited)
     if value is None:
@@ -65,8 +66,10 @@ def text_value(
     if not plain(value):
         problem(f"{key} = {value!r}: a line of at most {MAX_TEXT} characters, no control ones")
         return None
-    if pattern and not (value[0].isalpha() and set(value) <= NAME_CHARACTERS):
-        problem(f"{key} = {value!r}: lower-case letters, digits and _, a letter first")
+    allowed = NAME_CHARACTERS | {"-"} if dashes else NAME_CHARACTERS
+    if pattern and not (value[0].isalpha() and value[-1] != "-" and set(value) <= allowed):
+        kinds = "lower-case letters, digits, _" + (" and -" if dashes else "")
+        problem(f"{key} = {value!r}: {kinds}, a letter first")
         return None
     return value
 

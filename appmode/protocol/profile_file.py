@@ -14,6 +14,7 @@ import sys
 from collections.abc import Callable, Mapping
 from functools import cache
 
+from appmode.protocol.chassis_profile import ChassisSpec, chassis_spec
 from appmode.protocol.profile_checks import (
     SCALE_TEXT,
     in_scales,
@@ -31,7 +32,7 @@ if TYPE_CHECKING:
 else:
     from appmode.protocol.tuples import NamedTuple
 
-SHIPPED = ("sheet", "minibalance", "balance")
+SHIPPED = ("sheet", "minibalance", "balance", "wheeltec-mec", "wheeltec-akm", "wheeltec-diff")
 """The profiles appmode ships, in the order `profile list` shows them (the command line's
 options.SHIPPED_PROFILES names them too: a test keeps the two equal)."""
 MAX_SIZE = 256_000
@@ -108,6 +109,8 @@ class ProfileFile(NamedTuple):
     velocity_si: tuple[float, float]
     """What one velocity unit is: metres a second of x and y, radians a second of z
     (WHEELTEC's firmware counts mm/s and mrad/s: 0.001 each, the default)."""
+    chassis: ChassisSpec | None
+    """A WHEELTEC board's chassis port (`7B … 7D` frames), or None: it has none."""
     path: str
     """Where it was read from (a file's path, or a shipped profile's name)."""
     text: str
@@ -168,7 +171,7 @@ def parse(
 TOP = {
     "name", "description", "source", "like", "baud", "period_ms", "control_port", "saves",
     "replies", "pages", "speed_keys", "records", "params", "defaults", "boot", "speed_param",
-    "velocity_si",
+    "velocity_si", "chassis",
 }  # fmt: skip
 SI_DEFAULT = (0.001, 0.001)
 """A velocity unit, when a profile does not say: mm/s and mrad/s, as WHEELTEC counts."""
@@ -181,7 +184,7 @@ def _build(
 ) -> ProfileFile | None:
     for key in sorted(set(data) - TOP):
         problem(f"unknown key {key!r}: the keys are {', '.join(sorted(TOP))}")
-    name = text_value(data, "name", problem, pattern=True)
+    name = text_value(data, "name", problem, pattern=True, dashes=True)
     description = text_value(data, "description", problem, base.description if base else None)
     source = text_value(data, "source", problem, base.source if base else None)
     baud = data.get("baud", base.baud if base else 9600)
@@ -229,6 +232,7 @@ def _build(
     if speed_param is not None and params is not None and speed_param not in names:
         problem(f"speed_param = {speed_param!r}: name one of the parameters ({', '.join(names)})")
     velocity_si = _velocity_si(data, base, problem)
+    chassis = chassis_spec(data, base.chassis if base else None, problem)
     if not isinstance(name, str) or a is None or b is None or params is None:
         return None
     return ProfileFile(
@@ -248,6 +252,7 @@ def _build(
         speed_param,
         boot,
         velocity_si,
+        chassis,
         where,
         "",
     )

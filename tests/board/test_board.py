@@ -428,7 +428,7 @@ def test_poll_ports_is_poll_then_poll_uart2(inputs: list[tuple[float, bytes]]) -
         now += gap
         one.receive(data, now)
         twin.receive(data, now)
-        assert one.poll_ports(now) == (twin.poll(now), twin.poll_uart2(now))
+        assert one.poll_ports(now) == (twin.poll(now), twin.poll_uart2(now), b"")
 
 
 @pytest.mark.parametrize("target", [(0.0, 300.0, 0.0), (-0.0, -120.5, 40.0), (250.0, 0.0, -0.0)])

@@ -312,7 +312,7 @@ def test_each_port_plans_only_what_it_sends() -> None:
     reports (and records in APP mode)."""
     board = Board(drive=DriveType.MECANUM)
     board.poll(0.0)
-    uart3, uart2 = board.next_sends()
+    uart3, uart2, _ = board.next_sends()
     assert uart3 > 0 and uart2 == float("inf"), "no report, no read: UART2 plans nothing"
     board.receive_uart2(encode(control.read("max_speed")), 0.001)
     assert board.next_sends()[1] == 0.01, "a read: its reply in the next tick"
@@ -321,7 +321,7 @@ def test_each_port_plans_only_what_it_sends() -> None:
     assert board.next_sends()[1] == 0.05, "the next report, on the 50 ms grid"
     set_setting(board, "system_mode", 1 | params.MODE_BIT["app_mode"], 0.02)
     board.poll(0.03)
-    uart3, uart2 = board.next_sends()
+    uart3, uart2, _ = board.next_sends()
     assert uart3 == float("inf") and uart2 < 0.2, "APP mode: records on UART2, UART3 idle"
     assert board.next_slot() == uart2
 

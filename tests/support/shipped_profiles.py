@@ -34,7 +34,7 @@ def render() -> str:
     texts = {name: (FOLDER / f"{name}.toml").read_text(encoding="utf-8") for name in SHIPPED}
     data = {name: tomllib.loads(text) for name, text in texts.items()}
     shown = {
-        name: pprint.pformat(value, width=100, sort_dicts=False)
+        name: pprint.pformat(value, width=160, sort_dicts=False)
         for name, value in (("texts", texts), ("data", data))
     }
     return (
