@@ -13,11 +13,18 @@ import threading
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from appmode.protocol import app, control
+from appmode.protocol import app, chassis, control
 from appmode.protocol.control_view import view
 from appmode.protocol.layouts import Layout
 from appmode.protocol.odometry import Odometry, Pose2D
-from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2
+from appmode.protocol.reader import (
+    RECEIVED,
+    RECEIVED2,
+    RECEIVED_CHASSIS,
+    SENT,
+    SENT2,
+    SENT_CHASSIS,
+)
 from appmode.protocol.twist import Twist
 
 POSE_FRAME = "odom"
@@ -29,6 +36,8 @@ RAW = {
     "<": "/raw/app/received",
     "2>": "/raw/uart2/sent",
     "2<": "/raw/uart2/received",
+    "c>": "/raw/chassis/sent",
+    "c<": "/raw/chassis/received",
 }
 """Each direction's raw channel: a message a unit, its bytes as they went."""
 
@@ -77,6 +86,20 @@ TRANSFORM_SCHEMA = {
 }
 
 
+_TRIPLE = {"type": "array", "items": {"type": "number"}}
+CHASSIS_STATUS = {
+    "type": "object",
+    "properties": {
+        "forward": {"type": "number", "description": "m/s"},
+        "left": {"type": "number", "description": "m/s"},
+        "turn": {"type": "number", "description": "rad/s counter-clockwise"},
+        "flag_stop": {"type": "integer", "description": "1: booting, or stopped by the board"},
+        "acceleration": {**_TRIPLE, "description": "m/s², x forward, y left, z up"},
+        "angular_velocity": {**_TRIPLE, "description": "rad/s about x, y, z"},
+        "volts": {"type": "number", "description": "the battery, V"},
+        "raw": {"type": "string"},
+    },
+}
 _WHEELS = {"type": "array", "items": {"type": "integer"}}
 ENCODERS = {
     "type": "object",
@@ -102,6 +125,10 @@ def channels(layout: Layout) -> dict[str, ChannelSpec]:
         ChannelSpec("/uart2/commands", "appmode.event", OBJECT, "control-port frames sent"),
         ChannelSpec("/uart2/replies", "appmode.event", OBJECT, "control-port replies"),
         ChannelSpec("/uart2/encoders", "appmode.encoders", ENCODERS, "encoder reports"),
+        ChannelSpec("/chassis/commands", "appmode.event", OBJECT, "chassis frames sent"),
+        ChannelSpec(
+            "/chassis/status", "appmode.chassis.status", CHASSIS_STATUS, "chassis status in SI"
+        ),
         ChannelSpec("/pose", "foxglove.PoseInFrame", POSE_SCHEMA, "dead reckoning"),
         ChannelSpec("/tf", "foxglove.FrameTransform", TRANSFORM_SCHEMA, "dead reckoning"),
     ]
@@ -120,6 +147,8 @@ class Decoded:
 
     def unit(self, time: float, direction: str, event: Any) -> list[tuple[str, dict[str, Any]]]:
         """The messages one decoded unit makes (`time`: seconds, the session's)."""
+        if direction in (SENT_CHASSIS, RECEIVED_CHASSIS):
+            return self._chassis(time, direction, event)
         body = view(event, self.layout)[0]
         if direction == SENT:
             return [("/app/commands", body)]
@@ -138,6 +167,22 @@ class Decoded:
             pose = self._pose(time, values)
             found += [("/pose", pose_message(pose, time)), ("/tf", transform(pose, time))]
         return found
+
+    def _chassis(
+        self, time: float, direction: str, event: chassis.Event
+    ) -> list[tuple[str, dict[str, Any]]]:
+        """A chassis port's frame in SI; a status frame also moves the pose."""
+        body = chassis.as_json(event)
+        if direction == SENT_CHASSIS:
+            return [("/chassis/commands", body)]
+        if not isinstance(event, chassis.Status):
+            return [("/app/other", body)]
+        pose = self.odometry.step(time, event.twist)
+        return [
+            ("/chassis/status", body),
+            ("/pose", pose_message(pose, time)),
+            ("/tf", transform(pose, time)),
+        ]
 
     def _scaled(self, letter: str, values: tuple[int, ...], raw: bytes) -> dict[str, Any]:
         """A record's values in the user's units (each field's value over its scale)."""

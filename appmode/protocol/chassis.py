@@ -251,14 +251,21 @@ class StatusDecoder(_Finder[Status]):
         return _status_of(raw)
 
 
+JSON_KEYS = (
+    "kind", "forward", "left", "turn", "mode", "reserved", "flag_stop", "acceleration",
+    "angular_velocity", "volts", "reason", "raw",
+)  # fmt: skip
+"""Every key `as_json` writes, in the order a table (CSV) shows them."""
+
+
 def as_json(event: Event) -> dict[str, object]:
     """An event as `appmode decode --chassis` writes it: SI units, the bytes in hex."""
     raw = event.raw.hex(" ")
     if isinstance(event, Junk):
-        return {"type": "junk", "reason": event.reason, "raw": raw}
+        return {"kind": "garbage", "reason": event.reason, "raw": raw}
     moving = event.twist
     out: dict[str, object] = {
-        "type": "command" if isinstance(event, Command) else "status",
+        "kind": "chassis_command" if isinstance(event, Command) else "chassis_status",
         "forward": moving.forward,
         "left": moving.left,
         "turn": moving.turn,

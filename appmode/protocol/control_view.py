@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from appmode.protocol import app, control, render, settings
+from appmode.protocol import app, chassis, control, render, settings
 from appmode.protocol.layouts import VELOCITY, Layout
 
 EVENTS = (
@@ -113,10 +113,14 @@ def settings_table(values: dict[str, int]) -> str:
 
 
 def view(
-    event: app.Event | control.HostEvent | control.BoardEvent, layout: Layout = VELOCITY
+    event: app.Event | control.HostEvent | control.BoardEvent | chassis.Event,
+    layout: Layout = VELOCITY,
 ) -> tuple[dict[str, Any], str, str | None]:
-    """An event of either port for people and machines: its JSON body, its
-    description, and how to show its bytes (hex pairs on UART2; None: escaped text)."""
+    """An event of any port for people and machines: its JSON body, its description,
+    and how to show its bytes (hex pairs on UART2 and a chassis port; None: escaped
+    text)."""
+    if isinstance(event, (chassis.Command, chassis.Status, chassis.Junk)):
+        return chassis.as_json(event), str(event), event.raw.hex(" ").upper()
     if isinstance(event, EVENTS):
         shown = hex_text(event.raw)
         return to_json(event), describe(event), shown

@@ -29,6 +29,7 @@ from appmode.protocol.channels import RAW, Decoded, channels
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.transcript import (
+    CHASSIS_DIRECTIONS,
     DIRECTIONS,
     TIME_DIGITS,
     UART2_DIRECTIONS,
@@ -69,7 +70,11 @@ class RawChannel:
         return RAW[self.direction] + suffix
 
 
-RAW_CHANNELS = tuple(RawChannel(d, form) for d in DIRECTIONS for form in ("", "as_text", "pattern"))
+RAW_CHANNELS = tuple(
+    RawChannel(d, form)
+    for d in DIRECTIONS
+    for form in (("", "pattern") if d in CHASSIS_DIRECTIONS else ("", "as_text", "pattern"))
+)
 BY_TOPIC = {channel.topic: channel for channel in RAW_CHANNELS}
 LINE_TOPICS = {*BY_TOPIC, COMMENTS, DIRECTIVES}
 """The channels a transcript's lines are on (the rest are views of them)."""
@@ -228,6 +233,8 @@ def is_pattern(entry: Entry) -> bool:
 def _form(entry: Entry) -> str:
     """How `entry`'s bytes show in a transcript: "" as the format writes bytes, "as_text"
     (UART2 APP text), or "pattern" when no bytes stand for its text."""
+    if entry.direction in CHASSIS_DIRECTIONS:
+        return "" if entry.text == entry.data.hex(" ").upper() else "pattern"
     if entry.direction in UART2_DIRECTIONS:
         if entry.text == uart2_payload(entry.data, False):
             return ""
@@ -375,7 +382,9 @@ def entry_of(topic: str, data: bytes, ns: int, lineno: int, where: str) -> Entry
     time = ns / NS
     if channel.form == "pattern":
         return parse_entry(f"{time} {channel.direction} {data.decode()}", lineno, where)
-    if channel.direction in UART2_DIRECTIONS:
+    if channel.direction in CHASSIS_DIRECTIONS:
+        payload = data.hex(" ").upper()
+    elif channel.direction in UART2_DIRECTIONS:
         payload = uart2_payload(data, channel.form == "as_text")
     else:
         payload = escape(data)

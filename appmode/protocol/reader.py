@@ -1,4 +1,4 @@
-"""Both ports of one board read together, with no I/O (docs/protocol.md §8–§12).
+"""A board's ports read together, with no I/O (docs/protocol.md §8–§12, §15).
 
 UART2's grammar depends on the board's state: the drive type fixes the length of motor
 frames and encoder reports, and system_mode bit 7 (APP mode) turns it into APP text. A
@@ -8,18 +8,21 @@ system_mode setting), from the moment it is sent, and decodes every direction.
 
 from __future__ import annotations
 
-from appmode.protocol import app, app_decoders, control, control_decoders, params
+from appmode.protocol import app, app_decoders, chassis, control, control_decoders, params
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
 
 SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
-Event = app.Event | control.HostEvent | control.BoardEvent
+SENT_CHASSIS, RECEIVED_CHASSIS = "c>", "c<"
+"""A WHEELTEC board's chassis port (§15): velocity frames in, status frames out."""
+Event = app.Event | control.HostEvent | control.BoardEvent | chassis.Event
 APP_EVENTS = app.Event
 """The events of APP text: on UART2, what APP mode carries (§12)."""
 
 
 class PortsReader:
-    """Decoders for `>`, `<`, `2>` and `2<`, kept in step with the board's system_mode."""
+    """Decoders for `>`, `<`, `2>` and `2<`, kept in step with the board's system_mode,
+    and for the chassis port's `c>` and `c<`."""
 
     def __init__(
         self, system_mode: int = 0, drive: DriveType | None = None, layout: Layout = VELOCITY
@@ -28,6 +31,10 @@ class PortsReader:
         self.board = layout.board_decoder()
         self.host2 = control_decoders.FrameDecoder()
         self.board2 = control_decoders.ReplyDecoder()
+        self.chassis: dict[str, chassis.CommandDecoder | chassis.StatusDecoder] = {
+            SENT_CHASSIS: chassis.CommandDecoder(),
+            RECEIVED_CHASSIS: chassis.StatusDecoder(),
+        }
         self.app_mode = False
         self.follow(system_mode if drive is None else system_mode & ~7 | int(drive))
 
@@ -49,6 +56,8 @@ class PortsReader:
             return [(RECEIVED, e) for e in self.board.feed(data)]
         if direction == RECEIVED2:
             return [(RECEIVED2, e) for e in self.board2.feed(data)]
+        if direction in self.chassis:
+            return [(direction, e) for e in self.chassis[direction].feed(data)]
         decoder = self.host if direction == SENT else self.host2
         out: list[tuple[str, Event]] = []
         for event in decoder.feed(data):
@@ -64,4 +73,6 @@ class PortsReader:
         out += [(RECEIVED, e) for e in self.board.flush()]
         out += [(SENT2, e) for e in self.host2.flush()]
         out += [(RECEIVED2, e) for e in self.board2.flush()]
+        for direction, decoder in self.chassis.items():
+            out += [(direction, e) for e in decoder.flush()]
         return out

@@ -12,6 +12,7 @@ from appmode.errors import AppmodeError
 from appmode.protocol.escaping import escape
 from appmode.protocol.reader import APP_EVENTS, Event, PortsReader
 from appmode.protocol.transcript import (
+    CHASSIS_DIRECTIONS,
     DIRECTIONS,
     HEADER,
     TIME_DIGITS,
@@ -91,7 +92,10 @@ class TextLines:
         return "".join([HEADER + "\n", *(f"@{d}\n" for d in directives)])
 
     def line(self, time: float, raw: bytes, direction: str, text: bool, event: Any = None) -> str:
-        payload = uart2_payload(raw, text) if direction in UART2_DIRECTIONS else escape(raw)
+        if direction in CHASSIS_DIRECTIONS:
+            payload = raw.hex(" ").upper()
+        else:
+            payload = uart2_payload(raw, text) if direction in UART2_DIRECTIONS else escape(raw)
         return f"{time:.{TIME_DIGITS}f} {direction} {payload}\n"
 
     def comment(self, time: float, text: str) -> str:

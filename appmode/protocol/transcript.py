@@ -11,7 +11,14 @@ from typing import BinaryIO
 
 from appmode.errors import AppmodeError
 from appmode.protocol.escaping import escape, unescape
-from appmode.protocol.reader import RECEIVED, RECEIVED2, SENT, SENT2
+from appmode.protocol.reader import (
+    RECEIVED,
+    RECEIVED2,
+    RECEIVED_CHASSIS,
+    SENT,
+    SENT2,
+    SENT_CHASSIS,
+)
 
 HEADER = "# appmode transcript v1"
 SUFFIX = ".transcript"
@@ -22,8 +29,11 @@ TIME_DIGITS = 4
 """A line's time is written to 0.1 ms."""
 MAX_LINE = 64 * 1024
 """Bytes a line may have: a recorded line is one command or record, well under this."""
-DIRECTIONS = (SENT, RECEIVED, SENT2, RECEIVED2)
+DIRECTIONS = (SENT, RECEIVED, SENT2, RECEIVED2, SENT_CHASSIS, RECEIVED_CHASSIS)
 UART2_DIRECTIONS = (SENT2, RECEIVED2)
+CHASSIS_DIRECTIONS = (SENT_CHASSIS, RECEIVED_CHASSIS)
+"""A WHEELTEC board's chassis port (§15): its lines are hex pairs, always."""
+HEX_DIRECTIONS = UART2_DIRECTIONS + CHASSIS_DIRECTIONS
 HEX_LINE = re.compile(r"(?:[0-9A-F]{2}|\?\?)(?: (?:[0-9A-F]{2}|\?\?))*")
 """A UART2 line of bytes as hex pairs (`??`: any byte, in an expectation). A UART2 line
 of any other form is APP text (escaped), as UART2 carries in APP mode (§12); a recorder
@@ -245,17 +255,25 @@ def parse_entry(line: str, lineno: int, where: str) -> Entry:
     if direction not in DIRECTIONS:
         raise TranscriptError(
             f"{where}: direction {_cut(direction)!r} must be '>' (host to board) or '<' "
-            "(board to host) on the APP port, '2>' or '2<' on UART2"
+            "(board to host) on the APP port, '2>' or '2<' on UART2, 'c>' or 'c<' on a "
+            "chassis port"
         )
-    hexed = uart2_bytes(payload) if direction in UART2_DIRECTIONS else None
+    hexed = uart2_bytes(payload) if direction in HEX_DIRECTIONS else None
+    if direction in CHASSIS_DIRECTIONS and hexed is None:
+        raise TranscriptError(
+            f"{where}: {_cut(payload)!r} is not hex pairs (upper case, one space apart: "
+            "7B 00 00 …), as a chassis port's lines are"
+        )
     if direction in UART2_DIRECTIONS and hexed is None and " " in payload:
         raise TranscriptError(
             f"{where}: {_cut(payload)!r} is neither hex pairs (upper case, one space apart: "
             "FF FE 01 …) nor APP text (escaped, so it has no spaces)"
         )
     if hexed is not None:
-        if direction == SENT2 and "??" in payload:
-            raise TranscriptError(f"{where}: '??' matches a byte the board sends: not in a 2> line")
+        if direction in (SENT2, SENT_CHASSIS) and "??" in payload:
+            raise TranscriptError(
+                f"{where}: '??' matches a byte the board sends: not in a {direction} line"
+            )
         return Entry(lineno, time, direction, hexed[0], payload)
     try:
         data = unescape(payload)

@@ -12,7 +12,7 @@ from typing import Any, TextIO
 from appmode.board.profiles import profile_named
 from appmode.errors import AppmodeError, InvalidValue
 from appmode.files import say_if_fifo
-from appmode.protocol import app, control
+from appmode.protocol import app, chassis, control
 from appmode.protocol.control_view import view
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.params import DriveType
@@ -28,7 +28,9 @@ from appmode.transcript.matcher import (
 )
 from appmode.transcript.reading import iter_lines, iter_transcript
 
-Decoded = app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent
+Decoded = (
+    app.Event | Pattern | BytesPattern | control.HostEvent | control.BoardEvent | chassis.Event
+)
 
 
 def decoded(
@@ -96,7 +98,7 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
     needs = needs_of(path, lambda text: None)  # the second pass warns
     layout = (given or needs.profile).a_layout
     if fmt == "csv":
-        fields = ("t", "dir", *json_keys(layout))
+        fields = tuple(dict.fromkeys(("t", "dir", *json_keys(layout), *chassis.JSON_KEYS)))
         writer = csv.DictWriter(out, fieldnames=fields, extrasaction="ignore")
         writer.writeheader()
     items = iter_transcript(path, lambda text: print(f"appmode: WARNING: {text}", file=sys.stderr))
