@@ -179,8 +179,10 @@ class Boards:
         assert proc.stdout is not None
         shown = _start_up(proc.stdout.fileno())
         assert len(shown) >= 2, f"the board printed {shown}"
-        for want, got in zip(example.expected[:2], shown[:2], strict=True):
-            self.names[want.split(": ", 1)[1]] = got.split(": ", 1)[1]
+        for want, got in zip(example.expected, shown, strict=False):  # port, uart2, chassis
+            named = PTY.search(want), PTY.search(got)
+            if named[0] is not None and named[1] is not None:
+                self.names[named[0].group(0)] = named[1].group(0)
         time.sleep(SWITCH)
         return shown
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_profile
@@ -91,22 +91,56 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="who sent the bytes (default: board, i.e. board→host records)",
     )
     add_profile(decode, default=None, unset="sheet")
+    decode.add_argument(
+        "--chassis",
+        action="store_true",
+        help="the bytes are a WHEELTEC chassis port's (7B … 7D frames at 115200 bps): "
+        "velocity frames from the host, status frames from the board, in SI units",
+    )
     return decode
 
 
+def run_chassis(stream: BinaryIO, out: TextIO, source: str, name: str) -> int:
+    """Write one JSON object a frame of a chassis port's bytes (and one a run of bytes
+    that is no frame); returns the number of those runs."""
+    import json
+
+    from appmode.protocol import chassis
+
+    decoder = chassis.CommandDecoder() if source == "host" else chassis.StatusDecoder()
+    errors = 0
+    for chunk in (*read_chunks(stream, name, out), None):
+        for event in decoder.feed(chunk) if chunk is not None else decoder.flush():
+            errors += isinstance(event, chassis.Junk)
+            out.write(json.dumps(chassis.as_json(event), ensure_ascii=False) + "\n")
+    out.flush()
+    return errors
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.chassis and args.profile:
+        raise AppmodeError("--profile names an APP port's records: leave it out with --chassis")
+    if args.chassis:
+        return _read(args, lambda stream, name: run_chassis(stream, sys.stdout, args.source, name))
     layout = None  # the sheet's
     if args.profile:
         from appmode.board.profiles import profile_named
 
         layout = profile_named(args.profile).a_layout
+    return _read(
+        args, lambda stream, name: run_decode(stream, sys.stdout, args.source, name, layout)
+    )
+
+
+def _read(args: argparse.Namespace, decode: Callable[[BinaryIO, str], int]) -> int:
+    """`decode` the file the arguments name, or standard input."""
     if args.file in (None, "-"):
-        run_decode(sys.stdin.buffer, sys.stdout, args.source, layout=layout)
+        decode(sys.stdin.buffer, "standard input")
         return 0
     try:
         stream = open(args.file, "rb")  # noqa: SIM115 - closed below
     except OSError as exc:
         raise AppmodeError(f"cannot read {args.file}: {exc.strerror}") from None
     with stream:
-        run_decode(stream, sys.stdout, args.source, args.file, layout)
+        decode(stream, args.file)
     return 0

@@ -10,6 +10,7 @@ from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
+    add_chassis,
     add_profile,
     add_record,
     add_uart2,
@@ -81,6 +82,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
         help="the same board's control port: as --uart2-url",
     )
     add_uart2(parser, "drive over the board's control port (UART2, velocity frames)")
+    add_chassis(parser, "drive over the board's chassis port")
     parser.add_argument(
         "--uart2-url",
         type=target,

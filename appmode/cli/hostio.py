@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, TextIO, TypeVar
 from appmode.board.profiles import board_line
 from appmode.host.app.client import Event, Host
 from appmode.host.app.query import QueryDone
+from appmode.host.chassis.client import ChassisHost
 from appmode.host.control.client import ControlHost
 from appmode.host.events import BoardWarning, LinkStatus
 from appmode.host.outcomes import QueryFailed
@@ -24,7 +25,7 @@ if TYPE_CHECKING:
     from appmode.ports.choice import BoardChoice
     from appmode.protocol.channels import Viewer
 
-H = TypeVar("H", Host, ControlHost)
+H = TypeVar("H", Host, ControlHost, ChassisHost)
 E = TypeVar("E")
 
 

@@ -13,6 +13,7 @@ from appmode.cli.options import (
     DAY,
     ON_A_BOARD,
     Subparsers,
+    add_chassis,
     add_profile,
     add_record,
     add_uart2,
@@ -47,6 +48,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="send Z when the monitor ends (it sends nothing otherwise)",
     )
     add_uart2(mon, "print the replies and encoder reports of the board's control port")
+    add_chassis(mon, "print the status frames of the board's chassis port")
     add_record(mon)
     add_foxglove(mon, "the records")
     return mon
@@ -75,10 +77,27 @@ def add_limits(parser: argparse.ArgumentParser, filtering: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.line.wire import APP, UART2
+    from appmode.line.wire import APP, CHASSIS, UART2
 
     choice = board_choice(args)
-    return {APP: _on_app, UART2: _on_control}[choice.port](choice, args)
+    return {APP: _on_app, UART2: _on_control, CHASSIS: _on_chassis}[choice.port](choice, args)
+
+
+def _on_chassis(choice: BoardChoice, args: argparse.Namespace) -> int:
+    from appmode.cli import chassis
+
+    if args.filter is not None:
+        raise AppmodeError("--filter picks APP records: not with --chassis")
+    return chassis.run_monitor(
+        choice,
+        as_json=args.json,
+        duration=args.duration,
+        count=args.count,
+        record=args.record,
+        out=sys.stdout,
+        stop_on_exit=args.stop_on_exit,
+        foxglove=args.foxglove,
+    )
 
 
 def _on_control(choice: BoardChoice, args: argparse.Namespace) -> int:

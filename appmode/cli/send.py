@@ -11,6 +11,7 @@ from appmode.cli.options import (
     DAY,
     ON_A_BOARD,
     Subparsers,
+    add_chassis,
     add_profile,
     add_record,
     add_uart2,
@@ -18,7 +19,8 @@ from appmode.cli.options import (
     board_choice,
     number_type,
 )
-from appmode.host.token_help import APP_TOKENS, CONTROL_TOKENS
+from appmode.errors import AppmodeError
+from appmode.host.token_help import APP_TOKENS, CHASSIS_TOKENS, CONTROL_TOKENS
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
@@ -53,16 +55,34 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="with --uart2: leave the encoder report as it is (it is on for the session)",
     )
+    add_chassis(send, "send over the board's chassis port; " + CHASSIS_TOKENS)
     add_profile(send, ON_A_BOARD, default=None)
     add_record(send)
     return send
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.line.wire import APP, UART2
+    from appmode.line.wire import APP, CHASSIS, UART2
 
     choice = board_choice(args)
-    return {APP: _on_app, UART2: _on_control}[choice.port](choice, args)
+    return {APP: _on_app, UART2: _on_control, CHASSIS: _on_chassis}[choice.port](choice, args)
+
+
+def _on_chassis(choice: BoardChoice, args: argparse.Namespace) -> int:
+    from appmode.cli import chassis
+
+    if args.raw or args.no_report:
+        raise AppmodeError(
+            "--raw and --no-report are the APP and control ports': not with --chassis"
+        )
+    return chassis.run_send(
+        choice,
+        args.tokens,
+        listen=args.listen,
+        as_json=args.json,
+        record=args.record,
+        out=sys.stdout,
+    )
 
 
 def _on_app(choice: BoardChoice, args: argparse.Namespace) -> int:

@@ -7,17 +7,19 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from appmode.host.app.client import Host
+from appmode.host.chassis.client import ChassisHost
 from appmode.host.control.client import ControlHost
-from appmode.line.wire import APP, UART2, Tap
+from appmode.line.wire import APP, CHASSIS, UART2, Tap
 from appmode.ports.choice import BoardChoice
 from appmode.ports.target import Target
 
-AnyHost = Host | ControlHost
+AnyHost = Host | ControlHost | ChassisHost
 HOSTS: dict[str, Callable[[Target, BoardChoice, Tap | None], AnyHost]] = {
     APP: lambda target, choice, tap: Host(target, tap=tap, profile=choice.profile),
     UART2: lambda target, choice, tap: ControlHost(
         target, tap=tap, profile=choice.profile, drive=choice.drive
     ),
+    CHASSIS: lambda target, choice, tap: ChassisHost(target, tap=tap, profile=choice.profile),
 }
 """How each port's host is opened, for the board `choice` names."""
 

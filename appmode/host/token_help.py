@@ -10,3 +10,8 @@ CONTROL_TOKENS = (
     "motors:A,B,C[,D], position:X,Y,Z, read:NAME, set:NAME=VALUE, save, load, defaults, "
     "stop, wait:SECONDS and raw hex (FFFE0100000000000000)"
 )
+CHASSIS_TOKENS = (
+    "tokens are velocity:FORWARD,LEFT,TURN (m/s, m/s, rad/s counter-clockwise; held, "
+    "sent again every 0.1 s, until the next token that moves or stops), stop, "
+    "wait:SECONDS and raw hex (7B000000000000000000 7B7D, sent once)"
+)

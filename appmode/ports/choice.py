@@ -1,8 +1,9 @@
-"""Which board a command opens, decided once: the port it drives (the APP port, or the
-control port with the APP port of the same board beside it), the board's profile and,
-where it matters, its drive type. `choose` holds every rule of how URLs, `--uart2`,
-`--profile` and `--drive` combine; hosts and sessions read the `BoardChoice`, and every
-command its ports (`ports()`, `app_port`, `control_port`): none chooses again."""
+"""Which board a command opens, decided once: the port it drives (the APP port, the
+control port with the APP port of the same board beside it, or a WHEELTEC board's
+chassis port), the board's profile and, where it matters, its drive type. `choose` holds
+every rule of how URLs, `--uart2`, `--chassis`, `--profile` and `--drive` combine; hosts
+and sessions read the `BoardChoice`, and every command its ports (`ports()`, `app_port`,
+`control_port`): none chooses again."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from dataclasses import dataclass
 
 from appmode.board.profiles import Profile, profile_named
 from appmode.errors import AppmodeError
-from appmode.line.wire import APP, UART2
+from appmode.line.wire import APP, CHASSIS, UART2
 from appmode.ports.target import Target, board_ports
 from appmode.protocol.params import DriveType
 
@@ -29,16 +30,20 @@ class BoardChoice:
     """With `control`: the same board's APP port, opened beside it (its records shown)."""
     drive: DriveType | None = None
     """The car's drive type when given or fixed by the profile (else read from the board)."""
+    chassis: bool = False
+    """Driven over a WHEELTEC board's chassis port (`7B … 7D` frames), alone."""
 
     @property
     def port(self) -> str:
-        """The port driven, by name (`app`, `uart2`): the key of a command's table of
-        what it does on each port."""
-        return UART2 if self.control else APP
+        """The port driven, by name (`app`, `uart2`, `chassis`): the key of a command's
+        table of what it does on each port."""
+        return CHASSIS if self.chassis else UART2 if self.control else APP
 
     @property
     def app_port(self) -> Target | None:
         """The board's APP port, when it is opened (driven, or beside the control port)."""
+        if self.chassis:
+            return None
         return self.app if self.control else self.target
 
     @property
@@ -48,7 +53,11 @@ class BoardChoice:
 
     def ports(self) -> dict[str, Target]:
         """The board's ports this choice opens, by name, the APP port first."""
-        found = {APP: self.app_port, UART2: self.control_port}
+        found = {
+            APP: self.app_port,
+            UART2: self.control_port,
+            CHASSIS: self.target if self.chassis else None,
+        }
         return {name: target for name, target in found.items() if target is not None}
 
 
@@ -60,13 +69,17 @@ def choose(
     profile: str | None = None,
     drive: str | None = None,
     both: bool = False,
+    chassis: bool = False,
 ) -> BoardChoice:
     """The board `url` names — driven over its control port with `uart2`, or at `url2`
     (the same board's control port, `url` then its APP port) — with the `profile` named
     (else a sim:// URL's, else the sheet) and the `drive` type given; AppmodeError says
     what does not fit together. With `both`, a URL that reaches both of a board's ports
     (a simulated board that has a control port; a shared car with `uart2`) opens both,
-    its control port driven."""
+    its control port driven. With `chassis` (or a sim:// URL's `port=chassis`), the
+    board's chassis port alone."""
+    if chassis or url.sim_port == CHASSIS:
+        return _chassis(url, url2, uart2=uart2, profile=profile, drive=drive)
     if both and url2 is None and (url.simulated or (uart2 and url.remote is not None)):
         named = profile_named(profile or url.profile or "sheet")
         if named.file is None or named.file.control_port:
@@ -83,3 +96,38 @@ def choose(
     chosen.check_uart2()
     fixed = DriveType.from_cli_name(drive) if drive else chosen.fixed_drive
     return BoardChoice(driven, chosen, control=True, app=beside, drive=fixed)
+
+
+def _chassis(
+    url: Target, url2: Target | None, *, uart2: bool, profile: str | None, drive: str | None
+) -> BoardChoice:
+    """The chassis port of the board `url` names, with a WHEELTEC profile (by default
+    wheeltec-mec: a host sends what it is asked, and the car does what its kind can)."""
+    if uart2 or url2 is not None:
+        raise AppmodeError(
+            "--chassis drives a WHEELTEC board's chassis port alone: leave out --uart2 "
+            "and a second URL"
+        )
+    if drive:
+        raise AppmodeError(
+            "--drive is the control port's drive type: a chassis's kind is its profile's "
+            "(--profile wheeltec-mec, wheeltec-akm or wheeltec-diff)"
+        )
+    name = profile or url.profile or "wheeltec-mec"
+    chosen = profile_named(name)
+    if chosen.chassis is None:
+        raise AppmodeError(
+            f"the {chosen.name} profile has no chassis port: give --profile wheeltec-mec, "
+            "wheeltec-akm, wheeltec-diff, or a profile file with a [chassis] table"
+        )
+    board = url.with_sim(profile=name)
+    if board.simulated or board.remote is not None:
+        if board.sim_port not in (APP, CHASSIS) or (
+            "port" in board.options and board.sim_port != CHASSIS
+        ):
+            raise AppmodeError(
+                f"{board} names the board's {board.sim_port} port: --chassis drives its "
+                "chassis port (port=chassis, or leave port= out)"
+            )
+        board = board.on_port(CHASSIS)
+    return BoardChoice(board, chosen, chassis=True)

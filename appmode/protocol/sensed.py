@@ -12,6 +12,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from appmode.protocol.layouts import Layout
 from appmode.protocol.profile_file import Field
@@ -85,3 +86,14 @@ def yaw_rate(points: Sequence[tuple[float, float]], at: float) -> float | None:
         return None
     turned = sum(math.remainder(b[1] - a[1], 360.0) for a, b in itertools.pairwise(window))
     return turned / (window[-1][0] - window[0][0])
+
+
+@dataclass(frozen=True, slots=True)
+class Inertial:
+    """What a board's IMU reports, in SI and REP 103's axes (x forward, y left, z up):
+    the angular velocity (rad/s), the linear acceleration (m/s², gravity included) and,
+    where the same report carries it, the battery's voltage."""
+
+    angular_velocity: tuple[float, float, float]
+    acceleration: tuple[float, float, float]
+    volts: float | None = None

@@ -1,8 +1,7 @@
 """What every driving session shares, whatever port it drives: messages, recording,
-hold-to-drive, the stop authority, the twist (`move`: the one motion interface in SI
-units, which each port translates), the twist the records show (`sensed`) and the
-command line (`commands`). `app.session.AppSession` drives the APP port,
-`control.session.ControlSession` the control port.
+hold-to-drive, the stop authority, the twist (`move`, in SI, which each port translates;
+`sensed`, what the records show) and the command line. Each port's session is in its
+folder: `app/` (the APP port), `control/` (UART2), `chassis/` (WHEELTEC's chassis port).
 """
 
 from __future__ import annotations
@@ -22,6 +21,7 @@ from appmode.ports.recording import open_recorder
 from appmode.ports.target import Target
 from appmode.protocol.channels import Viewer
 from appmode.protocol.recorder import Recorder
+from appmode.protocol.sensed import Inertial
 from appmode.protocol.twist import Twist
 from appmode.session import sensing
 from appmode.session.authority import LAPSE, StopGuard
@@ -40,6 +40,7 @@ from appmode.writer import CLOSE_WAIT
 if TYPE_CHECKING:
     from appmode.host.app.client import Host
     from appmode.host.app.state import HostState
+    from appmode.host.chassis.client import ChassisHost
     from appmode.host.control.client import ControlHost
     from appmode.session.instruments import Instruments
     from appmode.session.rows import Row
@@ -108,7 +109,7 @@ class BaseSession(ABC):
 
     # ------------------------------------------------------------ what a session is
 
-    host: Host | ControlHost
+    host: Host | ControlHost | ChassisHost
     """The host that drives (its clock is the session's)."""
 
     @property
@@ -288,6 +289,10 @@ class BaseSession(ABC):
         in time order (`session.sensing`)."""
         state = self.telemetry_state()
         return [] if state is None else sensing.twists(state, self._signs, after)
+
+    def inertial(self, after: float) -> list[tuple[float, Inertial]]:
+        """The IMU's own readings since `after`, in time order (a chassis port's)."""
+        return []
 
     def _signs(self) -> tuple[float, float, float] | None:
         """The signs of x, y and z the motion in force drives, where the port knows them

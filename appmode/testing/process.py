@@ -14,10 +14,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from appmode.board.profiles import profile_named
+
 
 class BoardProcess:
     """`appmode board ARGS` running. `url` and `uart2` are the first board's ports (what
-    it printed after `port: ` and `uart2: `), `urls` every board's APP port (`--count`),
+    it printed after `port: ` and `uart2: `), `chassis` its chassis port (a WHEELTEC
+    profile's, else None), `urls` every board's APP port (`--count`),
     `details` what `--bluetooth` (`bus`, `ble`, `spp`) or `--advertise` (`ble`, `spp`)
     printed after them."""
 
@@ -31,14 +34,19 @@ class BoardProcess:
         )
         self.urls: list[str] = []
         self.uart2s: list[str] = []
+        self.chassis: str | None = None
         self._started(start)
         count = int(args[args.index("--count") + 1]) if "--count" in args else 1
+        profile = args[args.index("--profile") + 1] if "--profile" in args else "sheet"
         for _ in range(count):
             self.urls.append(self._line("port: "))
             self.clock_after = time.monotonic()
             """At or after the board's clock zero (it printed its port line after it): a
             time of its recording, t, happened at or before `clock_after + t`."""
             self.uart2s.append(self._line("uart2: "))
+            if profile_named(profile).chassis is not None:
+                chassis = self._line("chassis: ")
+                self.chassis = self.chassis or chassis
         self.url, self.uart2 = self.urls[0], self.uart2s[0]
         self.details: dict[str, str] = {}
         lines = 3 if "--bluetooth" in args else 2 if "--advertise" in args else 0

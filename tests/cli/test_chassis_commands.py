@@ -1,0 +1,84 @@
+"""The commands with `--chassis`, as a user runs them: decode, send, monitor, drive's
+session, the board's chassis line and its recording, and the mistakes said in a line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from appmode.protocol import chassis
+from appmode.protocol.twist import Twist
+from tests.support.processes import board_process, run
+
+
+def quick(tmp_path: Path) -> str:
+    path = tmp_path / "quick.toml"
+    path.write_text(
+        'name = "quick"\nlike = "wheeltec-mec"\n[chassis]\nkind = "mec"\nboot_ms = 300\n'
+    )
+    return str(path)
+
+
+def test_decode_chassis_prints_a_line_per_frame_in_si_and_names_bad_ones(tmp_path: Path) -> None:
+    good = chassis.status(0, (300, 0, -500), (0, 0, 16384), (0, 0, -1877), 11800)
+    bad = bytearray(good)
+    bad[3] ^= 1
+    capture = tmp_path / "capture.bin"
+    capture.write_bytes(b"\x00\x01" + good[:9] + good + bytes(bad) + good + good[:5])
+    done = run("decode", "--chassis", str(capture))
+    assert done.returncode == 0, done.stderr
+    lines = [json.loads(line) for line in done.stdout.splitlines()]
+    kinds = [line["kind"] for line in lines]
+    assert kinds == ["garbage", "chassis_status", "garbage", "chassis_status", "garbage"]
+    assert lines[1]["forward"] == 0.3 and lines[1]["turn"] == -0.5 and lines[1]["volts"] == 11.8
+    assert "wrong XOR" in lines[2]["reason"] and lines[-1]["reason"] == "a frame cut off"
+    host = run("decode", "--chassis", "--from", "host", stdin=chassis.command(Twist(0.1)))
+    assert json.loads(host.stdout)["kind"] == "chassis_command"
+
+
+def test_the_board_serves_a_chassis_port_and_records_it(tmp_path: Path) -> None:
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--profile", quick(tmp_path), "--record", str(record)) as board:
+        assert board.chassis is not None and board.chassis.startswith("/dev/")
+        done = run(
+            "send", board.chassis, "--chassis", "--profile", quick(tmp_path),
+            "wait:0.4", "velocity:0.2,0,0", "wait:0.5", "--json", "--listen", "0",
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+    statuses = [json.loads(line) for line in done.stdout.splitlines()]
+    assert max(s["forward"] for s in statuses) == pytest.approx(0.2, abs=0.01)
+    sent = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " c> " in line]
+    assert sent[0] == chassis.command(Twist(0.2)).hex(" ").upper()
+    assert sent[-1] == chassis.STOP.hex(" ").upper(), "the board's last frame is the stop"
+    dumped = run("dump", str(record), "--profile", quick(tmp_path))
+    assert dumped.returncode == 0, dumped.stderr
+    assert "velocity +0.20 m/s" in dumped.stdout and "status" in dumped.stdout
+
+
+def test_monitor_chassis_counts_status_frames() -> None:
+    done = run("monitor", "sim://?profile=wheeltec-akm", "--chassis", "--count", "5")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count(" c< ") == 5 and "status STOP" in done.stdout
+    assert "monitor: 5 status frames, 0 errors" in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["send", "sim://", "--chassis", "--uart2", "stop"], "--chassis drives"),
+        (["send", "sim://?profile=sheet", "--chassis", "stop"], "has no chassis port"),
+        (["send", "sim://?port=uart2", "--chassis", "stop"], "names the board's uart2 port"),
+        (["send", "sim://", "--chassis", "velocity:1e9"], "no car's"),
+        (["send", "sim://", "--chassis", "velocity:a,b"], "velocity takes FORWARD"),
+        (["send", "sim://", "--chassis", "--raw", "stop"], "not with --chassis"),
+        (["decode", "--chassis", "--profile", "sheet"], "leave it out with --chassis"),
+        (["board", "--listen-chassis", "127.0.0.1:0"], "has no chassis port"),
+    ],
+)
+def test_mistakes_are_one_line(args: list[str], said: str) -> None:
+    done = run(*args)
+    assert done.returncode != 0
+    assert said in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert "Traceback" not in done.stderr
