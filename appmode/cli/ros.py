@@ -12,7 +12,15 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.live_view import add_foxglove, live_view
-from appmode.cli.options import HOLDS, Subparsers, add_profile, add_uart2, board_choice, target
+from appmode.cli.options import (
+    HOLDS,
+    Subparsers,
+    add_chassis,
+    add_profile,
+    add_uart2,
+    board_choice,
+    target,
+)
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
@@ -44,6 +52,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "url2", nargs="?", type=target, metavar="URL2", help="the same car's control port"
     )
     add_uart2(ros, "drive over the URL's own control port (a sim:// board's, a zenoh:// car's)")
+    add_chassis(ros, "drive a WHEELTEC car as its vendor's driver does, over its chassis port")
     ros.add_argument(
         "--connect",
         action="append",

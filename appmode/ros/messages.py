@@ -117,18 +117,27 @@ class Messages:
         caps it, and 11.10 V at 0 %, where the sheet's floors it: the voltage is then at
         least, or at most, that; the reference firmware's −740 % at power-up is 0 V);
         nothing else measured (NaN)."""
+        volts = (min(100.0, percent) * 1.5 + 1110) / 100
+        return self._battery(volts, max(0.0, min(1.0, percent / 100)), time_ns, frame)
+
+    def battery_volts(self, volts: float, time_ns: int, frame: str) -> bytes:
+        """A battery's voltage as the board measured it (a chassis port's status, in mV);
+        its percentage not known (NaN)."""
+        return self._battery(volts, math.nan, time_ns, frame)
+
+    def _battery(self, volts: float, fraction: float, time_ns: int, frame: str) -> bytes:
         kind = self.types[BATTERY]
         nan = math.nan
         message = self._make(
             BATTERY,
             header=self._header(time_ns, frame),
-            voltage=(min(100.0, percent) * 1.5 + 1110) / 100,
+            voltage=volts,
             temperature=nan,
             current=nan,
             charge=nan,
             capacity=nan,
             design_capacity=nan,
-            percentage=max(0.0, min(1.0, percent / 100)),
+            percentage=fraction,
             power_supply_status=kind.POWER_SUPPLY_STATUS_UNKNOWN,
             power_supply_health=kind.POWER_SUPPLY_HEALTH_UNKNOWN,
             power_supply_technology=kind.POWER_SUPPLY_TECHNOLOGY_UNKNOWN,
@@ -139,6 +148,29 @@ class Messages:
             serial_number="",
         )
         return self._cdr(message, BATTERY)
+
+    def imu_raw(
+        self,
+        angular_velocity: tuple[float, float, float],
+        acceleration: tuple[float, float, float],
+        time_ns: int,
+        frame: str,
+    ) -> bytes:
+        """An IMU's rates and accelerations as it measured them (a chassis port's status):
+        no orientation (covariance −1, REP 145)."""
+        unknown = np.zeros(9)
+        unknown[0] = UNKNOWN
+        message = self._make(
+            IMU,
+            header=self._header(time_ns, frame),
+            orientation=self._make("geometry_msgs/msg/Quaternion", x=0.0, y=0.0, z=0.0, w=1.0),
+            orientation_covariance=unknown,
+            angular_velocity=self._vector(*angular_velocity),
+            angular_velocity_covariance=_diagonal(3, (GYRO_VARIANCE,) * 3),
+            linear_acceleration=self._vector(*acceleration),
+            linear_acceleration_covariance=_diagonal(3, (ACCEL_VARIANCE,) * 3),
+        )
+        return self._cdr(message, IMU)
 
     def imu(
         self,
@@ -192,6 +224,12 @@ class Messages:
 @cache
 def _store(distro: str) -> Any:
     return get_typestore(STORES[distro])
+
+
+GYRO_VARIANCE = 1e-4
+"""(rad/s)²: a MEMS gyro's noise, about 0.01 rad/s."""
+ACCEL_VARIANCE = 2.5e-3
+"""(m/s²)²: its accelerometer's, about 0.05 m/s²."""
 
 
 def _diagonal(size: int, values: tuple[float, ...]) -> Any:

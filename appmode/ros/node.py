@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from appmode.protocol import app
 from appmode.protocol.odometry import Odometry
 from appmode.protocol.render import to_json
-from appmode.protocol.sensed import YAW_WINDOW, yaw_rate
+from appmode.protocol.sensed import YAW_WINDOW, Inertial, yaw_rate
 from appmode.protocol.twist import BadTwist, Twist
 from appmode.ros.graph import Node, Qos
 from appmode.ros.messages import (
@@ -45,6 +45,8 @@ TICK = 0.01
 """Seconds between two turns of the node's loop (the session's reads, the queue)."""
 QUEUE = 8
 """cmd_vel samples kept waiting at most (the newest count: a twist replaces the last)."""
+BATTERY_EVERY = 10
+"""IMU readings a battery_state is sent for (a chassis's 20 Hz status: 2 Hz)."""
 Log = Callable[[str], None]
 
 
@@ -89,6 +91,8 @@ class RosNode:
         self.messages = Messages(graph.distro)
         self.odometry = Odometry()
         self._sensed_at = -math.inf
+        self._inertial_at = -math.inf
+        self._readings = 0
         self._angles: deque[tuple[float, tuple[float, float, float]]] = deque()
         """The last YAW_WINDOW s of B records' roll, pitch and yaw (degrees, REP 103)."""
         """The time of the last A record whose twist was published."""
@@ -185,15 +189,20 @@ class RosNode:
     # ------------------------------------------------------------ the records
 
     def _publish_records(self) -> None:
-        state = self.session.telemetry_state()
-        if state is None:
-            self._say_once("no app", "no APP port beside: odom, battery and imu are not sent")
-            return
         now_ns, now = time.time_ns(), self.session.now()
         sensed = self.session.sensed(self._sensed_at)
         for at, twist in sensed:
             self._sensed_at = at
             self._odometry(twist, at, now_ns - int((now - at) * 1e9))
+        inertial = self.session.inertial(self._inertial_at)
+        for at, reading in inertial:
+            self._inertial_at = at
+            self._inertial(reading, now_ns - int((now - at) * 1e9))
+        state = self.session.telemetry_state()
+        if state is None:
+            if not (sensed or inertial or self._readings):
+                self._say_once("no app", "no APP port beside: odom, battery and imu are not sent")
+            return
         for at, event in self._new(state, "A"):
             stamp = now_ns - int((now - at) * 1e9)
             self._raw(event, state, stamp)
@@ -244,6 +253,16 @@ class RosNode:
             imu = self.messages.imu(roll, pitch, yaw, stamp, self.options.base_frame, known)
             self._put("imu", imu)
         self._battery(fields, stamp)
+
+    def _inertial(self, reading: Inertial, stamp: int) -> None:
+        """An IMU's own rates and accelerations as imu; its battery, every BATTERY_EVERY
+        readings, as battery_state."""
+        frame = self.options.base_frame
+        imu = self.messages.imu_raw(reading.angular_velocity, reading.acceleration, stamp, frame)
+        self._put("imu", imu)
+        self._readings += 1
+        if reading.volts is not None and self._readings % BATTERY_EVERY == 1:
+            self._put("battery_state", self.messages.battery_volts(reading.volts, stamp, frame))
 
     def _battery(self, fields: dict[str, tuple[float, Any]], stamp: int) -> None:
         for value, field in fields.values():
