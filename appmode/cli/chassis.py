@@ -150,8 +150,10 @@ def run_monitor(
     out: TextIO | None,
     stop_on_exit: bool = False,
     foxglove: str | None = None,
+    name: str = "monitor",
 ) -> int:
-    """Print status frames as they arrive; passive unless `stop_on_exit`."""
+    """Print status frames as they arrive (`out` None: none, `appmode record`); passive
+    unless `stop_on_exit`."""
     seen = errors = 0
     with ExitStack() as stack:
         view = stack.enter_context(live_view(foxglove, choice.profile.a_layout))
@@ -166,12 +168,12 @@ def run_monitor(
                 seen += _is_status(event)
         finally:
             print(
-                f"monitor: {counted(seen, 'status frame')}, {counted(errors, 'error')} in "
+                f"{name}: {counted(seen, 'status frame')}, {counted(errors, 'error')} in "
                 f"{host.now():.1f} s",
                 file=sys.stderr,
             )
             if not seen:
-                print(f"monitor: {QUIET}", file=sys.stderr)
+                print(f"{name}: {QUIET}", file=sys.stderr)
     return 0
 
 

@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, add_profile, file_name, target
+from appmode.cli.options import Subparsers, add_chassis, add_profile, file_name, target
 from appmode.errors import AppmodeError
 
 
@@ -49,6 +49,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         default=None,
         unset="a sim:// --board's profile, else sheet",
     )
+    add_chassis(
+        conform,
+        "run the transcripts for a WHEELTEC profile (wheeltec-mec unless --profile says), "
+        "with --board on its chassis port",
+    )
     conform.add_argument(
         "--junit", type=file_name, metavar="FILE", help="also write a JUnit XML report"
     )
@@ -76,11 +81,16 @@ def run(args: argparse.Namespace) -> int:
     if args.url2 and not args.url:
         raise AppmodeError("--board2 names the control port of the --board: give --board too")
     board = board2 = None
-    profile = profile_named(args.profile or "sheet").name
+    profile = profile_named(args.profile or ("wheeltec-mec" if args.chassis else "sheet")).name
     if args.url:
         choice = board_choice(args)
-        board, board2 = choice.app_port, choice.control_port
+        board, board2 = choice.app_port or choice.target, choice.control_port
         profile = choice.profile.name
+    if args.chassis and profile_named(profile).chassis is None:
+        raise AppmodeError(
+            f"--chassis: the {profile} profile has no chassis port: give --profile "
+            "wheeltec-mec, wheeltec-akm or wheeltec-diff"
+        )
     if board and not board.simulated and not args.yes:
         warning = WARNING.format(url=board)
         if not sys.stdin.isatty():
@@ -89,4 +99,6 @@ def run(args: argparse.Namespace) -> int:
         if sys.stdin.readline().strip().lower() not in ("y", "yes"):
             print("not run", file=sys.stderr)
             return 1
-    return run_conform(args.paths, board, args.junit, sys.stdout, profile, board2=board2)
+    return run_conform(
+        args.paths, board, args.junit, sys.stdout, profile, board2=board2, chassis=args.chassis
+    )

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.monitor import add_limits, run_monitor
-from appmode.cli.options import Subparsers, add_url, board_choice, file_name
+from appmode.cli.options import Subparsers, add_chassis, add_url, board_choice, file_name
+from appmode.errors import AppmodeError
+
+if TYPE_CHECKING:
+    from appmode.ports.choice import BoardChoice
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -21,12 +26,36 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_url(rec)
     rec.add_argument("file", type=file_name, metavar="FILE", help="the transcript to write")
     add_limits(rec, "count only these (the transcript holds everything)")
+    add_chassis(rec, "record the status frames of the board's chassis port")
     return rec
 
 
 def run(args: argparse.Namespace) -> int:
+    from appmode.line.wire import APP, CHASSIS
+
+    choice = board_choice(args)
+    return {APP: _on_app, CHASSIS: _on_chassis}[choice.port](choice, args)
+
+
+def _on_chassis(choice: BoardChoice, args: argparse.Namespace) -> int:
+    from appmode.cli import chassis
+
+    if args.filter is not None:
+        raise AppmodeError("--filter picks APP records: not with --chassis")
+    return chassis.run_monitor(
+        choice,
+        as_json=False,
+        duration=args.duration,
+        count=args.count,
+        record=args.file,
+        out=None,
+        name="record",
+    )
+
+
+def _on_app(choice: BoardChoice, args: argparse.Namespace) -> int:
     return run_monitor(
-        board_choice(args),
+        choice,
         as_json=False,
         duration=args.duration,
         count=args.count,

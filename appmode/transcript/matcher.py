@@ -1,9 +1,10 @@
 """Transcripts as conformance tests (docs/design.md, "Contracts"): the matcher, with no I/O.
 
-`>` lines are sent at their times (`2>` lines on UART2). Each `<` line that is a record
-is an expectation, to be matched in file order by a record the board sends (each `2<`
-line of hex pairs by a reply, report or undecodable run on UART2 with those bytes, `??`
-matching any byte); `*` in place of a field matches
+`>` lines are sent at their times (`2>` lines on UART2, `c>` on a chassis port). Each
+`<` line that is a record is an expectation, to be matched in file order by a record the
+board sends (each `2<` line of hex pairs by a reply, report or undecodable run on UART2
+with those bytes, each `c<` line by a chassis port's frame, `??` matching any byte); `*`
+in place of a field matches
 any integer, `LO..HI` any integer from LO to HI (`{A0:4..16:*:0}$`). A record matches an
 expectation only once every `>` line before it in the file has been sent, and within
 `tolerance` seconds of its time (default TOLERANCE). Other records are ignored — unless
@@ -27,15 +28,34 @@ from dataclasses import dataclass, field
 from appmode.board.profiles import SHEET, Profile, recorded_profile
 from appmode.errors import AppmodeError, InvalidValue
 from appmode.line.wire import APP as APP_PORT
+from appmode.line.wire import CHASSIS as CHASSIS_PORT
 from appmode.line.wire import UART2 as UART2_PORT
 from appmode.protocol import app
 from appmode.protocol.escaping import escape
 from appmode.protocol.params import DriveType
-from appmode.protocol.reader import RECEIVED2, SENT, SENT2
+from appmode.protocol.reader import (
+    RECEIVED,
+    RECEIVED2,
+    RECEIVED_CHASSIS,
+    SENT,
+    SENT2,
+    SENT_CHASSIS,
+)
 from appmode.protocol.reader import Event as Unit
 from appmode.protocol.transcript import MAX_TIME, Directive, Entry, Transcript, uart2_bytes
 
 TOLERANCE = 0.5
+PORT_OF = {
+    SENT: APP_PORT,
+    RECEIVED: APP_PORT,
+    SENT2: UART2_PORT,
+    RECEIVED2: UART2_PORT,
+    SENT_CHASSIS: CHASSIS_PORT,
+    RECEIVED_CHASSIS: CHASSIS_PORT,
+}
+"""The port of each direction."""
+BYTES_PORTS = (UART2_PORT, CHASSIS_PORT)
+"""The ports whose lines are hex pairs: their expectations are bytes."""
 _FIELD = r"(?:-?\d+(?:\.\.-?\d+)?|\*)"
 _PATTERN = re.compile(rf"\{{([A-Za-z])({_FIELD}(?::{_FIELD})*)?\}}\$?")
 Span = tuple[int, int] | None
@@ -69,7 +89,7 @@ class Pattern:
 
 @dataclass(frozen=True, slots=True)
 class BytesPattern:
-    """A UART2 unit as hex pairs, `??` for any byte: `23 01 ?? ?? ?? ??`."""
+    """A unit of UART2 or a chassis port as hex pairs, `??` for any byte: `23 01 ?? ??`."""
 
     data: bytes
     mask: bytes
@@ -77,7 +97,7 @@ class BytesPattern:
 
     @property
     def what(self) -> str:
-        return f"UART2 unit {self.data[:1].hex().upper()}"
+        return f"unit {self.data[:1].hex().upper()}"
 
     def matches(self, unit: Unit) -> bool:
         raw = unit.raw
@@ -161,7 +181,7 @@ class Check:
                 align = True
             elif isinstance(item, Directive):
                 tolerance, strict = self._directive(item, tolerance, strict)
-            elif item.direction in (SENT, SENT2):
+            elif item.direction in (SENT, SENT2, SENT_CHASSIS):
                 self.sends.append(item)
                 last_send = max(last_send, item.time)
             elif (pattern := _expected(item, self.transcript.path)) is not None:
@@ -208,19 +228,23 @@ class Check:
         return self._end
 
     def due(self, now: float) -> list[tuple[str, bytes]]:
-        """The `>` and `2>` payloads to send by `now`, each with its port."""
+        """The `>`, `2>` and `c>` payloads to send by `now`, each with its port."""
         out = []
         while self.sent < len(self.sends) and self.sends[self.sent].time <= now:
             entry = self.sends[self.sent]
-            out.append((UART2_PORT if entry.direction == SENT2 else APP_PORT, entry.data))
+            out.append((PORT_OF[entry.direction], entry.data))
             self.late.append(max(0.0, now - entry.time))
             self.sent += 1
         return out
 
     @property
     def uses_uart2(self) -> bool:
-        return any(e.direction == SENT2 for e in self.sends) or any(
-            e.entry.direction == RECEIVED2 for e in self.expectations
+        return self.uses(UART2_PORT)
+
+    def uses(self, port: str) -> bool:
+        """Some line sends or expects on `port`."""
+        return any(PORT_OF[e.direction] == port for e in self.sends) or any(
+            PORT_OF[e.entry.direction] == port for e in self.expectations
         )
 
     def next_time(self) -> float | None:
@@ -240,11 +264,11 @@ class Check:
         if self.done or self.matched >= len(self.expectations):
             return
         exp = self.expectations[self.matched]
-        if (exp.entry.direction == RECEIVED2) != (port == UART2_PORT):
-            return  # the other port's: ignored like unmentioned telemetry
+        if PORT_OF[exp.entry.direction] != port:
+            return  # another port's: ignored like unmentioned telemetry
         raw = record.raw
-        if port == UART2_PORT and isinstance(exp.pattern, BytesPattern):
-            letter, shown = f"2<{raw[:1].hex()}", raw.hex(" ").upper()
+        if port in BYTES_PORTS and isinstance(exp.pattern, BytesPattern):
+            letter, shown = f"{exp.entry.direction}{raw[:1].hex()}", raw.hex(" ").upper()
         elif isinstance(record, app.RECORDS):
             letter = app.record_fields(record)[0]
             shown = escape(raw) if raw else escape(app.encode(record))
@@ -310,8 +334,8 @@ class Check:
 
 
 def _expected(entry: Entry, path: str) -> Pattern | BytesPattern | None:
-    """The expectation of a `<` or `2<` line, or None when it expects nothing."""
-    if entry.direction == RECEIVED2:
+    """The expectation of a `<`, `2<` or `c<` line, or None when it expects nothing."""
+    if PORT_OF[entry.direction] in BYTES_PORTS:
         hexed = uart2_bytes(entry.text)
         if hexed is not None:
             return BytesPattern(hexed[0], hexed[1], entry.text)

@@ -21,15 +21,16 @@ from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
 from appmode.host.app.client import Host
 from appmode.host.link import LinkLost, Refused
+from appmode.line.wire import CHASSIS, UART2_BAUD, Wire
 from appmode.line.wire import UART2 as UART2_PORT
-from appmode.line.wire import UART2_BAUD, Wire
 from appmode.ports.target import Target, both_ports
 from appmode.ports.urls import open_link
-from appmode.protocol import app, app_decoders, param_values, params
+from appmode.protocol import app, app_decoders, chassis, param_values, params
 from appmode.protocol.formats import WRITERS
 from appmode.protocol.reader import RECEIVED2, SENT, SENT2, PortsReader
 from appmode.protocol.transcript import Transcript
 from appmode.text import escaped, wrapped
+from appmode.transcript.chassis_runs import feed_virtual, run_live_chassis
 from appmode.transcript.matcher import Check
 from appmode.transcript.reading import read_transcript
 
@@ -58,15 +59,18 @@ def run_virtual(transcript: Transcript) -> Result:
     layout = needs.profile.a_layout
     decoder = layout.board_decoder()
     reader = PortsReader(drive=needs.drive, layout=layout)
+    statuses = chassis.StatusDecoder()
     now = 0.0
     while not check.done and now <= check.end:
         # what arrived by `now` first: it came before what is sent at `now`
         _feed(check, decoder, wire.pump_timed(now))
         for when, data in wire.pump_timed(now, UART2_PORT):
             _feed2(check, reader, RECEIVED2, data, when)
+        feed_virtual(check, statuses, wire, now)
         for port, data in check.due(now):
             wire.write(data, now, port)
-            _feed2(check, reader, SENT2 if port == UART2_PORT else SENT, data, now)
+            if port != CHASSIS:
+                _feed2(check, reader, SENT2 if port == UART2_PORT else SENT, data, now)
         check.on_time(now)
         due = check.next_time()
         if due is None:
@@ -249,8 +253,10 @@ def run_conform(
     out: TextIO,
     profile: str = "sheet",
     board2: Target | None = None,
+    chassis: bool = False,
 ) -> int:
-    """Run every transcript for `profile`; one line each; exit status 1 on any failure."""
+    """Run every transcript for `profile` (on a `chassis` port: none to put back); one line
+    each; exit status 1 on any failure."""
     if junit:
         check_writable(junit, "JUnit report")
     if paths:
@@ -274,7 +280,7 @@ def run_conform(
         if interactive:
             print(f"\r\033[K{text}", end="", file=sys.stderr, flush=True)
 
-    live = board is not None and not board.simulated  # sim:// is a new board each time
+    live = board is not None and not board.simulated and not chassis  # sim://: a new board
     found = _read_params(board, chosen) if live and board is not None else None
     results: list[Result] = []
     between = None
@@ -309,8 +315,7 @@ TAKEN_OVER = (
 
 
 def _saves(transcript: Transcript) -> bool:
-    """Whether `transcript` sends the board a save ({Q:W}): its flash may hold what the
-    run set."""
+    """Whether `transcript` sends a save ({Q:W}): the flash may hold what the run set."""
     decoder = app_decoders.HostDecoder()
     return any(
         isinstance(event, app.SaveParams)
@@ -347,6 +352,10 @@ def _run_all(
         elif needs.power_up and not board.simulated:
             why = "starts at the board's power-up: run it on virtual time (no --board)"
             result = Result(transcript.path, transcript.title, True, 0.0, 0.0, None, why)
+        elif Check(transcript).uses(CHASSIS):
+            started = time.perf_counter()
+            check, reached = run_live_chassis(transcript, board, progress)
+            result = _result(transcript, check, reached, time.perf_counter() - started)
         else:
             result = run_live(transcript, board, progress, board2)
             if interactive:

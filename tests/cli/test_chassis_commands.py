@@ -82,3 +82,36 @@ def test_mistakes_are_one_line(args: list[str], said: str) -> None:
     assert done.returncode != 0
     assert said in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize("profile", ["wheeltec-mec", "wheeltec-akm", "wheeltec-diff"])
+def test_conform_chassis_passes_the_shipped_dialect_suite(profile: str) -> None:
+    done = run("conform", "--chassis", "--profile", profile)
+    assert done.returncode == 0, done.stdout + done.stderr
+    counts = done.stdout.strip().splitlines()[-1]
+    assert counts.startswith(("3 passed, 0 failed", "1 passed, 0 failed")), counts
+    assert f"({profile} profile)" in counts
+
+
+def test_conform_chassis_runs_in_real_time_against_a_board(tmp_path: Path) -> None:
+    suite = Path(__file__).parents[2] / "transcripts" / "suite" / "wheeltec"
+    one = suite / "s15_3_bad_frames_dropped.transcript"
+    done = run("conform", "--chassis", "--board", "sim://", str(one), timeout=90)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1 passed, 0 failed against sim://?profile=wheeltec-mec&port=chassis" in done.stdout
+
+
+def test_a_chassis_line_is_hex_pairs(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.transcript"
+    bad.write_text("# appmode transcript v1\n0.1 c< {A0:0:0:0}$\n")
+    done = run("dump", str(bad))
+    assert done.returncode != 0 and "as a chassis port's lines are" in done.stderr
+
+
+def test_record_chassis_writes_the_status_frames(tmp_path: Path) -> None:
+    out = tmp_path / "status.transcript"
+    done = run("record", "sim://?profile=wheeltec-diff", "--chassis", str(out), "--count", "4")
+    assert done.returncode == 0, done.stderr
+    lines = [line for line in out.read_text().splitlines() if " c< " in line]
+    assert len(lines) == 4 and all(line.endswith(" 7D") for line in lines)
+    assert "record: 4 status frames, 0 errors" in done.stderr
