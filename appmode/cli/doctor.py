@@ -140,6 +140,11 @@ def verdict(finding: probe.Finding) -> str:
             else "the reference firmware's status bursts (§13.1)"
         )
         return f"this is a car's control port (UART2){rate}: it sends {what}"
+    if finding.kind == "chassis":
+        booting = (
+            " (Flag_Stop set: booting, or stopped by the board)" if shown and shown.booting else ""
+        )
+        return f"this is a WHEELTEC chassis port{rate}: status frames every 50 ms{booting}"
     if finding.kind == "silent":
         spent = sum(h.seconds for h in finding.heard)
         return f"silent: nothing came in {spent:.1f} s{_tried(finding)}"
@@ -182,6 +187,14 @@ def fix(finding: probe.Finding) -> str:
         return (
             f"drive it with: appmode drive {_at_rate(finding, 115200)} --uart2 (it takes "
             "the motion over from the APP port)"
+        )
+    if finding.kind == "chassis":
+        where = _at_rate(finding, 115200)
+        if finding.profile is not None or finding.target.simulated:  # sim:// names its own
+            return f"drive it with: appmode drive {where} --chassis (it moves sideways: mecanum)"
+        return (
+            f"drive it with: appmode drive {where} --chassis --profile wheeltec-mec, "
+            "wheeltec-akm or wheeltec-diff: your car's kind (its status frames do not say)"
         )
     if finding.kind == "silent":
         return (

@@ -1,7 +1,8 @@
 """What a port carries, judged on the bytes alone (no I/O): `Heard` counts what came at
-one rate — APP records and their rhythm, control-port traffic, text — and `judge` says
-what the rates heard so far show: a car's APP port, its control port, a port that is
-silent, one that talks text, or noise; or that the next rate is worth a listen. The
+one rate — APP records and their rhythm, control-port traffic, a chassis port's status
+frames, text — and `judge` says what the rates heard so far show: a car's APP port, its
+control port, a WHEELTEC chassis port, a port that is silent, one that talks text, or
+noise; or that the next rate is worth a listen. The
 firmware is told from what it sends, against the shipped profiles (`identify`)."""
 
 from __future__ import annotations
@@ -12,8 +13,8 @@ from typing import Literal
 
 from appmode.board.profiles import Profile, profile_named
 from appmode.host import identify
-from appmode.line.wire import UART2_BAUD
-from appmode.protocol import app, app_decoders, control, control_decoders
+from appmode.line.wire import CHASSIS_BAUD, UART2_BAUD
+from appmode.protocol import app, app_decoders, chassis, control, control_decoders
 from appmode.protocol.escaping import text_part
 
 ENOUGH = 3
@@ -54,6 +55,13 @@ class Heard:
     """The first records (letter, values), whatever their field counts."""
     said: bytearray = field(default_factory=bytearray)
     """The first text outside records (a start-up text, a `##$` reply)."""
+    statuses: int = 0
+    """A chassis port's status frames (§15)."""
+    status_bytes: int = 0
+    sideways: bool = False
+    """A status frame showed sideways motion: only a mecanum car's can."""
+    booting: bool = False
+    """A status frame had Flag_Stop set."""
 
     @property
     def sent(self) -> identify.Sent:
@@ -91,6 +99,11 @@ class Heard:
         return self.reports > 0 or self.uart2_bursts <= STATUS_RATE * max(self.seconds, 0.1)
 
     @property
+    def carries_chassis(self) -> bool:
+        """A chassis port's status frames, making up most of the bytes."""
+        return self.statuses >= ENOUGH and 10 * self.status_bytes >= 8 * self.size
+
+    @property
     def text(self) -> bool:
         """Mostly printable text outside records: a program that talks, or a board's
         start-up text, not a board at a wrong rate (whose bytes are mostly not text)."""
@@ -109,9 +122,16 @@ class Heard:
         at: float,
         app_decoder: app_decoders.BoardDecoder,
         uart2_decoder: control_decoders.ReplyDecoder,
+        status_decoder: chassis.StatusDecoder,
     ) -> None:
         """Count what `data`, come at `at` s, holds."""
         self.size += len(data)
+        for status in status_decoder.feed(data):
+            if isinstance(status, chassis.Status):
+                self.statuses += 1
+                self.status_bytes += len(status.raw)
+                self.sideways |= status.vy != 0
+                self.booting |= bool(status.flag_stop)
         for event in app_decoder.feed(data):
             if isinstance(event, app.RECORDS) and event.terminated:
                 self.record_times.append(at)
@@ -132,7 +152,7 @@ class Heard:
                 self.reports += isinstance(burst, control.EncoderReport)
 
 
-Kind = Literal["app", "uart2", "silent", "text", "noise"]
+Kind = Literal["app", "uart2", "chassis", "silent", "text", "noise"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -153,6 +173,8 @@ def judge(heard: list[Heard], fixed: bool, more: bool) -> Verdict | None:
         return Verdict("app", one)
     if one.carries_uart2 and (one.baud == UART2_BAUD or fixed):
         return Verdict("uart2", one)
+    if one.carries_chassis and (one.baud == CHASSIS_BAUD or fixed):
+        return Verdict("chassis", one)
     settled = (one.text and not one.records) or (len(heard) == 2 and not any(h.size for h in heard))
     # text that reads as text: the rate is right, and no board talks so; or silent at the
     # APP port's rate and at the control port's

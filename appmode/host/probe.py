@@ -28,7 +28,7 @@ from appmode.host.heard import STARTED, Heard, Kind, firmware, judge
 from appmode.line.wire import APP_BAUD, UART2_BAUD
 from appmode.ports.target import Target
 from appmode.ports.urls import open_link
-from appmode.protocol import app_decoders, control_decoders, param_values
+from appmode.protocol import app_decoders, chassis, control_decoders, param_values
 
 RATES = (APP_BAUD, UART2_BAUD, 38400, 57600, 19200, 4800, 2400, 1200)
 """The rates tried, in order: the APP port's, the control port's, then a Bluetooth
@@ -52,7 +52,8 @@ class Finding:
 
     target: Target
     kind: Kind | str
-    """`app`, `uart2` (a car's port), `silent`, `noise`, `text`; `unopened` or `lost`."""
+    """`app`, `uart2`, `chassis` (a car's port), `silent`, `noise`, `text`; `unopened` or
+    `lost`."""
     baud: int | None = None
     """The rate the port carried what it did at (None: none showed)."""
     profile: str | None = None
@@ -79,7 +80,7 @@ class Finding:
 
     @property
     def is_car(self) -> bool:
-        return self.kind in ("app", "uart2")
+        return self.kind in ("app", "uart2", "chassis")
 
     @property
     def shown(self) -> Heard | None:
@@ -94,9 +95,10 @@ def listen(
     its start-up text); the port stays open for a read that follows."""
     port = open_link(url, timeout=0.02, baud=baud)
     heard = Heard(baud)
-    app_decoder, uart2_decoder = (
+    app_decoder, uart2_decoder, status_decoder = (
         app_decoders.BoardDecoder(b_fields=None),  # any field count: the firmware is not known
         control_decoders.ReplyDecoder(wheels=None),
+        chassis.StatusDecoder(),
     )
     start = time.monotonic()
     try:
@@ -105,7 +107,8 @@ def listen(
             # (a loaded machine) still reads what came meanwhile before it judges
             data = port.read(max(1, port.in_waiting))
             if data:
-                heard.feed(data, time.monotonic() - start, app_decoder, uart2_decoder)
+                decoders = (app_decoder, uart2_decoder, status_decoder)
+                heard.feed(data, time.monotonic() - start, *decoders)
             starting = heard.text and heard.records < STARTED
             if time.monotonic() - start >= (STARTING if starting else seconds):
                 break
@@ -151,7 +154,9 @@ def _probe(target: Target, stop: threading.Event, progress: Progress) -> Finding
 
 def _found(target: Target, kind: Kind, shown: Heard | None, heard: list[Heard]) -> Finding:
     baud = None if shown is None else shown.baud
-    return Finding(target=target, kind=kind, baud=baud, heard=heard)
+    mecanum = kind == "chassis" and shown is not None and shown.sideways
+    profile = "wheeltec-mec" if mecanum else None  # only a mecanum car moves sideways
+    return Finding(target=target, kind=kind, baud=baud, heard=heard, profile=profile)
 
 
 def _car(

@@ -115,3 +115,13 @@ def test_record_chassis_writes_the_status_frames(tmp_path: Path) -> None:
     lines = [line for line in out.read_text().splitlines() if " c< " in line]
     assert len(lines) == 4 and all(line.endswith(" 7D") for line in lines)
     assert "record: 4 status frames, 0 errors" in done.stderr
+
+
+def test_doctor_recognises_a_chassis_port(tmp_path: Path) -> None:
+    with board_process("--pty", "--profile", "wheeltec-akm") as board:
+        assert board.chassis is not None
+        done = run("doctor", board.chassis, "--json")
+    assert done.returncode == 0, done.stderr
+    (finding,) = [json.loads(line) for line in done.stdout.splitlines()]
+    assert finding["kind"] == "chassis" and finding["car"] and finding["baud"] == 115200
+    assert "--chassis --profile wheeltec-mec, wheeltec-akm or wheeltec-diff" in finding["fix"]
