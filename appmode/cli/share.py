@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import quote
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import HOLDS, Subparsers, add_profile, board_choice, target
+from appmode.cli.options import HOLDS, Subparsers, add_chassis, add_profile, board_choice, target
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
@@ -74,6 +74,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "checked and everything encrypted (a client needs the certificate: ca= in the URL)",
     )
     add_profile(share, f"the car's profile, {HOLDS}", default=None)
+    add_chassis(share, "share a WHEELTEC car's chassis port (clients open it with port=chassis)")
     return share
 
 

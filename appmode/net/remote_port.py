@@ -31,6 +31,7 @@ from appmode.net.share import unstamp
 from appmode.ports.modemless import Modemless
 from appmode.ports.remote import RemoteTarget, WriteRefused
 from appmode.ports.urls import port_target
+from appmode.protocol.reader import RECEIVED_DIRECTIONS
 
 if TYPE_CHECKING:
     import zenoh
@@ -142,7 +143,7 @@ class RemoteSerial(Modemless):
         if sample.attachment is None:
             return
         at, direction = unstamp(sample.attachment.to_bytes())
-        if direction not in ("<", "2<"):
+        if direction not in RECEIVED_DIRECTIONS:
             return
         data = sample.payload.to_bytes()
         self._host_heard = time.monotonic()

@@ -27,6 +27,7 @@ from appmode.net.hosts import claim
 from appmode.net.lease import Driver, Granted, Lease, Refused
 from appmode.net.names import ANY_STOP, Keys
 from appmode.protocol import app
+from appmode.protocol.reader import SENT_DIRECTIONS
 from appmode.protocol.render import to_json
 from appmode.text import escaped, shortened
 
@@ -136,7 +137,7 @@ class Share:
             if link is None or publisher is None or self._closed.is_set():
                 return
             when = at + link.origin - self._origin
-            if direction in (">", "2>"):
+            if direction in SENT_DIRECTIONS:
                 self._written[port] = when
             publisher.put(data, attachment=stamp(when, direction))
 

@@ -15,6 +15,10 @@ from appmode.protocol.params import DriveType
 SENT, RECEIVED, SENT2, RECEIVED2 = ">", "<", "2>", "2<"
 SENT_CHASSIS, RECEIVED_CHASSIS = "c>", "c<"
 """A WHEELTEC board's chassis port (§15): velocity frames in, status frames out."""
+SENT_DIRECTIONS = (SENT, SENT2, SENT_CHASSIS)
+"""What a host sent, on any port."""
+RECEIVED_DIRECTIONS = (RECEIVED, RECEIVED2, RECEIVED_CHASSIS)
+"""What a board sent, on any port."""
 Event = app.Event | control.HostEvent | control.BoardEvent | chassis.Event
 APP_EVENTS = app.Event
 """The events of APP text: on UART2, what APP mode carries (§12)."""

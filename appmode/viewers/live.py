@@ -19,10 +19,10 @@ from typing import Any
 
 from appmode.errors import AppmodeError
 from appmode.protocol.channels import RAW, channels
+from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
-from appmode.protocol.reader import PortsReader
-from appmode.protocol.render import describe
+from appmode.protocol.reader import SENT_DIRECTIONS, PortsReader
 
 QUEUE = 4096
 """Units and notes waiting for the worker at most (seconds of a flood: they are small)."""
@@ -157,9 +157,9 @@ class LiveView:
         self._channels[RAW[direction]].log(
             {"text": escape(raw), "hex": raw.hex(" "), "length": len(raw)}, log_time=ns
         )
-        text = describe(event, self._layout)
+        text = view(event, self._layout)[1]
         self._note(when, f"{direction} {escape(raw)}  {text}", level="Debug")
-        moves = _moves(event) if direction in (">", "2>") else None
+        moves = _moves(event) if direction in SENT_DIRECTIONS else None
         if moves is not None:
             self._channels[IN_FORCE].log(
                 {"command": escape(raw), "text": text, "moving": moves}, log_time=ns
@@ -198,8 +198,10 @@ def _ns(when: float) -> int:
 
 def _moves(event: Any) -> bool | None:
     """Whether a command sets the car moving (True), stops it (False), or neither."""
-    from appmode.protocol import app, control
+    from appmode.protocol import app, chassis, control
 
+    if isinstance(event, chassis.Command):
+        return not event.twist.still
     if isinstance(event, app.Move):
         return event.direction != 0
     if isinstance(event, app.Stop):
