@@ -6,7 +6,14 @@ import argparse
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.live_view import add_foxglove, live_view
-from appmode.cli.options import DAY, Subparsers, add_profile, file_name, number_type
+from appmode.cli.options import (
+    DAY,
+    Subparsers,
+    add_chassis,
+    add_profile,
+    file_name,
+    number_type,
+)
 from appmode.errors import AppmodeError
 
 
@@ -62,12 +69,14 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "-v", "--verbose", action="store_true", help="print each line as it is played"
     )
     add_profile(replay, default=None, unset="the transcript's @board profile=…, else sheet")
+    add_chassis(replay, "play the transcript's chassis lines (c> or c<) to a chassis port")
     add_foxglove(replay, "the transcript")
     return replay
 
 
 def run(args: argparse.Namespace) -> int:
     from appmode.board.profiles import profile_named
+    from appmode.line.wire import APP, CHASSIS
     from appmode.transcript.dump import needs_of
     from appmode.transcript.replay import run_replay
 
@@ -91,4 +100,5 @@ def run(args: argparse.Namespace) -> int:
             skip=args.skip,
             verbose=args.verbose,
             view=view,
+            port=CHASSIS if args.chassis else APP,
         )

@@ -25,10 +25,15 @@ import serial
 
 from appmode.errors import AppmodeError
 from appmode.host.app.client import Host
+from appmode.host.chassis.client import ChassisHost
+from appmode.line.wire import APP, CHASSIS
 from appmode.ports.urls import new_pty, open_link
 from appmode.ports.wakeups import exact_wakeups
+from appmode.protocol import chassis
 from appmode.protocol.app_decoders import BoardDecoder, HostDecoder
-from appmode.protocol.render import describe, line
+from appmode.protocol.control_view import view as view_of
+from appmode.protocol.reader import RECEIVED, RECEIVED_CHASSIS, SENT, SENT_CHASSIS
+from appmode.protocol.render import line
 from appmode.transcript.reading import read_transcript
 
 if TYPE_CHECKING:
@@ -36,13 +41,26 @@ if TYPE_CHECKING:
     from appmode.protocol.channels import Viewer
 
 Item = tuple[float, bytes]
+Decoder = HostDecoder | BoardDecoder | chassis.CommandDecoder | chassis.StatusDecoder
 EARLY = 0.0005
 """Seconds before a deadline that `play` wakes, to sleep the rest."""
 
 
-def plan(entries: Sequence[tuple[float, str, bytes]], side: str) -> list[Item]:
-    """The (time, bytes) a side sends: `>` lines for the host, `<` lines for the board."""
-    direction = ">" if side == "host" else "<"
+LINES = {APP: (SENT, RECEIVED), CHASSIS: (SENT_CHASSIS, RECEIVED_CHASSIS)}
+"""The lines each port's host and board send, by the port a replay plays."""
+DECODERS: dict[str, tuple[Callable[[], Decoder], Callable[[], Decoder]]] = {
+    APP: (HostDecoder, BoardDecoder),
+    CHASSIS: (chassis.CommandDecoder, chassis.StatusDecoder),
+}
+"""What reads each side of each port, for `--verbose`."""
+HOSTS: dict[str, Callable[[str], Host | ChassisHost]] = {APP: Host, CHASSIS: ChassisHost}
+"""The host that plays the host's side of each port (and stops the car at its end)."""
+
+
+def plan(entries: Sequence[tuple[float, str, bytes]], side: str, port: str = APP) -> list[Item]:
+    """The (time, bytes) a side sends: `>` lines for the host, `<` lines for the board
+    (`c>` and `c<` on a chassis port)."""
+    direction = LINES[port][side != "host"]
     return sorted(((t, data) for t, d, data in entries if d == direction), key=lambda i: i[0])
 
 
@@ -109,10 +127,12 @@ def run_replay(
     skip: float | None = None,
     verbose: bool = False,
     view: Viewer | None = None,
+    port: str = APP,
 ) -> int:
     """Play one side (`host` or `board`) of the transcript at `path` to `url` (`pty`: a new
-    pseudo-terminal, for an app to open), `loops` times at `speed`× its pace; with a live
-    `view`, what is played is shown there too (both sides when `url` is None)."""
+    pseudo-terminal, for an app to open), `loops` times at `speed`× its pace, of its APP
+    port or a chassis `port`; with a live `view`, what is played is shown there too (both
+    sides when `url` is None)."""
     transcript = read_transcript(path)
     for warning in transcript.warnings:
         print(f"appmode: WARNING: {warning}", file=sys.stderr)
@@ -121,8 +141,8 @@ def run_replay(
         if view is None:
             raise AppmodeError("replay: nowhere to play to: give --to URL or --foxglove PORT")
         return _to_view(path, entries, view, speed, loops, gap, skip)
-    items = retime(plan(entries, side), gap, skip)
-    mark = ">" if side == "host" else "<"
+    items = retime(plan(entries, side, port), gap, skip)
+    mark = LINES[port][side != "host"]
     if not items:
         raise AppmodeError(f"{path} has no '{mark}' lines to play as the {side}")
     show = _progress(path) if sys.stderr.isatty() and not verbose else None
@@ -135,17 +155,19 @@ def run_replay(
             write = _also_shown(write, view, mark, started)
         if not verbose:
             return write
-        decoder = HostDecoder() if side == "host" else BoardDecoder()
+        decoder = DECODERS[port][side != "host"]()
 
         def write_and_print(data: bytes) -> None:
             write(data)
-            text = ", ".join(describe(e) for e in decoder.feed(data))
-            print(line(time.monotonic() - started, mark, data, text), flush=True)
+            views = [view_of(e) for e in decoder.feed(data)]
+            text = ", ".join(v[1] for v in views)
+            hexed = views[0][2] if views else None  # a chassis port's frames as hex
+            print(line(time.monotonic() - started, mark, data, text, hexed), flush=True)
 
         return write_and_print
 
     if side == "host":
-        with Host(url) as host:
+        with HOSTS[port](url) as host:
             late = play(
                 items,
                 shown(host.send),
@@ -155,20 +177,20 @@ def run_replay(
                 progress=show,
             )
     else:
-        port = _open_for_app(url)
+        link = _open_for_app(url)
         try:
             late = play(
                 items,
-                shown(port.write),
+                shown(link.write),
                 speed=speed,
                 loops=loops,
-                idle=lambda: port.read(port.in_waiting),  # what the app says meanwhile
+                idle=lambda: link.read(link.in_waiting),  # what the app says meanwhile
                 progress=show,
             )
         except (serial.SerialException, OSError) as exc:
             raise AppmodeError(f"lost {url} during the replay: {exc}") from None
         finally:
-            port.close()
+            link.close()
     if show is not None:
         print(file=sys.stderr)
     worst = max(late) * 1000

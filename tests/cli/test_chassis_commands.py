@@ -125,3 +125,22 @@ def test_doctor_recognises_a_chassis_port(tmp_path: Path) -> None:
     (finding,) = [json.loads(line) for line in done.stdout.splitlines()]
     assert finding["kind"] == "chassis" and finding["car"] and finding["baud"] == 115200
     assert "--chassis --profile wheeltec-mec, wheeltec-akm or wheeltec-diff" in finding["fix"]
+
+
+def test_replay_chassis_plays_a_session_again_and_ends_with_a_zero_frame(tmp_path: Path) -> None:
+    session = tmp_path / "session.transcript"
+    done = run(
+        "send", "sim://?profile=wheeltec-mec", "--chassis", "velocity:0.2,0,0.3", "wait:0.35",
+        "stop", "--record", str(session), "--listen", "0",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    played = [line.split(" ", 2)[2] for line in session.read_text().splitlines() if " c> " in line]
+    record = tmp_path / "board.transcript"
+    with board_process("--pty", "--profile", "wheeltec-mec", "--record", str(record)) as board:
+        assert board.chassis is not None
+        again = run("replay", str(session), "--to", board.chassis, "--chassis")
+        assert again.returncode == 0, again.stderr
+    got = [line.split(" ", 2)[2] for line in record.read_text().splitlines() if " c> " in line]
+    assert got[: len(played)] == played
+    assert got[-1] == chassis.STOP.hex(" ").upper(), "the replay, a host, ends with the stop"
+    assert f"replayed {len(played)} commands" in again.stderr
