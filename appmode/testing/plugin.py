@@ -61,11 +61,17 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         metavar="URL",
         help="with --appmode-board: the real board's control port (UART2)",
     )
+    group.addoption(
+        "--appmode-chassis",
+        metavar="URL",
+        help="with --appmode-board: the real WHEELTEC board's chassis port "
+        "(/dev/wheeltec_controller)",
+    )
 
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", MARKER)
-    for option in ("--appmode-board", "--appmode-board2"):
+    for option in ("--appmode-board", "--appmode-board2", "--appmode-chassis"):
         url = config.getoption(option)
         if url is not None:
             _check_url(option, url)
@@ -93,9 +99,9 @@ def _stop_real(board: RealBoard, profile: str | None) -> None:
     """Send a real car its stop, whatever the test left (it may have failed mid-drive)."""
     from appmode.board.profiles import profile_named
     from appmode.errors import AppmodeError
-    from appmode.line.wire import UART2_BAUD
+    from appmode.line.wire import CHASSIS_BAUD, UART2_BAUD
     from appmode.ports.urls import BAUD, open_link
-    from appmode.protocol import control
+    from appmode.protocol import chassis, control
     from appmode.protocol.session_end import stop_again
 
     try:
@@ -105,6 +111,8 @@ def _stop_real(board: RealBoard, profile: str | None) -> None:
     stops = [(board.port, stop_again(frames_take_letters=not steer_in_frames), BAUD)]
     if board.uart2_url is not None:  # twice: the second is whole whatever half-frame was left
         stops.append((board.uart2_url, control.STOP * 2, UART2_BAUD))
+    if board.chassis_url is not None:  # a chassis may never stop by itself: its zero frame
+        stops.append((board.chassis_url, chassis.STOP, CHASSIS_BAUD))
     for url, stop, baud in stops:
         try:
             link = open_link(url, baud=baud)
@@ -141,15 +149,22 @@ def _check_options(options: dict[str, Any]) -> None:
 class RealBoard:
     """A real board given by --appmode-board: its URLs; the rest skips the test."""
 
-    def __init__(self, port: str, uart2: str | None) -> None:
+    def __init__(self, port: str, uart2: str | None, chassis: str | None = None) -> None:
         self.port = port
         self.uart2_url = uart2
+        self.chassis_url = chassis
 
     @property
     def uart2(self) -> str:
         if self.uart2_url is None:
             pytest.skip("the test uses the control port (UART2): give --appmode-board2 URL")
         return self.uart2_url
+
+    @property
+    def chassis(self) -> str:
+        if self.chassis_url is None:
+            pytest.skip("the test uses the chassis port: give --appmode-chassis URL")
+        return self.chassis_url
 
     @staticmethod
     def _only_simulated(what: str) -> Any:
@@ -179,7 +194,8 @@ def _real(config: pytest.Config, options: dict[str, Any]) -> RealBoard | None:
     for name in ("faults", "flash", "drive"):
         if options.get(name):
             pytest.skip(f"{name}= is for the simulated board; --appmode-board is a real one")
-    return RealBoard(url, config.getoption("--appmode-board2"))
+    config_of = config.getoption
+    return RealBoard(url, config_of("--appmode-board2"), config_of("--appmode-chassis"))
 
 
 @pytest.fixture
@@ -230,7 +246,8 @@ def appmode_board(
     request: pytest.FixtureRequest, appmode_board_factory: Callable[..., ServedBoard | RealBoard]
 ) -> ServedBoard | RealBoard:
     """A simulated board served on two ptys for this test: `.port` (APP port, 9600 bps),
-    `.uart2` (control port, 115200 bps), `.recording()`, `.state`, `.wait_until(…)`,
+    `.uart2` (control port, 115200 bps), `.chassis` (a WHEELTEC profile's chassis port,
+    on a third), `.recording()`, `.state`, `.wait_until(…)`,
     `.restart()`, `.assert_conforms(path)`; options by `@pytest.mark.appmode_board`."""
     return appmode_board_factory(**_options(request))
 

@@ -5,8 +5,8 @@ With `bluetooth=True` its APP port is a Bluetooth module behind the BlueZ stand-
 `appmode board --bluetooth` serves it. Its ports are otherwise what `appmode board`
 serves: the APP port (UART3, 9600 bps) and the control port (UART2, 115200 bps), paced
 like the real lines; on Windows, where there are no ptys, two loopback TCP ports
-(`socket://127.0.0.1:N`). Everything either port carries is recorded, as by
-`appmode board --record`.
+(`socket://127.0.0.1:N`); a WHEELTEC profile's board serves its chassis port too (115200
+bps). Everything each port carries is recorded, as by `appmode board --record`.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from appmode.board.profiles import SHEET, profile_named
 from appmode.board.store import open_store
 from appmode.errors import AppmodeError
 from appmode.line.faults import FaultSpec
-from appmode.line.wire import APP, UART2
+from appmode.line.wire import APP, CHASSIS, UART2
 from appmode.ports.endpoints import MakeEndpoint, PtyEndpoint, TcpEndpoint
 from appmode.ports.serve import BoardServer
 from appmode.protocol import params
@@ -130,6 +130,7 @@ class ServedBoard:
                 record=str(self.transcript_path),
                 directives=(f"board {' '.join(needs)}",) if needs else (),
                 make_uart2=[_endpoint()],
+                make_chassis=[_endpoint()] if self.profile.chassis is not None else None,
                 faults=spec,
             )
         except BaseException:
@@ -141,6 +142,8 @@ class ServedBoard:
         """The APP port (UART3, 9600 bps): a path or URL that pyserial opens."""
         self.uart2: str = urls[UART2]
         """The control port (UART2, 115200 bps)."""
+        self.chassis: str | None = urls.get(CHASSIS)
+        """A WHEELTEC profile's chassis port (115200 bps), else None."""
         details = dict(line.split(": ", 1) for line in self._server.details())
         self.bus: str | None = details.get("bus")
         """With `bluetooth`: the BlueZ stand-in's bus, for DBUS_SYSTEM_BUS_ADDRESS."""

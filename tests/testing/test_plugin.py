@@ -237,3 +237,35 @@ def test_a_bad_marker_fails_in_one_line(tmp_path: Path) -> None:
     assert "appmode_board: appmode_board:" not in done.stdout
     assert "During handling of the above exception" not in done.stdout
     assert "appmode_board: " in done.stdout
+
+
+@pytest.mark.appmode_board(profile="wheeltec-diff")
+def test_a_wheeltec_board_serves_its_chassis_port(appmode_board: ServedBoard) -> None:
+    from appmode.protocol import chassis
+
+    assert appmode_board.chassis is not None
+    with serial.Serial(appmode_board.chassis, 115200, timeout=1) as port:
+        data = port.read(3 * chassis.STATUS_LEN)
+    frames = [e for e in chassis.StatusDecoder().feed(data) if isinstance(e, chassis.Status)]
+    assert frames and frames[-1].flag_stop == 1, "booting: Flag_Stop"
+    assert any(e.direction == "c<" for e in appmode_board.recording().entries)
+
+
+def test_a_real_chassis_is_sent_its_zero_frame_at_every_teardown(tmp_path: Path) -> None:
+    """A chassis may never stop by itself: the plugin ends a test with its zero frame."""
+    (tmp_path / "pytest.ini").write_text("[pytest]\n")
+    (tmp_path / "test_car.py").write_text(
+        "import serial\n\n"
+        "def test_drives_then_fails(appmode_board):\n"
+        "    with serial.serial_for_url(appmode_board.chassis, 115200, timeout=1) as port:\n"
+        "        port.write(bytes.fromhex('7B 00 00 01 2C 00 00 00 00 56 7D'))\n"
+        "        port.flush()\n"
+        "    assert False, 'the test failed mid-drive'\n"
+    )
+    with ServedBoard(tmp_path / "car", profile="wheeltec-mec") as car:
+        assert car.chassis is not None
+        done = pytest_in(tmp_path, "--appmode-board", car.port, "--appmode-chassis", car.chassis)
+        time.sleep(0.3)
+        sent = [e.text for e in car.recording().entries if e.direction == "c>"]
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert sent[-1] == "7B 00 00 00 00 00 00 00 00 7B 7D", sent
