@@ -147,24 +147,14 @@ def run_replay(
         raise AppmodeError(f"{path} has no '{mark}' lines to play as the {side}")
     show = _progress(path) if sys.stderr.isatty() and not verbose else None
     started = time.monotonic()
+    decoder = DECODERS[port][side != "host"]() if verbose else None
 
     def shown(write: Callable[[bytes], object]) -> Callable[[bytes], object]:
         """`write`, printing each unit as it goes (-v), and showing it in the live view."""
         if view is not None:
             view.epoch = time.time()
             write = _also_shown(write, view, mark, started)
-        if not verbose:
-            return write
-        decoder = DECODERS[port][side != "host"]()
-
-        def write_and_print(data: bytes) -> None:
-            write(data)
-            views = [view_of(e) for e in decoder.feed(data)]
-            text = ", ".join(v[1] for v in views)
-            hexed = views[0][2] if views else None  # a chassis port's frames as hex
-            print(line(time.monotonic() - started, mark, data, text, hexed), flush=True)
-
-        return write_and_print
+        return write if decoder is None else _printed(write, decoder, mark, started)
 
     if side == "host":
         with HOSTS[port](url) as host:
@@ -200,6 +190,21 @@ def run_replay(
         file=sys.stderr,
     )
     return 0
+
+
+def _printed(
+    write: Callable[[bytes], object], decoder: Decoder, mark: str, started: float
+) -> Callable[[bytes], object]:
+    """`write`, printing each unit as it goes (`replay -v`)."""
+
+    def write_and_print(data: bytes) -> None:
+        write(data)
+        views = [view_of(e) for e in decoder.feed(data)]
+        text = ", ".join(v[1] for v in views)
+        hexed = views[0][2] if views else None  # a chassis port's frames as hex
+        print(line(time.monotonic() - started, mark, data, text, hexed), flush=True)
+
+    return write_and_print
 
 
 def _also_shown(
