@@ -87,6 +87,14 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="cmd_vel is geometry_msgs/TwistStamped (as Jazzy's Nav2 sends it)",
     )
     ros.add_argument(
+        "--topics",
+        choices=("appmode", "wheeltec"),
+        default="appmode",
+        help="the topics and frames published: appmode's (odom, /tf, imu, battery_state in "
+        "base_link) or WHEELTEC's driver's (odom in odom_combined → base_footprint, imu in "
+        "gyro_link, PowerVoltage in volts, no TF), for launch files written for it",
+    )
+    ros.add_argument(
         "--cmd-vel-timeout",
         type=float,
         default=0.5,
@@ -125,7 +133,7 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
     from appmode.net.config import close_session, open_session
     from appmode.ports.remote import BadRemote, check_endpoint
     from appmode.ros.graph import Node
-    from appmode.ros.node import Options, RosNode
+    from appmode.ros.node import TOPIC_SETS, Options, RosNode
     from appmode.session.hold import HoldToDrive
     from appmode.session.opener import open_session as open_car
 
@@ -152,7 +160,8 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
         if view is not None:
             session.add_viewer(view)
         graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
-        ros = RosNode(session, zenoh, graph, Options(args.stamped, timeout), _log)
+        options = Options(args.stamped, timeout, TOPIC_SETS[args.topics])
+        ros = RosNode(session, zenoh, graph, options, _log)
         ended = [False]
         try:
             session.start()

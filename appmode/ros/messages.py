@@ -22,7 +22,8 @@ BATTERY = "sensor_msgs/msg/BatteryState"
 IMU = "sensor_msgs/msg/Imu"
 TF = "tf2_msgs/msg/TFMessage"
 STRING = "std_msgs/msg/String"
-TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING)
+FLOAT32 = "std_msgs/msg/Float32"
+TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING, FLOAT32)
 STORES = {"jazzy": Stores.ROS2_JAZZY, "humble": Stores.ROS2_HUMBLE}
 UNKNOWN = -1.0
 """A covariance's first element when the quantity is not measured (REP 145)."""
@@ -117,8 +118,8 @@ class Messages:
         caps it, and 11.10 V at 0 %, where the sheet's floors it: the voltage is then at
         least, or at most, that; the reference firmware's −740 % at power-up is 0 V);
         nothing else measured (NaN)."""
-        volts = (min(100.0, percent) * 1.5 + 1110) / 100
-        return self._battery(volts, max(0.0, min(1.0, percent / 100)), time_ns, frame)
+        fraction = max(0.0, min(1.0, percent / 100))
+        return self._battery(volts_of(percent), fraction, time_ns, frame)
 
     def battery_volts(self, volts: float, time_ns: int, frame: str) -> bytes:
         """A battery's voltage as the board measured it (a chassis port's status, in mV);
@@ -206,6 +207,10 @@ class Messages:
     def text(self, data: str) -> bytes:
         return self._cdr(self._make(STRING, data=data), STRING)
 
+    def float32(self, value: float) -> bytes:
+        """A std_msgs/Float32 (the vendor driver's PowerVoltage, in volts)."""
+        return self._cdr(self._make(FLOAT32, data=value), FLOAT32)
+
     def twist(self, payload: bytes, stamped: bool) -> tuple[float, float, float, float]:
         """A Twist's (or TwistStamped's) linear x and y and angular z, and its angular x
         and y summed (a car ignores them); ValueError if it is not one."""
@@ -230,6 +235,11 @@ GYRO_VARIANCE = 1e-4
 """(rad/s)²: a MEMS gyro's noise, about 0.01 rad/s."""
 ACCEL_VARIANCE = 2.5e-3
 """(m/s²)²: its accelerometer's, about 0.05 m/s²."""
+
+
+def volts_of(percent: float) -> float:
+    """The voltage an APP record's battery percentage is made from (§3.2)."""
+    return (min(100.0, percent) * 1.5 + 1110) / 100
 
 
 def _diagonal(size: int, values: tuple[float, ...]) -> Any:

@@ -25,6 +25,7 @@ from appmode.protocol.twist import BadTwist, Twist
 from appmode.ros.graph import Node, Qos
 from appmode.ros.messages import (
     BATTERY,
+    FLOAT32,
     IMU,
     ODOMETRY,
     STRING,
@@ -32,6 +33,7 @@ from appmode.ros.messages import (
     TWIST,
     TWIST_STAMPED,
     Messages,
+    volts_of,
 )
 from appmode.ros.wire import attachment, gid
 
@@ -51,14 +53,44 @@ Log = Callable[[str], None]
 
 
 @dataclass(frozen=True, slots=True)
+class TopicSet:
+    """What the node publishes each reading as: the topic (None: not published) and, for
+    the battery, its message type; the frames it names."""
+
+    odom: str
+    tf: str | None
+    imu: str
+    battery: str
+    battery_type: str
+    raw: str | None
+    odom_frame: str
+    base_frame: str
+    imu_frame: str
+
+
+TOPIC_SETS = {
+    "appmode": TopicSet(
+        "odom", "/tf", "imu", "battery_state", BATTERY, "~/raw", "odom", "base_link", "base_link"
+    ),
+    # turn_on_wheeltec_robot: odom (odom_combined → base_footprint, no TF of its own: an
+    # EKF broadcasts it), imu in gyro_link, PowerVoltage as std_msgs/Float32 volts
+    "wheeltec": TopicSet(
+        "odom", None, "imu", "PowerVoltage", FLOAT32, None,
+        "odom_combined", "base_footprint", "gyro_link",
+    ),
+}  # fmt: skip
+"""The topic sets `appmode ros --topics` names."""
+
+
+@dataclass(frozen=True, slots=True)
 class Options:
     """How the node is seen and what it takes: `stamped` cmd_vel (TwistStamped, as
-    Jazzy's Nav2 sends it), the frames it names, the silence after which it stops."""
+    Jazzy's Nav2 sends it), the silence after which it stops, the topics and frames it
+    publishes (`TOPIC_SETS`)."""
 
     stamped: bool = False
     timeout: float = 0.5
-    odom_frame: str = "odom"
-    base_frame: str = "base_link"
+    topics: TopicSet = TOPIC_SETS["appmode"]
 
 
 @dataclass
@@ -116,21 +148,23 @@ class RosNode:
         subscription and its token (what `ros2 node list` and `topic info` show)."""
         liveliness = self.zenoh.liveliness()
         self._declared.append(liveliness.declare_token(self.graph.node_token()))
-        topics = [
-            ("odom", ODOMETRY, Qos(depth=10)),
-            ("/tf", TF, Qos(depth=100)),
-            ("battery_state", BATTERY, Qos(depth=10)),
-            ("imu", IMU, Qos(depth=10)),
-            ("~/raw", STRING, Qos(depth=10)),
+        names = self.options.topics
+        each = [
+            ("odom", names.odom, ODOMETRY, Qos(depth=10)),
+            ("tf", names.tf, TF, Qos(depth=100)),
+            ("battery", names.battery, names.battery_type, Qos(depth=10)),
+            ("imu", names.imu, IMU, Qos(depth=10)),
+            ("raw", names.raw, STRING, Qos(depth=10)),
         ]
-        for entity_id, (topic, ros_type, qos) in enumerate(topics, start=1):
+        topics = [(name, topic, kind, qos) for name, topic, kind, qos in each if topic]
+        for entity_id, (name, topic, ros_type, qos) in enumerate(topics, start=1):
             type_hash = self.messages.type_hash(ros_type)
             token = self.graph.entity_token(entity_id, "MP", topic, ros_type, type_hash, qos)
             key = self.graph.topic_key(topic, ros_type, type_hash)
             publisher = Publisher(topic, ros_type, key, token, gid(token))
             publisher.zenoh = self.zenoh.declare_publisher(key)
             self._declared += [publisher.zenoh, liveliness.declare_token(token)]
-            self.publishers[topic] = publisher
+            self.publishers[name] = publisher
         twist = TWIST_STAMPED if self.options.stamped else TWIST
         type_hash = self.messages.type_hash(twist)
         entity_id = len(topics) + 1
@@ -230,10 +264,10 @@ class RosNode:
 
     def _odometry(self, twist: Twist, at: float, stamp: int) -> None:
         pose = self.odometry.step(at, twist)
-        odom, base = self.options.odom_frame, self.options.base_frame
+        odom, base = self.options.topics.odom_frame, self.options.topics.base_frame
         variance = self.odometry.variance
         self._put("odom", self.messages.odometry(pose, stamp, odom, base, variance))
-        self._put("/tf", self.messages.transform(pose, stamp, odom, base))
+        self._put("tf", self.messages.transform(pose, stamp, odom, base))
 
     def _attitude(self, event: Any, state: HostState, at: float, stamp: int) -> None:
         """The B record's attitude as imu: its orientation, and its rates over the last
@@ -245,38 +279,47 @@ class RosNode:
             self._angles.append((at, angles))
             while self._angles and self._angles[0][0] < at - YAW_WINDOW:
                 self._angles.popleft()
-            rates = [
-                yaw_rate([(t, a[axis]) for t, a in self._angles], at) for axis in range(3)
-            ]
+            rates = [yaw_rate([(t, a[axis]) for t, a in self._angles], at) for axis in range(3)]
             roll, pitch, yaw = (math.radians(angle) for angle in angles)
             known = None if None in rates else tuple(math.radians(r or 0.0) for r in rates)
-            imu = self.messages.imu(roll, pitch, yaw, stamp, self.options.base_frame, known)
-            self._put("imu", imu)
+            frame = self.options.topics.imu_frame
+            self._put("imu", self.messages.imu(roll, pitch, yaw, stamp, frame, known))
         self._battery(fields, stamp)
 
     def _inertial(self, reading: Inertial, stamp: int) -> None:
         """An IMU's own rates and accelerations as imu; its battery, every BATTERY_EVERY
-        readings, as battery_state."""
-        frame = self.options.base_frame
-        imu = self.messages.imu_raw(reading.angular_velocity, reading.acceleration, stamp, frame)
-        self._put("imu", imu)
+        readings."""
+        topics, messages = self.options.topics, self.messages
+        rates, accelerations = reading.angular_velocity, reading.acceleration
+        self._put("imu", messages.imu_raw(rates, accelerations, stamp, topics.imu_frame))
         self._readings += 1
-        if reading.volts is not None and self._readings % BATTERY_EVERY == 1:
-            self._put("battery_state", self.messages.battery_volts(reading.volts, stamp, frame))
+        if reading.volts is None or self._readings % BATTERY_EVERY != 1:
+            return
+        if topics.battery_type == FLOAT32:
+            self._put("battery", messages.float32(reading.volts))
+        else:
+            self._put("battery", messages.battery_volts(reading.volts, stamp, topics.base_frame))
 
     def _battery(self, fields: dict[str, tuple[float, Any]], stamp: int) -> None:
+        topics, messages = self.options.topics, self.messages
         for value, field in fields.values():
-            if field.battery:
-                self._put(
-                    "battery_state", self.messages.battery(value, stamp, self.options.base_frame)
-                )
+            if not field.battery:
+                continue
+            if topics.battery_type == FLOAT32:
+                self._put("battery", messages.float32(volts_of(value)))
+            else:
+                self._put("battery", messages.battery(value, stamp, topics.base_frame))
 
     def _raw(self, event: Any, state: HostState, stamp: int) -> None:
         raw = to_json(event, state.layout).get("raw", "")
-        self._put("~/raw", self.messages.text(str(raw)))
+        self._put("raw", self.messages.text(str(raw)))
 
-    def _put(self, topic: str, payload: bytes) -> None:
-        publisher = self.publishers[topic]
+    def _put(self, name: str, payload: bytes) -> None:
+        """Publish `payload` as the reading `name` (odom, tf, imu, battery, raw), where
+        the topic set publishes it."""
+        publisher = self.publishers.get(name)
+        if publisher is None:
+            return
         publisher.sequence += 1
         extra = attachment(publisher.sequence, time.time_ns(), publisher.gid)
         publisher.zenoh.put(payload, attachment=extra)

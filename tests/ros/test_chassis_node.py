@@ -28,8 +28,20 @@ def sent(record: Path) -> list[str]:
     return [line.split(" c> ", 1)[1] for line in lines if " c> " in line]
 
 
+TOPICS = {
+    "appmode": ("/battery_state", "base_link", "odom", "base_link"),
+    "wheeltec": ("/PowerVoltage", "gyro_link", "odom_combined", "base_footprint"),
+}
+
+
 @pytest.mark.slow
-def test_ros_drives_a_wheeltec_car_and_publishes_what_its_status_says(tmp_path: Path) -> None:
+@pytest.mark.parametrize("topics", list(TOPICS))
+def test_ros_drives_a_wheeltec_car_and_publishes_what_its_status_says(
+    tmp_path: Path, topics: str
+) -> None:
+    """As the vendor's driver: with `--topics wheeltec` its topic names, frames and
+    PowerVoltage (std_msgs/Float32, volts), and no TF of its own."""
+    power, imu_frame, odom_frame, base_frame = TOPICS[topics]
     profile = tmp_path / "quick.toml"
     profile.write_text(
         'name = "quick"\nlike = "wheeltec-mec"\n[chassis]\nkind = "mec"\nboot_ms = 500\n'
@@ -41,20 +53,22 @@ def test_ros_drives_a_wheeltec_car_and_publishes_what_its_status_says(tmp_path: 
     assert board.chassis is not None
     node, line = serving(
         "ros", board.chassis, "--chassis", "--profile", str(profile), "--connect", endpoint,
-        data=tmp_path / "data",
+        "--topics", topics, data=tmp_path / "data",
     )  # fmt: skip
     ros = peer.session(endpoint)
     try:
         assert line.startswith("ros: node /appmode"), f"{line!r}: {stop_process(node)}"
         end = time.monotonic() + 15
-        while len(entities := peer.graph(ros)) < 7 and time.monotonic() < end:
+        want = 7 if topics == "appmode" else 5  # the node, its publishers, cmd_vel
+        while len(entities := peer.graph(ros)) < want and time.monotonic() < end:
             time.sleep(0.2)
         topic = {e.topic: e for e in entities}
         odom, imu, battery = peer.Received(), peer.Received(), peer.Received()
         subscribers = [
             ros.declare_subscriber(topic[name].data_key, got.on_sample)
-            for name, got in (("/odom", odom), ("/imu", imu), ("/battery_state", battery))
+            for name, got in (("/odom", odom), ("/imu", imu), (power, battery))
         ]
+        assert ("/tf" in topic) == (topics == "appmode"), "the vendor's driver sends no TF"
         twist = peer.TwistPublisher(ros, topic["/cmd_vel"])
         start = time.monotonic()
         while time.monotonic() - start < 3.0:
@@ -80,8 +94,13 @@ def test_ros_drives_a_wheeltec_car_and_publishes_what_its_status_says(tmp_path: 
     assert median(m.angular_velocity.z for m in rates) == pytest.approx(0.5, abs=0.05)
     assert all(m.linear_acceleration.z == pytest.approx(9.8, abs=0.1) for m in rates)
     assert rates[-1].orientation_covariance[0] == -1, "no orientation: REP 145's −1"
-    volts = [m.voltage for m in battery.messages("sensor_msgs/msg/BatteryState")]
+    if topics == "wheeltec":
+        volts = [m.data for m in battery.messages("std_msgs/msg/Float32")]
+    else:
+        volts = [m.voltage for m in battery.messages("sensor_msgs/msg/BatteryState")]
     assert volts and all(11.5 <= v <= 12.61 for v in volts), volts[-3:]
+    assert moving[-1].header.frame_id == odom_frame and moving[-1].child_frame_id == base_frame
+    assert rates[-1].header.frame_id == imu_frame
     frames = sent(record)
     assert chassis.command(chassis.Command(300, 0, 500).twist).hex(" ").upper() in frames
     assert frames[-1] == STOP, "silence ends with the zero frame on the board's recording"

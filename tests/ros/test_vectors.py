@@ -28,6 +28,8 @@ HASHES = {
     messages.BATTERY: "RIHS01_4bee5dfce981c98faa6828b868307a0a73f992ed0789f374ee96c8f840e69741",
     messages.IMU: "RIHS01_7d9a00ff131080897a5ec7e26e315954b8eae3353c3f995c55faf71574000b5b",
     messages.TF: "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
+    # PowerVoltage (--topics wheeltec): ROS 2's own golden value (rosidl's CHECK_GOLDEN_HASH)
+    messages.FLOAT32: "RIHS01_7170d3d8f841f7be3172ce5f4f59f3a4d7f63b0447e8b33327601ad64d83d6e2",
 }
 
 
