@@ -166,6 +166,12 @@ class Instruments:
     wheels_age: float | None
     driver: str | None
     """Who drives, on the control port: "UART2" once it took over, else "APP port"."""
+    readings: tuple[tuple[str, str], ...] = ()
+    """What the car reports in SI, by label, as text (a chassis port's status), with the
+    age of the report in `readings_age`; none where its records say it (`telemetry`)."""
+    readings_age: float | None = None
+    volts: float | None = None
+    """The battery's voltage, where the car reports it so (no percentage is made up)."""
 
 
 def values(

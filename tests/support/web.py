@@ -60,12 +60,18 @@ class WebProcess:
 
 @contextmanager
 def web_process(
-    tmp_path: Path, *args: str, uart2: bool = False, bluetooth: str = "", profile: str = "sheet"
+    tmp_path: Path,
+    *args: str,
+    uart2: bool = False,
+    bluetooth: str = "",
+    profile: str = "sheet",
+    chassis: bool = False,
 ) -> Iterator[WebProcess]:
     """A board on a pty recording what it receives, and `appmode web` driving it (its
     data folder, where a certificate is kept, in `tmp_path`); with `uart2`, over the
     board's control port; with `bluetooth` "ble" or "spp", over that module of the board
-    behind the BlueZ stand-in; the board and the page of `profile`."""
+    behind the BlueZ stand-in; with `chassis`, a WHEELTEC profile's chassis port; the
+    board and the page of `profile`."""
     record = tmp_path / "board.transcript"
     where = "--bluetooth" if bluetooth else "--pty"
     if profile != "sheet":
@@ -75,9 +81,10 @@ def web_process(
         if bluetooth:
             address = board.details[bluetooth].split()[0]
             board.url = f"{'ble' if bluetooth == 'ble' else 'bt'}://{address}"
+        port = (board.uart2, "--uart2") if uart2 else (str(board.chassis), "--chassis")
         proc, line = serving(
             "web",
-            *((board.uart2, "--uart2") if uart2 else (board.url,)),
+            *(port if uart2 or chassis else (board.url,)),
             "--listen",
             "127.0.0.1:0",
             *args,

@@ -79,8 +79,21 @@ def chassis_rows(host: ChassisHost, keys: Keys) -> list[Row]:
 
 
 def chassis_instruments(host: ChassisHost, keys: Keys) -> Instruments:
-    """What the page's instruments show over the chassis port."""
+    """What the page's instruments show over the chassis port: its status in SI."""
     state = host.state
+    status, at = state.status, state.status_at
+    readings: tuple[tuple[str, str], ...] = ()
+    if status is not None:
+        twist = status.twist
+        ax, ay, _ = status.acceleration
+        readings = (
+            ("forward", f"{twist.forward:+.2f} m/s"),
+            ("left", f"{twist.left:+.2f} m/s"),
+            ("turn", f"{twist.turn:+.2f} rad/s"),
+            ("accel", f"{ax:+.2f} {ay:+.2f} m/s²"),
+            ("gyro z", f"{status.angular_velocity[2]:+.3f} rad/s"),
+            *((("Flag_Stop", "set"),) if status.flag_stop else ()),
+        )
     return Instruments(
         link=instruments.link(host.connected, state.stats, host.now(), host.latency),
         telemetry=None,
@@ -88,10 +101,13 @@ def chassis_instruments(host: ChassisHost, keys: Keys) -> Instruments:
         moving=keys.moving,
         stop_unsent=keys.moving and not host.connected,
         page=None,
-        speed=Value("speed", keys.speed, 0, keys.top_speed),
+        speed=Value("speed mm/s", keys.speed, 0, keys.top_speed),
         values=(),
         values_read=True,
         wheels=None,
         wheels_age=None,
         driver="chassis port",
+        readings=readings,
+        readings_age=None if at is None else host.now() - at,
+        volts=None if status is None else status.volts,
     )

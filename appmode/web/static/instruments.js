@@ -82,10 +82,19 @@ export function showInstruments(ins) {
     $("motion").classList.toggle("stale", !fresh(t.motion_age));
     $("measured").classList.toggle("stale", !fresh(t.motion_age));
   }
+  if (ins.readings.length) { // a chassis port's status, in SI
+    $("motion").textContent = ins.readings.map(([name, v]) => `${name} ${v}`).join("  ");
+    $("motion").classList.toggle("stale", !fresh(ins.readings_age));
+  }
+  $("battery").hidden = ins.volts !== null; // a voltage is no percentage: no gauge
+  if (ins.volts !== null) {
+    $("battery-text").textContent = `${ins.volts.toFixed(2)} V`;
+    $("battery-tile").classList.toggle("stale", !fresh(ins.readings_age));
+  }
   $("driver-tile").hidden = ins.driver === null;
   $("battery-tile").classList.toggle("wide", ins.driver === null);
   $("driver").textContent = ins.driver === null ? "" : ins.driver;
-  $("wheels-tile").hidden = ins.driver === null;
+  $("wheels-tile").hidden = ins.driver === null || ins.readings.length > 0;
   showWheels(ins.wheels, ins.wheels_age, speed ? speed.value : null);
   showParams(ins.values, ins.values_read);
 }
