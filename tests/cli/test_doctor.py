@@ -24,7 +24,7 @@ from appmode.cli import main as cli_main
 from appmode.cli.doctor import fix, verdict
 from appmode.host import heard, probe
 from appmode.ports.target import parse_target
-from appmode.protocol import app, app_decoders, control_decoders, params
+from appmode.protocol import app, app_decoders, chassis, control_decoders, params
 from tests.support.processes import ROOT, appmode_cmd, board_process, run
 
 
@@ -229,6 +229,7 @@ def timed_records(period_ms: float, records: list[bytes]) -> heard.Heard:
     decoders = (
         app_decoders.BoardDecoder(b_fields=None),
         control_decoders.ReplyDecoder(wheels=None),
+        chassis.StatusDecoder(),
     )
     for i, record in enumerate(records):
         one.feed(record, i * period_ms / 1000, *decoders)
