@@ -8,7 +8,7 @@ import sys
 from contextlib import ExitStack
 from typing import TYPE_CHECKING, TextIO
 
-from appmode.cli.hostio import until_count, with_recording
+from appmode.cli.hostio import close_host, until_count, with_recording
 from appmode.cli.live_view import live_view
 from appmode.host.chassis.client import RESEND, ChassisHost, Event
 from appmode.host.chassis.tokens import parse_token
@@ -109,15 +109,8 @@ def run_send(
             _hold(host, shown, 0)
         _hold(host, shown, listen)
         sent_at = host.now()  # the stop goes first; confirming it takes a while after
-        try:
-            stop = host.close()
-        finally:
-            for note in host.notes:
-                print(f"appmode: WARNING: {note}", file=sys.stderr)
+        stop = close_host(host)
         if stop is None:
-            from appmode.host.link import UNDELIVERED
-
-            print(f"appmode: {UNDELIVERED} (the link is down)", file=sys.stderr)
             return 1
         if not as_json:
             out.write(line(sent_at, host.sent, stop, "stop: a zero frame", stop.hex(" ")) + "\n")

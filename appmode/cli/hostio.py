@@ -102,3 +102,18 @@ def until_count(events: Iterable[E], counts: Callable[[E], bool], count: int | N
         seen += counts(event)
         if count is not None and seen >= count:
             return
+
+
+def close_host(host: Host | ChassisHost) -> bytes | None:
+    """Close `host`, its stop last, saying on stderr what closing had to do besides and
+    when the link was down (the stop not delivered); the stop's bytes, or None."""
+    try:
+        stop = host.close()
+    finally:
+        for note in host.notes:
+            print(f"appmode: WARNING: {note}", file=sys.stderr)
+    if stop is None:
+        from appmode.host.link import UNDELIVERED
+
+        print(f"appmode: {UNDELIVERED} (the link is down)", file=sys.stderr)
+    return stop

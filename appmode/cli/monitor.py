@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from contextlib import ExitStack
 from typing import TYPE_CHECKING, TextIO
 
@@ -80,32 +81,29 @@ def run(args: argparse.Namespace) -> int:
     from appmode.line.wire import APP, CHASSIS, UART2
 
     choice = board_choice(args)
-    return {APP: _on_app, UART2: _on_control, CHASSIS: _on_chassis}[choice.port](choice, args)
-
-
-def _on_chassis(choice: BoardChoice, args: argparse.Namespace) -> int:
-    from appmode.cli import chassis
-
-    if args.filter is not None:
-        raise AppmodeError("--filter picks APP records: not with --chassis")
-    return chassis.run_monitor(
-        choice,
-        as_json=args.json,
-        duration=args.duration,
-        count=args.count,
-        record=args.record,
-        out=sys.stdout,
-        stop_on_exit=args.stop_on_exit,
-        foxglove=args.foxglove,
-    )
+    monitors = {APP: _on_app, UART2: _on_control, CHASSIS: _on_chassis}
+    return monitors[choice.port](choice, args)
 
 
 def _on_control(choice: BoardChoice, args: argparse.Namespace) -> int:
     from appmode.cli import uart2
 
+    return _on_frames(choice, args, uart2.run_monitor, "--uart2")
+
+
+def _on_chassis(choice: BoardChoice, args: argparse.Namespace) -> int:
+    from appmode.cli import chassis
+
+    return _on_frames(choice, args, chassis.run_monitor, "--chassis")
+
+
+def _on_frames(
+    choice: BoardChoice, args: argparse.Namespace, run: Callable[..., int], flag: str
+) -> int:
+    """A port of binary frames, monitored by `run` with the command line's options."""
     if args.filter is not None:
-        raise AppmodeError("--filter picks APP records: not with --uart2")
-    return uart2.run_monitor(
+        raise AppmodeError(f"--filter picks APP records: not with {flag}")
+    return run(
         choice,
         as_json=args.json,
         duration=args.duration,

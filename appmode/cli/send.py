@@ -123,7 +123,7 @@ def run_send(
 ) -> int:
     """Send the tokens in order, printing what comes back; `Z` is always sent last,
     confirmed on the board's A records (the board's profile says what else stops it)."""
-    from appmode.cli.hostio import open_host, show
+    from appmode.cli.hostio import close_host, open_host, show
     from appmode.host.app.tokens import parse_token
     from appmode.host.waits import Wait
     from appmode.protocol.app_decoders import HostDecoder
@@ -147,13 +147,8 @@ def run_send(
             show(host, event, out, as_json)
         stop_text = host.state.end.stop_text  # what the stop below will do
         sent_at = host.now()  # the stop goes first; confirming it takes a while after
-        stop = host.close()
-        for note in host.notes:
-            print(f"appmode: WARNING: {note}", file=sys.stderr)
+        stop = close_host(host)
         if stop is None:
-            from appmode.host.link import UNDELIVERED
-
-            print(f"appmode: {UNDELIVERED} (the link is down)", file=sys.stderr)
             return 1
         if not as_json:
             out.write(line(sent_at, ">", stop, stop_text) + "\n")

@@ -20,15 +20,14 @@ from appmode.host.link import LinkLost, Refused
 from appmode.host.waits import Wait
 from appmode.ports.choice import BoardChoice
 from appmode.protocol import chassis, params
-from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
+from appmode.protocol.directions import MOTIONS, Motion
 from appmode.protocol.sensed import Inertial
 from appmode.protocol.twist import Twist
-from appmode.session.base import BaseSession
 from appmode.session.chassis.commands import COMMANDS, KEYS, KEYS_HELP
 from appmode.session.chassis.status import STOP, Keys, chassis_instruments, chassis_rows
-from appmode.session.control.status import control_grid
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
+from appmode.session.motion_grid import MotionGridSession
 from appmode.session.rows import Row, hold_mode
 
 DEFAULT_SPEED = 300
@@ -42,7 +41,7 @@ RESENDING = (
 )
 
 
-class ChassisSession(BaseSession):
+class ChassisSession(MotionGridSession):
     """A session on a chassis port."""
 
     host: ChassisHost
@@ -122,13 +121,6 @@ class ChassisSession(BaseSession):
     def instruments(self) -> Instruments:
         return chassis_instruments(self.host, self._keys())
 
-    def grid_cells(self) -> list[list[str]]:
-        return control_grid(self.cell_names())
-
-    def cell_names(self) -> list[list[str]]:
-        keys = [[self.grid_key(r, c) for c in range(3)] for r in range(3)]
-        return [["stop" if key == STOP_LETTER else key for key in row] for row in keys]
-
     def lit_cell(self) -> tuple[int, int] | None:
         """The cell of the motion the keys drive (none while stopped)."""
         names = self.cell_names()
@@ -158,19 +150,8 @@ class ChassisSession(BaseSession):
 
     # ------------------------------------------------------------ driving
 
-    def grid_key(self, row: int, col: int) -> str:
-        letter = GRID[row][col]
-        return STOP_LETTER if letter == STOP_LETTER else DIRECTION_PAGE[letter].name
-
-    def press(self, key: str) -> None:
-        """A held key: a motion's name (`forward`, `rotate-cw`…) or STOP_LETTER."""
-        if self.link_down():
-            return
-        what = self.driving.press(key, self.now())
-        if what == STOP_LETTER:
-            self.stop()
-        elif what is not None:
-            self._drive(self._twist_of(MOTIONS[what]), what)
+    def _drive_named(self, name: str) -> None:
+        self._drive(self._twist_of(MOTIONS[name]), name)
 
     def steer(self, x: float, y: float) -> None:
         """An analog stick (x right, y forward, each −1…1): forward and sideways on a

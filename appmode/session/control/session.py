@@ -25,16 +25,14 @@ from appmode.host.outcomes import QueryFailed
 from appmode.host.waits import Wait
 from appmode.ports.choice import BoardChoice
 from appmode.protocol import control, params, settings
-from appmode.protocol.directions import DIRECTION_PAGE, GRID, MOTIONS, STOP_LETTER, Motion
+from appmode.protocol.directions import MOTIONS, Motion
 from appmode.protocol.params import DriveType
 from appmode.protocol.twist import Twist
-from appmode.session.base import BaseSession
 from appmode.session.control.commands import COMMANDS, KEYS, KEYS_HELP, SETTING_NAMES
 from appmode.session.control.motion import velocity_for
 from appmode.session.control.status import (
     STOP,
     Keys,
-    control_grid,
     control_instruments,
     control_lit,
     control_rows,
@@ -42,6 +40,7 @@ from appmode.session.control.status import (
 from appmode.session.control.velocity import frame_fields, signs_in_force
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
+from appmode.session.motion_grid import MotionGridSession
 from appmode.session.rows import Row, hold_mode
 
 DEFAULT_SPEED = 300
@@ -55,7 +54,7 @@ NO_READS = (
 )
 
 
-class ControlSession(BaseSession):
+class ControlSession(MotionGridSession):
     """A session on the control port, with the APP port of the same board if given."""
 
     host: ControlHost
@@ -205,13 +204,6 @@ class ControlSession(BaseSession):
     def status_rows(self) -> list[Row]:
         return control_rows(self.host, self.app, self._keys())
 
-    def grid_cells(self) -> list[list[str]]:
-        return control_grid(self.cell_names())
-
-    def cell_names(self) -> list[list[str]]:
-        keys = [[self.grid_key(r, c) for c in range(3)] for r in range(3)]
-        return [["stop" if key == STOP_LETTER else key for key in row] for row in keys]
-
     def lit_cell(self) -> tuple[int, int] | None:
         return control_lit(self.cell_names(), self._keys())
 
@@ -230,21 +222,7 @@ class ControlSession(BaseSession):
 
     # ------------------------------------------------------------ driving
 
-    def grid_key(self, row: int, col: int) -> str:
-        letter = GRID[row][col]
-        return STOP_LETTER if letter == STOP_LETTER else DIRECTION_PAGE[letter].name
-
-    def press(self, key: str) -> None:
-        """A held key: a motion's name (`forward`, `rotate-cw`…) or STOP_LETTER."""
-        if self.link_down():
-            return
-        what = self.driving.press(key, self.now())
-        if what == STOP_LETTER:
-            self.stop()
-        elif what is not None:
-            self._drive(what)
-
-    def _drive(self, name: str) -> None:
+    def _drive_named(self, name: str) -> None:
         drive = self.drive
         if drive is None:
             self.driving.stop()
@@ -262,7 +240,7 @@ class ControlSession(BaseSession):
         self.driving.press("stick", self.now())  # a stick that is let go stops the car
         drive = self.drive
         if drive is None:
-            self._drive("forward")  # says the drive type is being read, and reads it
+            self._drive_named("forward")  # says the drive type is being read, and reads it
             return
         motion = Motion("stick", (x, y, 0.0), (y, x))
         self._drive_fields(velocity_for(motion, self.speed, drive), f"stick x {x:+.2f} y {y:+.2f}")

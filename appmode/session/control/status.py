@@ -13,7 +13,6 @@ from appmode.protocol.directions import PAGE_LETTERS, letter_name
 from appmode.session import instruments
 from appmode.session.instruments import Instruments, Value, Wheel
 from appmode.session.rows import (
-    GLYPHS,
     WIDTH,
     Row,
     Span,
@@ -149,11 +148,6 @@ def control_instruments(host: ControlHost, app: Host | None, keys: Keys) -> Inst
         wheels_age=None if state.report_at is None else now - state.report_at,
         driver="UART2" if state.took_over_at is not None else "APP port",
     )
-
-
-def control_grid(names: list[list[str]]) -> list[list[str]]:
-    """The grid's cells as shown: an arrow and what the key drives."""
-    return [[f"{GLYPHS[r][c]} {names[r][c]}" for c in range(3)] for r in range(3)]
 
 
 def control_lit(names: list[list[str]], keys: Keys) -> tuple[int, int] | None:
