@@ -13,5 +13,6 @@ CONTROL_TOKENS = (
 CHASSIS_TOKENS = (
     "tokens are velocity:FORWARD,LEFT,TURN (m/s, m/s, rad/s counter-clockwise; held, "
     "sent again every 0.1 s, until the next token that moves or stops), stop, "
-    "wait:SECONDS and raw hex (7B000000000000000000 7B7D, sent once)"
+    "wait:SECONDS and raw hex (7B00000000000000007B7D; a whole velocity frame holds as "
+    "velocity: does)"
 )

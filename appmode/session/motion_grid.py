@@ -1,11 +1,18 @@
 """What the sessions that drive a motion by its name share — the control port's and a
-chassis port's: the direction page's 3×3 grid of motions (row 0 is the front), and a
-held key that drives one."""
+chassis port's: the direction page's 3×3 grid of motions (row 0 is the front), a held
+key that drives one, and sends that turn a lost link into a message."""
 
 from __future__ import annotations
 
 from abc import abstractmethod
+from collections.abc import Callable
+from functools import partial
+from typing import ClassVar
 
+from appmode.errors import AppmodeError
+from appmode.host.link import LinkLost, Refused
+from appmode.host.waits import Wait
+from appmode.protocol import params
 from appmode.protocol.directions import DIRECTION_PAGE, GRID, STOP_LETTER
 from appmode.session.base import BaseSession
 from appmode.session.rows import GLYPHS
@@ -40,3 +47,50 @@ class MotionGridSession(BaseSession):
     @abstractmethod
     def _drive_named(self, name: str) -> None:
         """Drive the motion `name` (a held key's, or the `drive` command's)."""
+
+    speed: int
+    """What the keys drive at, in the port's units."""
+
+    def _speed_asked(self, args: list[str], top: int, unit: str = "") -> int:
+        """`speed +N`, `speed -N` or `speed N` from the keys' speed, within 0…`top`."""
+        number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
+        if number is None:
+            raise AppmodeError(f"usage: speed +N, speed -N or speed N{unit}")
+        sign = args[0][0]
+        wanted = self.speed + (-number if sign == "-" else number) if sign in "+-" else number
+        return min(top, max(0, wanted))
+
+    send_example: ClassVar[str] = ""
+    """A `send` command line of the port's tokens, for its usage."""
+
+    def send_tokens(self, tokens: list[str]) -> None:
+        """`send`: the port's tokens, as `send` takes them on it, sent in order (what they
+        do shows as the frame in force)."""
+        if not tokens:
+            raise AppmodeError(f"usage: send TOKEN..., e.g. {self.send_example}")
+        steps = [self._parse_token(token) for token in tokens]
+        if any(isinstance(step, Wait) for step in steps):
+            raise AppmodeError("send takes no waits here: use the wait command")
+        self._forget_motion()
+        for step in steps:
+            if not self._send(partial(self._perform, step)):
+                return
+        self.say(f"sent {' '.join(tokens)}")
+
+    @abstractmethod
+    def _parse_token(self, token: str) -> object:
+        """A `send` token as the port's step (AppmodeError: not one)."""
+
+    @abstractmethod
+    def _perform(self, step: object) -> None:
+        """Send one step that `_parse_token` made."""
+
+    def _send(self, send: Callable[[], object]) -> bool:
+        """Run a send; a lost link becomes a message (what was in force stays)."""
+        try:
+            send()
+        except (LinkLost, Refused) as exc:
+            self.say(str(exc))
+            self.driving.stop()
+            return False
+        return True

@@ -9,17 +9,13 @@ It never blocks. Closing sends a zero velocity frame last.
 from __future__ import annotations
 
 from collections.abc import Callable
-from functools import partial
 from typing import ClassVar
 
-from appmode.errors import AppmodeError
 from appmode.host.chassis.client import RESEND, ChassisHost
 from appmode.host.chassis.tokens import parse_token
 from appmode.host.events import LinkStatus
-from appmode.host.link import LinkLost, Refused
-from appmode.host.waits import Wait
 from appmode.ports.choice import BoardChoice
-from appmode.protocol import chassis, params
+from appmode.protocol import chassis
 from appmode.protocol.directions import MOTIONS, Motion
 from appmode.protocol.sensed import Inertial
 from appmode.protocol.twist import Twist
@@ -196,40 +192,20 @@ class ChassisSession(MotionGridSession):
         self.driving.stop()
         self.in_force = STOP
 
-    def _send(self, send: Callable[[], object]) -> bool:
-        """Run a send; a lost link becomes a message (what was in force stays)."""
-        try:
-            send()
-        except (LinkLost, Refused) as exc:
-            self.say(str(exc))
-            self.driving.stop()
-            return False
-        return True
-
     # ------------------------------------------------------------ commands
 
     def speed_command(self, args: list[str]) -> None:
         """`speed +N`, `speed -N` or `speed N`: the keys' speed in mm/s."""
-        number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
-        if number is None:
-            raise AppmodeError("usage: speed +N, speed -N or speed N (mm/s)")
-        sign = args[0][0]
-        wanted = self.speed + (-number if sign == "-" else number) if sign in "+-" else number
-        self.speed = min(TOP_SPEED, max(0, wanted))
+        self.speed = self._speed_asked(args, TOP_SPEED, " (mm/s)")
         metres = self.speed / chassis.MILLI
         self.say(f"speed {metres:.2f} m/s (turns at {metres / TURN_RADIUS:.2f} rad/s)")
 
-    def send_tokens(self, tokens: list[str]) -> None:
-        """`send`: frames as `send --chassis` takes them."""
-        if not tokens:
-            raise AppmodeError("usage: send TOKEN..., e.g. send velocity:0.3,0,0.5 or send stop")
-        steps = [parse_token(token) for token in tokens]
-        if any(isinstance(step, Wait) for step in steps):
-            raise AppmodeError("send takes no waits here: use the wait command")
-        self._forget_motion()  # what the frames do shows as the frame in force
-        for step in steps:
-            data = chassis.command(step) if isinstance(step, Twist) else step
-            assert isinstance(data, bytes)
-            if not self._send(partial(self.host.send, data)):
-                return
-        self.say(f"sent {' '.join(tokens)}")
+    send_example = "send velocity:0.3,0,0.5 or send stop"
+
+    def _parse_token(self, token: str) -> object:
+        """A token as `send --chassis` takes it."""
+        return parse_token(token)
+
+    def _perform(self, step: object) -> None:
+        assert isinstance(step, (Twist, bytes))
+        self.host.send(chassis.command(step) if isinstance(step, Twist) else step)

@@ -9,7 +9,6 @@ with `tick()`. Closing sends the zero velocity frame last on UART2.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from functools import partial
 from typing import ClassVar
 
 from appmode.errors import AppmodeError
@@ -18,11 +17,9 @@ from appmode.host.app.state import HostState
 from appmode.host.control.client import ControlHost
 from appmode.host.control.query import ROTATE_POLL, ReadDone, rotation_done
 from appmode.host.control.state import PortMode
-from appmode.host.control.tokens import parse_token, perform
+from appmode.host.control.tokens import Step, parse_token, perform
 from appmode.host.events import BoardWarning, LinkStatus
-from appmode.host.link import LinkLost, Refused
 from appmode.host.outcomes import QueryFailed
-from appmode.host.waits import Wait
 from appmode.ports.choice import BoardChoice
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import MOTIONS, Motion
@@ -309,16 +306,6 @@ class ControlSession(MotionGridSession):
             self._next_angle_read = self.now() + ROTATE_POLL
             self.say(f"rotating {degrees:g}°")
 
-    def _send(self, send: Callable[[], object]) -> bool:
-        """Run a send; a lost link becomes a message (what was in force stays)."""
-        try:
-            send()
-        except (LinkLost, Refused) as exc:
-            self.say(str(exc))
-            self.driving.stop()
-            return False
-        return True
-
     # ------------------------------------------------------------ settings
 
     def query(
@@ -390,16 +377,8 @@ class ControlSession(MotionGridSession):
 
     def speed_command(self, args: list[str]) -> None:
         """`speed +N`, `speed -N` or `speed N`: the speed the keys drive at."""
-        number = params.whole(args[0].lstrip("+-")) if len(args) == 1 else None
-        if number is None:
-            raise AppmodeError("usage: speed +N, speed -N or speed N")
-        wanted = (
-            self.speed + (-number if args[0][0] == "-" else number)
-            if args[0][0] in "+-"
-            else number
-        )
         top = self.top_speed()
-        self.speed = min(top, max(0, wanted))
+        self.speed = self._speed_asked(args, top)
         unit = (
             "‰ duty"
             if top == control.MAX_DUTY
@@ -412,16 +391,12 @@ class ControlSession(MotionGridSession):
         differential = self.drive is not None and self.drive.differential
         return control.MAX_DUTY if differential else control.U16
 
-    def send_tokens(self, tokens: list[str]) -> None:
-        """`send`: frames as `send --uart2` takes them, or raw hex."""
-        if not tokens:
-            raise AppmodeError("usage: send TOKEN..., e.g. send velocity:0,200,0 or send FFFE01…")
-        steps = [parse_token(token) for token in tokens]
-        if any(isinstance(step, Wait) for step in steps):
-            raise AppmodeError("send takes no waits here: use the wait command")
-        self._forget_motion()  # what the frames do shows as the frame in force
-        for step in steps:
-            assert not isinstance(step, Wait)
-            if not self._send(partial(perform, self.host, step)):
-                return
-        self.say(f"sent {' '.join(tokens)}")
+    send_example = "send velocity:0,200,0 or send FFFE01…"
+
+    def _parse_token(self, token: str) -> object:
+        """A token as `send --uart2` takes it: a frame by name, or raw hex."""
+        return parse_token(token)
+
+    def _perform(self, step: object) -> None:
+        assert isinstance(step, (Step, bytes))
+        perform(self.host, step)
