@@ -1,5 +1,6 @@
 """`appmode plot`: a transcript's telemetry drawn to a PNG — velocities, attitude and
-battery over time with the commands marked, or a UART2 transcript's wheels. The file is
+battery over time with the commands marked, a UART2 transcript's wheels, or a chassis
+port's status in SI. The file is
 read once as it streams, each series reduced to what the picture can show (envelope):
 memory is bounded whatever the file's size."""
 
@@ -16,9 +17,9 @@ from typing import Any
 from appmode.board.profiles import profile_named
 from appmode.errors import AppmodeError
 from appmode.files import check_writable, write_whole
-from appmode.protocol import app, control
+from appmode.protocol import app, chassis, control
 from appmode.protocol.layouts import VELOCITY, Layout
-from appmode.protocol.reader import SENT2
+from appmode.protocol.reader import SENT2, SENT_CHASSIS
 from appmode.protocol.transcript import Comment, Directive, Entry
 from appmode.transcript.dump import decoded, needs_of
 from appmode.transcript.envelope import Envelope, Marks
@@ -88,6 +89,25 @@ class _Wheels:
             self.target[i].add(t, target)
 
 
+class _Status:
+    """What a chassis plot draws, reduced: the velocity, the IMU and the battery of each
+    status frame (SI), and the velocities sent."""
+
+    NAMES = ("forward m/s", "left m/s", "turn rad/s", "accel x m/s²", "accel y m/s²",
+             "gyro z rad/s", "battery V")  # fmt: skip
+
+    def __init__(self) -> None:
+        self.series = [Envelope() for _ in self.NAMES]
+        self.frames = Marks()
+
+    def add(self, t: float, status: chassis.Status) -> None:
+        twist = status.twist
+        ax, ay, _ = status.acceleration
+        values = (twist.forward, twist.left, twist.turn, ax, ay, status.angular_velocity[2])
+        for envelope, value in zip(self.series, (*values, status.volts), strict=True):
+            envelope.add(t, value)
+
+
 def run_plot(path: str, output: str, profile: str | None = None) -> int:
     """Velocities, attitude and battery over time, with the commands marked; the fields
     named as `profile` lays them out (default: the transcript's `@board profile=…`)."""
@@ -105,9 +125,13 @@ def run_plot(path: str, output: str, profile: str | None = None) -> int:
     given = profile_named(profile) if profile else None  # a file the @board line may name
     needs = needs_of(path, lambda text: None)  # the second pass warns
     layout = (given or needs.profile).a_layout
-    read, seen, wheels = _Read(path), _Telemetry(layout), _Wheels()
+    read, seen, wheels, status = _Read(path), _Telemetry(layout), _Wheels(), _Status()
     for t, direction, event in decoded(read.items(), needs.drive, path, layout):
-        if isinstance(event, (app.Velocity, app.Attitude, app.OtherRecord)):
+        if isinstance(event, chassis.Status):
+            status.add(t, event)
+        elif isinstance(event, chassis.Command) and direction == SENT_CHASSIS:
+            status.frames.add(t, f"{event.vx / 1000:g},{event.vy / 1000:g},{event.wz / 1000:g}")
+        elif isinstance(event, (app.Velocity, app.Attitude, app.OtherRecord)):
             letter, values = app.record_fields(event)
             fields = seen.a if letter == "A" else seen.b if letter == "B" else []
             if len(values) == len(fields):
@@ -125,8 +149,11 @@ def run_plot(path: str, output: str, profile: str | None = None) -> int:
         return _plot_app(plt, seen, layout, title, output)
     if wheels.actual:
         return _plot_wheels(plt, wheels, title, output)
+    if status.series[0].count:
+        return _plot_status(plt, status, title, output)
     raise AppmodeError(
-        f"{path} has no A or B records, and no encoder reports (UART2, §12), to plot"
+        f"{path} has no A or B records, no encoder reports (UART2, §12) and no chassis "
+        "status frames (§15) to plot"
     )
 
 
@@ -193,6 +220,26 @@ def _plot_wheels(plt: Any, wheels: _Wheels, title: str, output: str) -> int:
     axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     every = [t for e in wheels.actual for t in e.points()[0]]
     _mark_commands(strip, (axes,), wheels.frames.kept(), every)
+    fig.suptitle(title, fontsize=11)
+    return _save(plt, fig, output)
+
+
+def _plot_status(plt: Any, status: _Status, title: str, output: str) -> int:
+    """A chassis port's transcript: its status in SI, the velocities sent marked."""
+    fig, (strip, vel, imu, bat) = plt.subplots(
+        4, 1, sharex=True, figsize=(11, 8.5), height_ratios=(0.7, 3, 3, 2), layout="constrained"
+    )
+    for axes, shown in ((vel, range(3)), (imu, range(3, 6)), (bat, range(6, 7))):
+        for i in shown:
+            axes.plot(*status.series[i].points(), label=_Status.NAMES[i], drawstyle="steps-post")
+        axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    vel.set_ylabel("velocity (SI)")
+    imu.set_ylabel("IMU (SI)")
+    bat.set_ylabel("battery V")
+    bat.ticklabel_format(axis="y", useOffset=False)
+    bat.set_xlabel("time (s)")
+    every = [t for e in status.series for t in e.points()[0]]
+    _mark_commands(strip, (vel, imu, bat), status.frames.kept(), every)
     fig.suptitle(title, fontsize=11)
     return _save(plt, fig, output)
 

@@ -144,3 +144,16 @@ def test_replay_chassis_plays_a_session_again_and_ends_with_a_zero_frame(tmp_pat
     assert got[: len(played)] == played
     assert got[-1] == chassis.STOP.hex(" ").upper(), "the replay, a host, ends with the stop"
     assert f"replayed {len(played)} commands" in again.stderr
+
+
+def test_plot_draws_a_chassis_transcript(tmp_path: Path) -> None:
+    session = tmp_path / "session.transcript"
+    done = run(
+        "send", "sim://?profile=wheeltec-mec", "--chassis", "velocity:0.2", "wait:0.3",
+        "--record", str(session), "--listen", "0",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    image = tmp_path / "session.png"
+    drawn = run("plot", str(session), "-o", str(image))
+    assert drawn.returncode == 0, drawn.stderr
+    assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and image.stat().st_size > 20_000
