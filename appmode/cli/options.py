@@ -87,8 +87,9 @@ SHIPPED_PROFILES = (
 command line offers them without loading them."""
 HOLDS = (
     "for what its records hold: sheet (x, y, z), minibalance (|0.7x|, |0.7y|, battery; "
-    "see appmode protocol 13), balance (the two-wheel balance car), or a profile FILE of "
-    "your own (appmode profile show sheet --toml writes one to start from)"
+    "see appmode protocol 13), balance (the two-wheel balance car), wheeltec-mec, "
+    "wheeltec-akm, wheeltec-diff (WHEELTEC's ROS cars: their chassis port, --chassis), or "
+    "a profile FILE of your own (appmode profile show sheet --toml writes one to start from)"
 )
 A_RECORD = f"the board's profile, {HOLDS}"
 ON_A_BOARD = f"the board's profile (with a sim:// URL, the simulated board's), {HOLDS}"
