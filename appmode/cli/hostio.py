@@ -106,12 +106,11 @@ def until_count(events: Iterable[E], counts: Callable[[E], bool], count: int | N
 
 def close_host(host: Host | ChassisHost) -> bytes | None:
     """Close `host`, its stop last, saying on stderr what closing had to do besides and
-    when the link was down (the stop not delivered); the stop's bytes, or None."""
-    try:
-        stop = host.close()
-    finally:
-        for note in host.notes:
-            print(f"appmode: WARNING: {note}", file=sys.stderr)
+    when the link was down (the stop not delivered); the stop's bytes, or None. Where
+    the stop did not take, the AppmodeError that says so is all that is said."""
+    stop = host.close()
+    for note in host.notes:
+        print(f"appmode: WARNING: {note}", file=sys.stderr)
     if stop is None:
         from appmode.host.link import UNDELIVERED
 

@@ -259,7 +259,7 @@ def test_plot_without_records_is_a_clear_error(tmp_path: Path) -> None:
     path.write_text("0.0 > J\n")
     done = run("plot", str(path), "-o", str(tmp_path / "x.png"))
     assert done.returncode == 2
-    assert "has no A or B records, and no encoder reports (UART2, §12), to plot" in done.stderr
+    assert "has no A or B records, no encoder reports (UART2, §12) and no chassis" in done.stderr
     assert not (tmp_path / "x.png").exists()
 
 
