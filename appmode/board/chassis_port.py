@@ -7,9 +7,9 @@ wrong tail or XOR is dropped without a word on the wire (the board's log says so
 velocity asked for holds until the next frame, or until `timeout_ms` without one zeroes
 it (0: never, as some firmware copies). Each kind drives what it can: mecanum all three,
 differential and Ackermann no sideways motion, Ackermann no turn in place and no radius
-under `min_radius`. The status carries the car's velocity, the IMU in the body's axes
-(the firmware's remap of the chip's: x = chip y, y = −chip x), gyro z sent as 0 while
-Flag_Stop is set, and the battery in mV.
+under `min_radius`. The status carries the car's velocity, the IMU as the profile's
+`imu_axes` remap the chip's (F1's `y,-x,z`: the body's x forward, y left, z up), gyro z
+sent as 0 while Flag_Stop is set, and the battery in mV.
 """
 
 from __future__ import annotations
@@ -138,6 +138,13 @@ class ChassisPort:
             changes.append(self.asked_ms + spec.timeout_ms)
         return min((c for c in changes if c >= ms), default=math.inf)
 
+    def _sent(self, body: tuple[float, float, float]) -> tuple[int, int, int]:
+        """A vector in the body's axes as the status frame sends it: the chip mounted as
+        on F1 (its x the body's −y, its y the body's x), then the profile's remap."""
+        chip = (-body[1], body[0], body[2])
+        x, y, z = (round(sign * chip[axis]) for sign, axis in self.spec.axes())
+        return (x, y, z)
+
     def skip(self, ms: int) -> None:
         """The board caught up at once to `ms` (it was stalled): the status frames due
         meanwhile are not sent."""
@@ -153,9 +160,9 @@ class ChassisPort:
         forward = vehicle.pitch / TILT_GAIN * milli  # m/s² (the body's tilt is its lean)
         left = -vehicle.roll / TILT_GAIN * milli
         scale = chassis.ACCEL_PER_MS2
-        accel = (round(forward * scale), round(left * scale), round(GRAVITY * scale))
         turn = -vehicle.vz * milli / chassis.GYRO_RAD_PER_COUNT
-        gyro = (0, 0, 0 if stop else round(turn))
+        accel = self._sent((forward * scale, left * scale, GRAVITY * scale))
+        gyro = self._sent((0.0, 0.0, 0.0 if stop else turn))
         mv = round(vehicle.centivolts * 10)
         self.out += chassis.status(int(stop), velocity, accel, gyro, mv)
         self.status_ms += PERIOD_MS

@@ -19,7 +19,10 @@ KINDS = {
     "akm": "Ackermann: no sideways motion; a turn steers, within its minimum radius",
     "diff": "differential or tank: no sideways motion",
 }
-KEYS = {"kind", "timeout_ms", "boot_ms", "self_test_ms", "min_radius", "max_speed"}
+KEYS = {"kind", "timeout_ms", "boot_ms", "self_test_ms", "min_radius", "max_speed", "imu_axes"}
+F1_AXES = "y,-x,z"
+"""F1–F4's remap of the IMU chip's axes: the status frame's x is the chip's y, its y the
+chip's −x, its z the chip's z (on those boards: the car's forward, left and up)."""
 
 
 class ChassisSpec(NamedTuple):
@@ -40,6 +43,15 @@ class ChassisSpec(NamedTuple):
     """Ackermann: the smallest turning radius, in m (F1's 0.35)."""
     max_speed: float = 3.5
     """m/s (and rad/s) past which the car's wheels cannot follow."""
+    imu_axes: str = F1_AXES
+    """What the status frame's IMU x, y and z are, as the chip's axes (`y,-x,z`: F1's
+    remap); the simulated chip is mounted as on F1, so another remap sends other axes."""
+
+    def axes(self) -> tuple[tuple[int, int], ...]:
+        """`imu_axes` as (sign, chip axis index) for x, y and z."""
+        return tuple(
+            (-1 if a[0] == "-" else 1, "xyz".index(a[-1])) for a in self.imu_axes.split(",")
+        )
 
 
 def chassis_spec(
@@ -55,9 +67,9 @@ def chassis_spec(
     for key in sorted(set(table) - KEYS):
         problem(f"chassis.{key}: unknown; the keys are {', '.join(sorted(KEYS))}")
     kind = table.get("kind", base.kind if base else None)
-    if kind not in KINDS:
+    known = kind in KINDS
+    if not known:
         problem(f"chassis.kind = {kind!r}: one of {', '.join(KINDS)}")
-        return base
     values: dict[str, Any] = {**(_fields(base) if base else {}), "kind": kind}
     for key, limit in (("timeout_ms", 60_000), ("boot_ms", 120_000), ("self_test_ms", 60_000)):
         if key in table:
@@ -66,6 +78,14 @@ def chassis_spec(
                 problem(f"chassis.{key} = {value!r}: whole milliseconds, 0 to {limit}")
                 continue
             values[key] = int(value)
+    if "imu_axes" in table:
+        axes = table["imu_axes"]
+        parts = axes.split(",") if isinstance(axes, str) else []
+        if sorted(p.lstrip("-") for p in parts) != ["x", "y", "z"]:
+            problem(f"chassis.imu_axes = {axes!r}: the chip's x, y and z in some order, each "
+                    f"maybe negated, such as {F1_AXES!r}")  # fmt: skip
+        else:
+            values["imu_axes"] = axes
     for key in ("min_radius", "max_speed"):
         if key in table:
             value = table[key]
@@ -73,7 +93,7 @@ def chassis_spec(
                 problem(f"chassis.{key} = {value!r}: a number over 0, up to 100")
                 continue
             values[key] = float(value)
-    return ChassisSpec(**values)
+    return ChassisSpec(**values) if known else base
 
 
 def _fields(spec: ChassisSpec) -> dict[str, Any]:

@@ -147,3 +147,15 @@ def test_no_profile_but_wheeltecs_has_a_chassis_port() -> None:
     board.receive_chassis(chassis.command(Twist(0.3, 0, 0)), 1.0)
     assert board.poll_ports(5.0)[2] == b""
     assert math.isinf(board.next_sends()[2])
+
+
+def test_the_imu_axes_are_the_profiles_remap_of_the_chip() -> None:
+    """F1 sends x = the chip's y, y = −the chip's x: the body's forward and left; a board
+    with no remap (`x,y,z`) sends the chip's own axes, forward on its y."""
+    for axes, forward_on in (("y,-x,z", 0), ("x,y,z", 1)):
+        board = board_of("wheeltec-mec", imu_axes=axes)
+        board.receive_chassis(chassis.command(Twist(0.5, 0, 0.5)), BOOT)
+        frame = statuses(board, BOOT + 0.1)[-1]
+        assert frame.acceleration[forward_on] > 0.5
+        assert abs(frame.acceleration[1 - forward_on]) < 0.01
+        assert frame.angular_velocity[2] > 0.1, "z is z on both"

@@ -112,3 +112,29 @@ def test_a_session_ends_with_a_zero_frame_and_senses_the_car() -> None:
     assert sensed and sensed[-1][1] == Twist(0.2, -0.1, 0.3)
     assert board.taken[-1] == (0, 0, 0)
     assert (0.2, -0.1, 0.3) in board.taken
+
+
+def test_a_stalled_status_shows_as_late_and_the_car_is_still_held_and_stopped() -> None:
+    """A board whose status frames stop: the session says how old the last one is, keeps
+    sending the velocity in force while it drives, and ends with the zero frame."""
+    with stm32() as (board, port):
+        choice = choose(parse_target(port), chassis=True)
+        session = open_session(choice, HoldToDrive())
+        try:
+            session.start()
+            for _ in range(5):
+                session.move(Twist(0.2))  # its source repeats it, as cmd_vel does
+                session.tick()
+                session.host.poll(0.1)
+            board.stalled = True
+            taken = len(board.taken)
+            for _ in range(15):
+                session.move(Twist(0.2))
+                session.tick()
+                session.host.poll(0.1)
+            rows = " ".join(row.text for row in session.status_rows())
+        finally:
+            session.close()
+    assert "last status frame" in rows and "s ago" in rows, rows
+    assert len(board.taken) - taken >= 8, "the velocity in force still sent again"
+    assert board.taken[-1] == (0, 0, 0)

@@ -122,3 +122,25 @@ def test_the_board_side_reads_command_frames() -> None:
     assert isinstance(events[-1], chassis.Command)
     assert events[-1].twist == Twist(-0.2, 0.1, -1.0) and events[-1].mode == 3
     assert str(events[-1]).startswith("velocity -0.20 m/s")
+
+
+def test_a_profiles_chassis_table_is_checked_a_line_a_mistake() -> None:
+    from appmode.protocol.profile_file import ProfileError, parse
+
+    text = (
+        'name = "mine"\nlike = "wheeltec-mec"\n[chassis]\nkind = "tank"\ntimeout_ms = -1\n'
+        'imu_axes = "x,x,z"\nspeed = 3\n'
+    )
+    try:
+        parse(text, "mine.toml")
+    except ProfileError as exc:
+        problems = exc.problems
+    else:
+        raise AssertionError("a bad [chassis] table was taken")
+    assert any("chassis.speed: unknown" in p for p in problems)
+    assert any("chassis.kind = 'tank'" in p for p in problems)
+    assert any("chassis.timeout_ms = -1" in p for p in problems)
+    assert any("chassis.imu_axes = 'x,x,z'" in p for p in problems)
+    good = parse('name = "mine"\nlike = "wheeltec-akm"\n[chassis]\nboot_ms = 500\n', "m.toml")
+    assert good.chassis is not None
+    assert (good.chassis.kind, good.chassis.boot_ms, good.chassis.min_radius) == ("akm", 500, 0.35)

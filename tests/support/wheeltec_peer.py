@@ -102,6 +102,8 @@ class Stm32(threading.Thread):
         os.set_blocking(fd, False)  # a port no one reads yet must not hold the board up
         self.taken: list[tuple[float, float, float]] = []
         self.dropped = 0
+        self.stalled = False
+        """Set: no more status frames (a board whose send task hangs), frames still taken."""
         self._velocity = (0, 0, 0)
         self._buffer = bytearray()
         self._done = threading.Event()
@@ -119,7 +121,8 @@ class Stm32(threading.Thread):
                     self._byte(byte)
             if time.monotonic() >= next_status:
                 next_status += 0.05
-                self._status()
+                if not self.stalled:
+                    self._status()
 
     def _byte(self, byte: int) -> None:
         if not self._buffer and byte != HEAD:

@@ -231,7 +231,8 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as the protocol referenc
                  'kind = "mec"\n'
                  'timeout_ms = 1000    # F1: zero velocity 1 s after the last valid frame (0: never, as F2)\n'
                  'boot_ms = 10000      # F1: frames ignored, Flag_Stop set, for 1000 ticks at 100 Hz\n'
-                 'self_test_ms = 0     # F2, F3: 2000 (a slow drive forward after the boot)\n',
+                 'self_test_ms = 0     # F2, F3: 2000 (a slow drive forward after the boot)\n'
+                 'imu_axes = "y,-x,z"  # the IMU chip\'s axes as the status sends them: F1–F4\'s remap\n',
  'wheeltec-akm': '# A WHEELTEC ROS car (mini_akm and up): an STM32 board whose chassis port takes the\n'
                  "# vendor's ROS driver's 7B … 7D velocity frames at 115200 bps and streams 24-byte status\n"
                  "# frames at 20 Hz (appmode protocol 15). Its APP port is read as the sheet's.\n"
@@ -247,7 +248,8 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as the protocol referenc
                  'min_radius = 0.35   # F1: the smallest turning radius, in m\n'
                  'timeout_ms = 1000    # F1: zero velocity 1 s after the last valid frame (0: never, as F2)\n'
                  'boot_ms = 10000      # F1: frames ignored, Flag_Stop set, for 1000 ticks at 100 Hz\n'
-                 'self_test_ms = 0     # F2, F3: 2000 (a slow drive forward after the boot)\n',
+                 'self_test_ms = 0     # F2, F3: 2000 (a slow drive forward after the boot)\n'
+                 'imu_axes = "y,-x,z"  # the IMU chip\'s axes as the status sends them: F1–F4\'s remap\n',
  'wheeltec-diff': '# A WHEELTEC ROS car (mini_diff, mini_tank, mini_4wd): an STM32 board whose chassis port takes the\n'
                   "# vendor's ROS driver's 7B … 7D velocity frames at 115200 bps and streams 24-byte status\n"
                   "# frames at 20 Hz (appmode protocol 15). Its APP port is read as the sheet's.\n"
@@ -262,7 +264,8 @@ TEXTS: dict[str, str] = {'sheet': "# The vendor's sheet as the protocol referenc
                   'kind = "diff"\n'
                   'timeout_ms = 1000    # F1: zero velocity 1 s after the last valid frame (0: never, as F2)\n'
                   'boot_ms = 10000      # F1: frames ignored, Flag_Stop set, for 1000 ticks at 100 Hz\n'
-                  'self_test_ms = 0     # F2, F3: 2000 (a slow drive forward after the boot)\n'}
+                  'self_test_ms = 0     # F2, F3: 2000 (a slow drive forward after the boot)\n'
+                  'imu_axes = "y,-x,z"  # the IMU chip\'s axes as the status sends them: F1–F4\'s remap\n'}
 
 DATA: dict[str, dict[str, object]] = {'sheet': {'name': 'sheet',
            'description': "the vendor's sheet: a mecanum/omni car, its velocity in the A record",
@@ -341,18 +344,18 @@ DATA: dict[str, dict[str, object]] = {'sheet': {'name': 'sheet',
                   'like': 'sheet',
                   'control_port': False,
                   'velocity_si': [0.001, 0.001],
-                  'chassis': {'kind': 'mec', 'timeout_ms': 1000, 'boot_ms': 10000, 'self_test_ms': 0}},
+                  'chassis': {'kind': 'mec', 'timeout_ms': 1000, 'boot_ms': 10000, 'self_test_ms': 0, 'imu_axes': 'y,-x,z'}},
  'wheeltec-akm': {'name': 'wheeltec-akm',
                   'description': 'a WHEELTEC Ackermann ROS car: the chassis port (7B frames), steering within a 0.35 m radius',
                   'source': 'the public WHEELTEC ROS drivers (turn_on_wheeltec_robot) and STM32 firmware copies; appmode protocol 15',
                   'like': 'sheet',
                   'control_port': False,
                   'velocity_si': [0.001, 0.001],
-                  'chassis': {'kind': 'akm', 'min_radius': 0.35, 'timeout_ms': 1000, 'boot_ms': 10000, 'self_test_ms': 0}},
+                  'chassis': {'kind': 'akm', 'min_radius': 0.35, 'timeout_ms': 1000, 'boot_ms': 10000, 'self_test_ms': 0, 'imu_axes': 'y,-x,z'}},
  'wheeltec-diff': {'name': 'wheeltec-diff',
                    'description': 'a WHEELTEC differential or tank ROS car: the chassis port (7B frames), forward and turn',
                    'source': 'the public WHEELTEC ROS drivers (turn_on_wheeltec_robot) and STM32 firmware copies; appmode protocol 15',
                    'like': 'sheet',
                    'control_port': False,
                    'velocity_si': [0.001, 0.001],
-                   'chassis': {'kind': 'diff', 'timeout_ms': 1000, 'boot_ms': 10000, 'self_test_ms': 0}}}
+                   'chassis': {'kind': 'diff', 'timeout_ms': 1000, 'boot_ms': 10000, 'self_test_ms': 0, 'imu_axes': 'y,-x,z'}}}
