@@ -234,7 +234,7 @@ class RosNode:
             self._inertial(reading, now_ns - int((now - at) * 1e9))
         state = self.session.telemetry_state()
         if state is None:
-            if not (sensed or inertial or self._readings):
+            if self.session.odometry_gap() is not None:  # a chassis senses with no records
                 self._say_once("no app", "no APP port beside: odom, battery and imu are not sent")
             return
         for at, event in self._new(state, "A"):
