@@ -91,8 +91,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         choices=("appmode", "wheeltec"),
         default="appmode",
         help="the topics and frames published: appmode's (odom, /tf, imu, battery_state in "
-        "base_link) or WHEELTEC's driver's (odom in odom_combined → base_footprint, imu in "
-        "gyro_link, PowerVoltage in volts, no TF), for launch files written for it",
+        "base_link) or WHEELTEC's driver's (odom in odom_combined → base_footprint, "
+        "imu/data_raw in gyro_link, PowerVoltage in volts, no TF), for its launch files",
     )
     ros.add_argument(
         "--cmd-vel-timeout",

@@ -35,7 +35,7 @@ from appmode.ros.messages import (
     Messages,
     volts_of,
 )
-from appmode.ros.wire import attachment, gid
+from appmode.ros.wire import BadAttachment, attachment, gid, read_attachment
 
 if TYPE_CHECKING:
     import zenoh
@@ -72,10 +72,10 @@ TOPIC_SETS = {
     "appmode": TopicSet(
         "odom", "/tf", "imu", "battery_state", BATTERY, "~/raw", "odom", "base_link", "base_link"
     ),
-    # turn_on_wheeltec_robot: odom (odom_combined → base_footprint, no TF of its own: an
-    # EKF broadcasts it), imu in gyro_link, PowerVoltage as std_msgs/Float32 volts
+    # turn_on_wheeltec_robot, ROS 2: odom (odom_combined → base_footprint, no TF of its
+    # own: an EKF broadcasts it), imu/data_raw in gyro_link, PowerVoltage in volts
     "wheeltec": TopicSet(
-        "odom", None, "imu", "PowerVoltage", FLOAT32, None,
+        "odom", None, "imu/data_raw", "PowerVoltage", FLOAT32, None,
         "odom_combined", "base_footprint", "gyro_link",
     ),
 }  # fmt: skip
@@ -132,6 +132,8 @@ class RosNode:
         self._woken = threading.Event()
         """Set by a cmd_vel: the loop takes it at once, not at its next turn."""
         self._lock = threading.Lock()
+        self._unattached: str | None = None
+        """Why the last cmd_vel dropped for its attachment was (None: none since)."""
         self.received = 0
         """cmd_vel samples taken (for the status and the tests)."""
         self.refused = 0
@@ -176,6 +178,16 @@ class RosNode:
         ]
 
     def _on_cmd_vel(self, sample: zenoh.Sample) -> None:
+        """A cmd_vel sample, taken as rmw_zenoh takes it: one with no attachment, or one
+        that is not rmw_zenoh's, is dropped (its publisher is no ROS 2 node)."""
+        extra = sample.attachment
+        try:
+            read_attachment(b"" if extra is None else extra.to_bytes())
+        except BadAttachment as exc:
+            with self._lock:
+                self._unattached = str(exc) if extra is not None else "none"
+            self._woken.set()
+            return
         with self._lock:
             self._queue.append(sample.payload.to_bytes())
         self._woken.set()
@@ -201,6 +213,13 @@ class RosNode:
         with self._lock:
             payloads = list(self._queue)
             self._queue.clear()
+            unattached, self._unattached = self._unattached, None
+        if unattached is not None:
+            self._say_once(
+                "attachment",
+                f"a cmd_vel whose attachment is not rmw_zenoh's ({unattached}) was dropped, as "
+                "rmw_zenoh drops it: its publisher is no ROS 2 node on rmw_zenoh",
+            )
         for payload in payloads:
             try:
                 forward, left, turn, ignored = self.messages.twist(payload, self.options.stamped)

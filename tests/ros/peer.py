@@ -102,14 +102,22 @@ class TwistPublisher:
         self.sequence = 0
 
     def publish(self, forward: float, turn: float = 0.0) -> None:
-        types = JAZZY.types
-        vector = types["geometry_msgs/msg/Vector3"]
-        twist = types["geometry_msgs/msg/Twist"](
-            linear=vector(x=forward, y=0.0, z=0.0), angular=vector(x=0.0, y=0.0, z=turn)
-        )
         self.sequence += 1
         attachment = zenoh.ext.z_serialize(
             (zenoh.ext.Int64(self.sequence), zenoh.ext.Int64(time.time_ns()), self.GID)
         )
-        payload = bytes(JAZZY.serialize_cdr(twist, "geometry_msgs/msg/Twist"))
-        self.publisher.put(payload, attachment=attachment)
+        self.publisher.put(twist_payload(forward, turn), attachment=attachment)
+
+
+ATTACHED = zenoh.ext.z_serialize((zenoh.ext.Int64(1), zenoh.ext.Int64(0), bytes(range(16))))
+"""An attachment of rmw_zenoh's form, for a sample that is otherwise no ROS message."""
+
+
+def twist_payload(forward: float, turn: float = 0.0) -> bytes:
+    """A geometry_msgs/Twist as CDR (Jazzy's)."""
+    types = JAZZY.types
+    vector = types["geometry_msgs/msg/Vector3"]
+    twist = types["geometry_msgs/msg/Twist"](
+        linear=vector(x=forward, y=0.0, z=0.0), angular=vector(x=0.0, y=0.0, z=turn)
+    )
+    return bytes(JAZZY.serialize_cdr(twist, "geometry_msgs/msg/Twist"))

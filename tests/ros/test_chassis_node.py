@@ -29,8 +29,8 @@ def sent(record: Path) -> list[str]:
 
 
 TOPICS = {
-    "appmode": ("/battery_state", "base_link", "odom", "base_link"),
-    "wheeltec": ("/PowerVoltage", "gyro_link", "odom_combined", "base_footprint"),
+    "appmode": ("/battery_state", "/imu", "base_link", "odom", "base_link"),
+    "wheeltec": ("/PowerVoltage", "/imu/data_raw", "gyro_link", "odom_combined", "base_footprint"),
 }
 
 
@@ -41,7 +41,7 @@ def test_ros_drives_a_wheeltec_car_and_publishes_what_its_status_says(
 ) -> None:
     """As the vendor's driver: with `--topics wheeltec` its topic names, frames and
     PowerVoltage (std_msgs/Float32, volts), and no TF of its own."""
-    power, imu_frame, odom_frame, base_frame = TOPICS[topics]
+    power, imu_topic, imu_frame, odom_frame, base_frame = TOPICS[topics]
     profile = tmp_path / "quick.toml"
     profile.write_text(
         'name = "quick"\nlike = "wheeltec-mec"\n[chassis]\nkind = "mec"\nboot_ms = 500\n'
@@ -66,7 +66,7 @@ def test_ros_drives_a_wheeltec_car_and_publishes_what_its_status_says(
         odom, imu, battery = peer.Received(), peer.Received(), peer.Received()
         subscribers = [
             ros.declare_subscriber(topic[name].data_key, got.on_sample)
-            for name, got in (("/odom", odom), ("/imu", imu), (power, battery))
+            for name, got in (("/odom", odom), (imu_topic, imu), (power, battery))
         ]
         assert ("/tf" in topic) == (topics == "appmode"), "the vendor's driver sends no TF"
         twist = peer.TwistPublisher(ros, topic["/cmd_vel"])
