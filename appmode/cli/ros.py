@@ -94,6 +94,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "base_link) or WHEELTEC's driver's (odom in odom_combined → base_footprint, "
         "imu/data_raw in gyro_link, PowerVoltage in volts, no TF), for its launch files",
     )
+    _add_frames(ros)
     ros.add_argument(
         "--cmd-vel-timeout",
         type=float,
@@ -160,7 +161,10 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
         if view is not None:
             session.add_viewer(view)
         graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
-        options = Options(args.stamped, timeout, TOPIC_SETS[args.topics])
+        topics = TOPIC_SETS[args.topics].placed(
+            ns, args.frame_prefix or "", args.odom_frame, args.base_frame
+        )
+        options = Options(args.stamped, timeout, topics)
         ros = RosNode(session, zenoh, graph, options, _log)
         ended = [False]
         try:
@@ -194,6 +198,39 @@ def _env_domain() -> int:
         return _domain(text)
     except argparse.ArgumentTypeError as exc:
         raise AppmodeError(f"ROS_DOMAIN_ID: {exc}") from None
+
+
+def _add_frames(ros: argparse.ArgumentParser) -> None:
+    """The frames the node names, and where its transforms go."""
+    ros.add_argument(
+        "--odom-frame",
+        type=frame_name,
+        metavar="FRAME",
+        help="odom's frame (default: the topic set's, odom or odom_combined)",
+    )
+    ros.add_argument(
+        "--base-frame",
+        type=frame_name,
+        metavar="FRAME",
+        help="the car's frame (default: the topic set's, base_link or base_footprint)",
+    )
+    ros.add_argument(
+        "--frame-prefix",
+        type=frame_name,
+        metavar="PREFIX",
+        help="put before every frame the node names (car1/: car1/odom, car1/base_link); with "
+        "--namespace the transforms go to the namespace's tf (/NS/tf), where a namespaced "
+        "Nav2 listens, so that two cars' trees stay apart",
+    )
+
+
+def frame_name(text: str) -> str:
+    """A tf frame's name (or prefix): printable, no spaces, not starting with / (tf2)."""
+    if not text or not text.isprintable() or " " in text or text.startswith("/"):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is no frame name: printable, no spaces, no leading / (e.g. car1/)"
+        )
+    return text
 
 
 def _ros_module() -> None:

@@ -14,7 +14,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from appmode.protocol import app
@@ -66,6 +66,23 @@ class TopicSet:
     odom_frame: str
     base_frame: str
     imu_frame: str
+
+    def placed(
+        self, namespace: str, prefix: str = "", odom: str | None = None, base: str | None = None
+    ) -> TopicSet:
+        """This set for a node in `namespace`: its transforms on the namespace's own `tf`
+        (two cars' trees apart, where a namespaced Nav2 listens), its frames `odom` and
+        `base` (else the set's; the IMU's follows the base's), each after `prefix`."""
+        base_frame = base or self.base_frame
+        imu = base_frame if self.imu_frame == self.base_frame else self.imu_frame
+        tf = self.tf if self.tf is None or namespace == "/" else self.tf.lstrip("/")
+        return replace(
+            self,
+            tf=tf,
+            odom_frame=prefix + (odom or self.odom_frame),
+            base_frame=prefix + base_frame,
+            imu_frame=prefix + imu,
+        )
 
 
 TOPIC_SETS = {
