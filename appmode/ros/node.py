@@ -18,11 +18,11 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from appmode.protocol import app
-from appmode.protocol.odometry import Odometry
+from appmode.protocol.odometry import Odometry, Pose2D
 from appmode.protocol.render import to_json
 from appmode.protocol.sensed import YAW_WINDOW, Inertial, yaw_rate
 from appmode.protocol.twist import BadTwist, Twist
-from appmode.ros.graph import Node, Qos
+from appmode.ros.graph import Durability, Node, Qos
 from appmode.ros.messages import (
     BATTERY,
     FLOAT32,
@@ -47,9 +47,22 @@ TICK = 0.01
 """Seconds between two turns of the node's loop (the session's reads, the queue)."""
 QUEUE = 8
 """cmd_vel samples kept waiting at most (the newest count: a twist replaces the last)."""
+STATIC = Qos(depth=1, durability=Durability.TRANSIENT_LOCAL)
+"""tf_static's QoS, as robot_state_publisher's: reliable, transient local, depth 1."""
+HEARTBEAT = 0.5
+"""Seconds between a transient-local publisher's sample-miss heartbeats (rmw_zenoh's
+SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD, sporadic)."""
+STILL = Pose2D(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+"""No offset: base_footprint lies under base_link (a flat car's ground projection)."""
 BATTERY_EVERY = 10
 """IMU readings a battery_state is sent for (a chassis's 20 Hz status: 2 Hz)."""
 Log = Callable[[str], None]
+
+
+def footprint(base: str) -> str:
+    """The ground projection of the car's frame `base` (REP 120), with `base`'s prefix."""
+    prefix, _, _ = base.rpartition("/")
+    return f"{prefix}/base_footprint" if prefix else "base_footprint"
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,6 +72,8 @@ class TopicSet:
 
     odom: str
     tf: str | None
+    tf_static: str | None
+    """Where the fixed frames go (base_link → base_footprint), transient local."""
     imu: str
     battery: str
     battery_type: str
@@ -75,10 +90,14 @@ class TopicSet:
         `base` (else the set's; the IMU's follows the base's), each after `prefix`."""
         base_frame = base or self.base_frame
         imu = base_frame if self.imu_frame == self.base_frame else self.imu_frame
-        tf = self.tf if self.tf is None or namespace == "/" else self.tf.lstrip("/")
+
+        def placed(topic: str | None) -> str | None:
+            return topic if topic is None or namespace == "/" else topic.lstrip("/")
+
         return replace(
             self,
-            tf=tf,
+            tf=placed(self.tf),
+            tf_static=placed(self.tf_static),
             odom_frame=prefix + (odom or self.odom_frame),
             base_frame=prefix + base_frame,
             imu_frame=prefix + imu,
@@ -87,12 +106,13 @@ class TopicSet:
 
 TOPIC_SETS = {
     "appmode": TopicSet(
-        "odom", "/tf", "imu", "battery_state", BATTERY, "~/raw", "odom", "base_link", "base_link"
+        "odom", "/tf", "/tf_static", "imu", "battery_state", BATTERY, "~/raw",
+        "odom", "base_link", "base_link",
     ),
     # turn_on_wheeltec_robot, ROS 2: odom (odom_combined → base_footprint, no TF of its
     # own: an EKF broadcasts it), imu/data_raw in gyro_link, PowerVoltage in volts
     "wheeltec": TopicSet(
-        "odom", None, "imu/data_raw", "PowerVoltage", FLOAT32, None,
+        "odom", None, None, "imu/data_raw", "PowerVoltage", FLOAT32, None,
         "odom_combined", "base_footprint", "gyro_link",
     ),
 }  # fmt: skip
@@ -174,6 +194,7 @@ class RosNode:
             ("battery", names.battery, names.battery_type, Qos(depth=10)),
             ("imu", names.imu, IMU, Qos(depth=10)),
             ("raw", names.raw, STRING, Qos(depth=10)),
+            ("tf_static", names.tf_static, TF, STATIC),
         ]
         topics = [(name, topic, kind, qos) for name, topic, kind, qos in each if topic]
         for entity_id, (name, topic, ros_type, qos) in enumerate(topics, start=1):
@@ -181,7 +202,7 @@ class RosNode:
             token = self.graph.entity_token(entity_id, "MP", topic, ros_type, type_hash, qos)
             key = self.graph.topic_key(topic, ros_type, type_hash)
             publisher = Publisher(topic, ros_type, key, token, gid(token))
-            publisher.zenoh = self.zenoh.declare_publisher(key)
+            publisher.zenoh = self._publisher(key, qos)
             self._declared += [publisher.zenoh, liveliness.declare_token(token)]
             self.publishers[name] = publisher
         twist = TWIST_STAMPED if self.options.stamped else TWIST
@@ -193,6 +214,27 @@ class RosNode:
             self.zenoh.declare_subscriber(key, self._on_cmd_vel),
             liveliness.declare_token(token),
         ]
+        base = self.options.topics.base_frame  # the fixed frame, kept for late subscribers
+        if footprint(base) != base:
+            fixed = self.messages.transform(STILL, time.time_ns(), base, footprint(base))
+            self._put("tf_static", fixed)
+
+    def _publisher(self, key: str, qos: Qos) -> Any:
+        """A Zenoh publisher as rmw_zenoh declares one for `qos`: transient local, an
+        advanced publisher that keeps its last `depth` samples for late subscribers and
+        can be detected (with sample-miss heartbeats, as it is reliable)."""
+        if qos.durability is not Durability.TRANSIENT_LOCAL:
+            return self.zenoh.declare_publisher(key)
+        import zenoh.ext as ext  # the ros extra's, as the session it runs on
+
+        misses = ext.MissDetectionConfig(heartbeat=None, sporadic_heartbeat=HEARTBEAT)
+        return ext.declare_advanced_publisher(
+            self.zenoh,
+            key,
+            cache=ext.CacheConfig(max_samples=qos.depth),
+            publisher_detection=True,
+            sample_miss_detection=misses,
+        )
 
     def _on_cmd_vel(self, sample: zenoh.Sample) -> None:
         """A cmd_vel sample, taken as rmw_zenoh takes it: one with no attachment, or one

@@ -60,3 +60,48 @@ def test_two_namespaced_cars_keep_their_transforms_apart(tmp_path: Path) -> None
     two = got["car2"].messages("nav_msgs/msg/Odometry")[-1]
     assert (one.header.frame_id, one.child_frame_id) == ("car1/odom", "car1/base_link")
     assert (two.header.frame_id, two.child_frame_id) == ("world", "chassis")
+
+
+def test_a_late_subscriber_gets_tf_static_as_rmw_zenoh_serves_it(tmp_path: Path) -> None:
+    """Issue 77.2: the fixed frame on tf_static, transient local as robot_state_publisher
+    has it — a subscriber that comes later, declared as rmw_zenoh declares a transient
+    local one (rmw_subscription_data.cpp: history, late publishers detected), gets it."""
+    import zenoh.ext
+
+    endpoint = free_endpoint()
+    router = peer.router(endpoint)
+    ros = peer.session(endpoint)
+    node, line = serving(
+        "ros", "sim://", "--connect", endpoint, "--frame-prefix", "car1/", data=tmp_path / "d"
+    )
+    got = peer.Received()
+    try:
+        assert line.startswith("ros: node /appmode"), f"{line!r}: {stop_process(node)}"
+        end = time.monotonic() + 15
+        found = peer.graph(ros)
+        while not any(e.topic == "/tf_static" for e in found):
+            assert time.monotonic() < end, found
+            time.sleep(0.2)
+            found = peer.graph(ros)
+        static = next(e for e in found if e.topic == "/tf_static")
+        assert static.qos.startswith(":1:,1:"), static.qos  # transient local, depth 1
+        time.sleep(1.0)  # later than the node's one sample
+        history = zenoh.ext.HistoryConfig(detect_late_publishers=True, max_samples=1)
+        subscriber = zenoh.ext.declare_advanced_subscriber(
+            ros, static.data_key, got.on_sample, history=history, subscriber_detection=True
+        )
+        end = time.monotonic() + 5
+        while not got.payloads and time.monotonic() < end:
+            time.sleep(0.1)
+        subscriber.undeclare()
+    finally:
+        err = stop_process(node)
+        ros.close()
+        router.close()
+    assert "Traceback" not in err, err
+    (message,) = got.messages("tf2_msgs/msg/TFMessage")
+    (transform,) = message.transforms
+    assert (transform.header.frame_id, transform.child_frame_id) == (
+        "car1/base_link",
+        "car1/base_footprint",
+    )
