@@ -205,8 +205,8 @@ def _write_private(path: Path, text: str) -> None:
 
 
 def _tls(host: str) -> Tls:
-    """appmode's own certificate (as `web` makes it) for a `tls/` listener; where it is
-    and its fingerprint said, for the clients' `ca=`."""
+    """appmode's own certificate for a share's `tls/` listener (its own: the page's is
+    another); where it is and its fingerprint said, for the clients' `ca=`."""
     from appmode.net.config import Tls
 
     try:
@@ -215,7 +215,7 @@ def _tls(host: str) -> Tls:
         raise AppmodeError(
             "--tls makes a certificate with cryptography: pip install 'appmode[web]'"
         ) from None
-    cert, key = own_certificate(machine_names(host))
+    cert, key = own_certificate(machine_names(host), server="share")
     lines = "".join(f"\nappmode:   {line}" for line in grouped(fingerprint(cert)))
     print(
         f"appmode: a client needs this share's certificate, {cert}: copy it to the client's "

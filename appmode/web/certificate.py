@@ -20,7 +20,9 @@ from pathlib import Path
 from appmode.errors import AppmodeError
 from appmode.files import data_folder, temporary_beside
 
-CERT, KEY = "web-cert.pem", "web-key.pem"
+SERVERS = {"web": "the page", "share": "the share"}
+"""The servers that keep a certificate of their own (`NAME-cert.pem`, `NAME-key.pem`), and
+what each is called: a new one for the page must not break the share's clients' `ca=`."""
 DAYS = 825
 """How long a made certificate is valid (the longest some browsers accept)."""
 
@@ -94,27 +96,30 @@ def _why_new(cert_path: Path, names: list[str]) -> str | None:
     return f"the one kept does not name {', '.join(missing)}" if missing else None
 
 
-def own_certificate(names: list[str], folder: Path | None = None) -> tuple[Path, Path]:
-    """appmode's certificate for `names` (made, or made anew, when the one kept does not
-    cover them): the certificate's path and its key's."""
+def own_certificate(
+    names: list[str], folder: Path | None = None, server: str = "web"
+) -> tuple[Path, Path]:
+    """appmode's certificate of `server` (`web`, `share`) for `names` (made, or made anew,
+    when the one kept does not cover them): the certificate's path and its key's."""
     from cryptography import x509
     from cryptography.hazmat.primitives import hashes, serialization
     from cryptography.hazmat.primitives.asymmetric import ec
     from cryptography.x509.oid import NameOID
 
     folder = folder or data_folder()
-    cert_path, key_path = folder / CERT, folder / KEY
+    cert_path, key_path = folder / f"{server}-cert.pem", folder / f"{server}-key.pem"
     why = _why_new(cert_path, names) if key_path.is_file() else ""
     if why is None:
         return cert_path, key_path
     if why:
         print(
-            f"appmode: made a new certificate for the page: {why}; its fingerprint is new, "
-            "so the browser asks again",
+            f"appmode: made a new certificate for {SERVERS[server]}: {why}; its fingerprint "
+            "is new, so "
+            + ("the browser asks again" if server == "web" else "clients need it anew (ca=)"),
             file=sys.stderr,
         )
     key = ec.generate_private_key(ec.SECP256R1())
-    subject = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "appmode web")])
+    subject = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, f"appmode {server}")])
     now = datetime.datetime.now(datetime.timezone.utc)
     cert = (
         x509.CertificateBuilder()

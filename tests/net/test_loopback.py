@@ -20,7 +20,7 @@ pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not instal
 def test_tls_checks_the_key_and_needs_the_share_s_certificate(tmp_path: Path) -> None:
     with shared_board(tmp_path, "car", "--tls") as car:
         assert "connect=tls/127.0.0.1:" in car.url
-        cert = tmp_path / "data" / "appmode" / "web-cert.pem"
+        cert = tmp_path / "data" / "appmode" / "share-cert.pem"
         done = run("params", f"{car.url}&ca={cert}", "--json")
         assert done.returncode == 0 and '"max_speed": 500' in done.stdout, done.stderr
         for url, said in (
@@ -150,3 +150,19 @@ def test_a_forged_car_name_or_field_makes_no_long_fleet_table() -> None:
     long = "x" * 20_000
     shown = table([Car("car-1", {"profile": long, "machine": "\x1b[2J" + long}, 1.0)])
     assert len(shown) < 500 and "\x1b" not in shown and "…" in shown
+
+
+def test_the_page_and_the_share_keep_certificates_of_their_own(tmp_path: Path) -> None:
+    """Issue 79.6/80.12: `web --listen 0.0.0.0` made a new certificate in the file the
+    share served, and every client's `ca=` copy stopped working."""
+    from tests.support.web import web_process
+
+    with shared_board(tmp_path, "car", "--tls") as car:
+        cert = tmp_path / "data" / "appmode" / "share-cert.pem"
+        held = cert.read_bytes()
+        with web_process(tmp_path, "--listen", "0.0.0.0:0"):
+            pass
+        assert (tmp_path / "data" / "appmode" / "web-cert.pem").is_file()
+        assert cert.read_bytes() == held, "the page's certificate is not the share's"
+        done = run("params", f"{car.url}&ca={cert}", "--json")
+        assert done.returncode == 0, done.stderr
