@@ -9,10 +9,11 @@ import shutil
 import sys
 import threading
 import time
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, target
+from appmode.cli.options import Subparsers, add_chassis, target
 from appmode.text import counted, escaped, wrapped
 
 if TYPE_CHECKING:  # imported by `run`: `appmode --help` does not load the host
@@ -58,6 +59,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="with no URL: do not look for Bluetooth modules (a 3-second scan)",
     )
     doctor.add_argument("--json", action="store_true", help="print one JSON object per port")
+    add_chassis(doctor, "listen for a chassis port only, at 115200 bps (quicker)")
     return doctor
 
 
@@ -83,7 +85,12 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    findings = _check(list(urls.values()))
+    from appmode.line.wire import CHASSIS_BAUD
+
+    findings = _check(list(urls.values()), (CHASSIS_BAUD,) if args.chassis else None)
+    if args.chassis:  # what else a port is, at a rate tried for a chassis, is not said
+        heard = ("app", "uart2", "silent", "text", "noise")  # a probe's finding, not a failure
+        findings = [replace(f, kind="no chassis") if f.kind in heard else f for f in findings]
     for finding in findings:
         if args.json:
             sys.stdout.write(json.dumps(to_json(finding)) + "\n")
@@ -140,6 +147,8 @@ def verdict(finding: probe.Finding) -> str:
             else "the reference firmware's status bursts (§13.1)"
         )
         return f"this is a car's control port (UART2){rate}: it sends {what}"
+    if finding.kind == "no chassis":
+        return "no chassis port: no status frames at 115200 bps"
     if finding.kind == "chassis":
         booting = (
             " (Flag_Stop set: booting, or stopped by the board)" if shown and shown.booting else ""
@@ -188,6 +197,8 @@ def fix(finding: probe.Finding) -> str:
             f"drive it with: appmode drive {_at_rate(finding, 115200)} --uart2 (it takes "
             "the motion over from the APP port)"
         )
+    if finding.kind == "no chassis":
+        return f"appmode doctor {url} (without --chassis) finds what it is"
     if finding.kind == "chassis":
         where = _at_rate(finding, 115200)
         if finding.profile is not None or finding.target.simulated:  # sim:// names its own
@@ -283,8 +294,9 @@ def _heard(heard: Heard) -> dict[str, object]:
     }
 
 
-def _check(targets: list[Target]) -> list[probe.Finding]:
-    """Probe every port at once, showing progress on a terminal."""
+def _check(targets: list[Target], rates: tuple[int, ...] | None) -> list[probe.Finding]:
+    """Probe every port at once (at `rates` only, if given), showing progress on a
+    terminal."""
     from concurrent.futures import ThreadPoolExecutor
 
     from appmode.host import probe
@@ -300,7 +312,7 @@ def _check(targets: list[Target]) -> list[probe.Finding]:
 
     pool = ThreadPoolExecutor(max_workers=min(WORKERS, len(targets)))
     futures: dict[str, Future[probe.Finding]] = {
-        t.url: pool.submit(probe.probe, t, stop, mark(t.url)) for t in targets
+        t.url: pool.submit(probe.probe, t, stop, mark(t.url), rates) for t in targets
     }
     show = sys.stderr.isatty()
     try:

@@ -7,7 +7,7 @@ import os
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, add_profile, file_name
+from appmode.cli.options import Subparsers, add_chassis, add_profile, file_name
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:
@@ -27,6 +27,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "file is there yet)",
     )
     add_profile(plot, default=None, unset="the transcript's @board profile=…, else sheet")
+    add_chassis(plot, "draw the chassis port's status (velocity, IMU, battery in SI)")
     return plot
 
 
@@ -41,6 +42,6 @@ def run(args: argparse.Namespace) -> int:
         output = str(Path(args.file).with_suffix(".png"))
         if os.path.lexists(output):  # a file of the user's that they did not name
             raise AppmodeError(f"{output} is already there: name the image with -o PNG")
-    run_plot(args.file, output, args.profile)
+    run_plot(args.file, output, args.profile, chassis_only=args.chassis)
     print(f"wrote {output}", file=sys.stderr)
     return 0

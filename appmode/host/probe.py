@@ -119,21 +119,29 @@ def listen(
     return heard, port
 
 
-def probe(target: Target, stop: threading.Event, progress: Progress) -> Finding:
-    """Listen to `target` and find what it is (never raises AppmodeError: a port that
-    does not open is a finding)."""
+def probe(
+    target: Target,
+    stop: threading.Event,
+    progress: Progress,
+    rates: tuple[int, ...] | None = None,
+) -> Finding:
+    """Listen to `target` (at `rates` only, if given) and find what it is (never raises
+    AppmodeError: a port that does not open is a finding)."""
     try:
-        return _probe(target, stop, progress)
+        return _probe(target, stop, progress, rates)
     except AppmodeError as exc:  # opening it failed: the message says what, then the fix
         return Finding(target=target, kind="unopened", failure=str(exc))
     except (serial.SerialException, OSError) as exc:
         return Finding(target=target, kind="lost", failure=str(exc))
 
 
-def _probe(target: Target, stop: threading.Event, progress: Progress) -> Finding:
+def _probe(
+    target: Target, stop: threading.Event, progress: Progress, only: tuple[int, ...] | None
+) -> Finding:
     fixed = bool(target.scheme)  # TCP, sim://, Bluetooth: no line rate of ours to get wrong
     given = 0 if fixed else target.baud or 0
     rates = RATES[:1] if fixed else (given, *(r for r in RATES if r != given)) if given else RATES
+    rates = only if only is not None and not fixed else rates
     bare = replace(target, baud=None)  # each rate tried, whatever ?baud= said
     heard: list[Heard] = []
     for n, baud in enumerate(rates, start=1):

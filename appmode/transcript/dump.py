@@ -90,9 +90,15 @@ def expectation_json(pattern: Pattern, layout: Layout = VELOCITY) -> dict[str, A
     return {**body, "raw": pattern.text}
 
 
-def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> int:
-    """Print every event; A records named as `profile` lays them out (default: the
-    transcript's `@board profile=…`, else the sheet's)."""
+def run_dump(
+    path: str,
+    fmt: str,
+    out: TextIO,
+    profile: str | None = None,
+    only: tuple[str, ...] | None = None,
+) -> int:
+    """Print every event (`only` those of these directions); A records named as `profile`
+    lays them out (default: the transcript's `@board profile=…`, else the sheet's)."""
     say_if_fifo(path)
     given = profile_named(profile) if profile else None  # a file the @board line may name
     needs = needs_of(path, lambda text: None)  # the second pass warns
@@ -103,6 +109,8 @@ def run_dump(path: str, fmt: str, out: TextIO, profile: str | None = None) -> in
         writer.writeheader()
     items = iter_transcript(path, lambda text: print(f"appmode: WARNING: {text}", file=sys.stderr))
     for t, direction, event in decoded(items, needs.drive, path, layout):
+        if only is not None and direction not in only:
+            continue
         shown = None
         if isinstance(event, BytesPattern):
             body = {"kind": "expectation", "raw": event.text}

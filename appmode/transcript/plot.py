@@ -108,9 +108,10 @@ class _Status:
             envelope.add(t, value)
 
 
-def run_plot(path: str, output: str, profile: str | None = None) -> int:
+def run_plot(path: str, output: str, profile: str | None = None, chassis_only: bool = False) -> int:
     """Velocities, attitude and battery over time, with the commands marked; the fields
-    named as `profile` lays them out (default: the transcript's `@board profile=…`)."""
+    named as `profile` lays them out (default: the transcript's `@board profile=…`);
+    `chassis_only`: the chassis port's status, whatever else the transcript holds."""
     check_writable(output, "plot")
     try:
         import matplotlib
@@ -145,6 +146,10 @@ def run_plot(path: str, output: str, profile: str | None = None) -> int:
             kind = type(event).__name__.removesuffix("Frame")
             wheels.frames.add(t, re.sub(r"(?<!^)(?=[A-Z])", " ", kind).lower())
     title = _title(path, read.title)
+    if chassis_only and not status.series[0].count:
+        raise AppmodeError(f"{path} has no chassis status frames (§15) to plot")
+    if chassis_only:
+        return _plot_status(plt, status, title, output)
     if any(envelope.count for envelope in seen.a + seen.b):
         return _plot_app(plt, seen, layout, title, output)
     if wheels.actual:

@@ -157,3 +157,28 @@ def test_plot_draws_a_chassis_transcript(tmp_path: Path) -> None:
     drawn = run("plot", str(session), "-o", str(image))
     assert drawn.returncode == 0, drawn.stderr
     assert image.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and image.stat().st_size > 20_000
+
+
+def test_dump_plot_and_doctor_take_chassis_too(tmp_path: Path) -> None:
+    session = tmp_path / "session.transcript"
+    done = run(
+        "send", "sim://?profile=wheeltec-mec", "--chassis", "velocity:0.2", "wait:0.2",
+        "--record", str(session), "--listen", "0",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    session.write_text(session.read_text() + "0.9000 > Z\n")  # an APP line, not shown
+    dumped = run("dump", str(session), "--chassis", "--json")
+    directions = {json.loads(line)["dir"] for line in dumped.stdout.splitlines()}
+    assert dumped.returncode == 0 and directions == {"c>", "c<"}, dumped.stderr
+    image = tmp_path / "status.png"
+    assert run("plot", str(session), "--chassis", "-o", str(image)).returncode == 0
+    assert image.read_bytes()[:4] == b"\x89PNG"
+    app_only = tmp_path / "app.transcript"
+    app_only.write_text("# appmode transcript v1\n0.0 < {A0:0:0:0}$\n0.1 < {A0:0:0:0}$\n")
+    refused = run("plot", str(app_only), "--chassis", "-o", str(tmp_path / "x.png"))
+    assert refused.returncode == 2 and "no chassis status frames" in refused.stderr
+    with board_process("--pty", "--profile", "wheeltec-diff") as board:
+        assert board.chassis is not None
+        found = run("doctor", board.chassis, board.url, "--chassis", "--json")
+    kinds = [json.loads(line)["kind"] for line in found.stdout.splitlines()]
+    assert kinds == ["chassis", "no chassis"], found.stdout
