@@ -50,8 +50,6 @@ class ChassisPort:
         """The velocity of the last frame taken (mm/s, mm/s, mrad/s), None: none in force."""
         self.asked_ms = 0
         """When it was taken, in ms from boot."""
-        self.frames = 0
-        self.rejected = 0
         self.out = bytearray()
 
     @property
@@ -65,13 +63,11 @@ class ChassisPort:
             return  # nothing is wired to it
         for event in self.decoder.feed(data):
             if isinstance(event, chassis.Junk):
-                self.rejected += 1
                 core.note(now, "rejected", f"{event} (dropped, as the firmware does)", PORT)
             elif isinstance(event, chassis.Command):
                 if self.flag_stop:
                     core.note(now, "rejected", f"{event}: ignored while booting", PORT)
                     continue
-                self.frames += 1
                 self.asked = self._drivable(event)
                 self.asked_ms = core.tick_ms
                 core.note(now, "applied", str(event), PORT)

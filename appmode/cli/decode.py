@@ -109,10 +109,14 @@ def run_chassis(stream: BinaryIO, out: TextIO, source: str, name: str) -> int:
 
     decoder = chassis.CommandDecoder() if source == "host" else chassis.StatusDecoder()
     errors = 0
-    for chunk in (*read_chunks(stream, name, out), None):
-        for event in decoder.feed(chunk) if chunk is not None else decoder.flush():
-            errors += isinstance(event, chassis.Junk)
-            out.write(json.dumps(chassis.as_json(event), ensure_ascii=False) + "\n")
+    def events() -> Iterator[chassis.Event]:
+        for chunk in read_chunks(stream, name, out):  # as it comes: a live pipe too
+            yield from decoder.feed(chunk)
+        yield from decoder.flush()
+
+    for event in events():
+        errors += isinstance(event, chassis.Junk)
+        out.write(json.dumps(chassis.as_json(event), ensure_ascii=False) + "\n")
     out.flush()
     return errors
 

@@ -119,17 +119,16 @@ def test_a_stalled_status_shows_as_late_and_the_car_is_still_held_and_stopped() 
     sending the velocity in force while it drives, and ends with the zero frame."""
     with stm32() as (board, port):
         choice = choose(parse_target(port), chassis=True)
-        session = open_session(choice, HoldToDrive())
+        session = open_session(choice, HoldToDrive(latched=True))
         try:
             session.start()
+            session.press("forward")  # latched: held with no repeats, by the re-sends alone
             for _ in range(5):
-                session.move(Twist(0.2))  # its source repeats it, as cmd_vel does
                 session.tick()
                 session.host.poll(0.1)
             board.stalled = True
             taken = len(board.taken)
             for _ in range(15):
-                session.move(Twist(0.2))
                 session.tick()
                 session.host.poll(0.1)
             rows = " ".join(row.text for row in session.status_rows())

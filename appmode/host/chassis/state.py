@@ -28,7 +28,6 @@ class ChassisState:
         """(session time, frame) of the last status frames, oldest first."""
         self.in_force: chassis.Command | None = None
         """The last velocity frame sent that asks for motion; None: the last was a stop."""
-        self.sent_frames = 0
         self.sent_at: float | None = None
         """When the last velocity frame went out (session time)."""
         self.query: None = None
@@ -68,7 +67,6 @@ class ChassisState:
         events: list[chassis.Command | chassis.Junk] = []
         for event in self.sent_decoder.feed(data):
             if isinstance(event, chassis.Command):
-                self.sent_frames += 1
                 self.sent_at = now
                 self.in_force = None if event.twist.still else event
             events.append(event)
