@@ -109,6 +109,7 @@ def run_chassis(stream: BinaryIO, out: TextIO, source: str, name: str) -> int:
 
     decoder = chassis.CommandDecoder() if source == "host" else chassis.StatusDecoder()
     errors = 0
+
     def events() -> Iterator[chassis.Event]:
         for chunk in read_chunks(stream, name, out):  # as it comes: a live pipe too
             yield from decoder.feed(chunk)

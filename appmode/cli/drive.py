@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.live_view import add_foxglove, live_view
+from appmode.cli.live_view import add_foxglove, attach, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -107,7 +107,7 @@ def add_board(parser: argparse.ArgumentParser) -> None:
         default=None,
     )
     add_record(parser)
-    add_foxglove(parser)
+    add_foxglove(parser, drives=True)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -121,10 +121,9 @@ def run(args: argparse.Namespace) -> int:
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
     on_message = None if interactive else _print_message
-    with live_view(args.foxglove, choice.profile.a_layout) as view:
+    with live_view(args.foxglove, choice.profile.a_layout, args.foxglove_drive) as view:
         session = open_session(choice, driving, on_message, args.record)
-        if view is not None:
-            session.add_viewer(view)
+        attach(view, session)
         script = command_lines(sys.stdin, MAX_COMMAND)
         return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
 

@@ -10,6 +10,7 @@ from contextlib import contextmanager
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:
     from appmode.protocol.layouts import Layout
+    from appmode.session.base import BaseSession
     from appmode.viewers.live import LiveView
 
 HELP = (
@@ -19,17 +20,34 @@ HELP = (
 )
 
 
-def add_foxglove(parser: argparse.ArgumentParser, what: str = "the session") -> None:
+DRIVE_HELP = (
+    "let the viewer drive (a Teleop panel publishing geometry_msgs/msg/Twist on /cmd_vel "
+    "at 5 Hz or more: each twist lasts 0.5 s) and tune the car (the Parameters panel); "
+    "this machine's viewers only"
+)
+
+
+def add_foxglove(
+    parser: argparse.ArgumentParser, what: str = "the session", drives: bool = False
+) -> None:
+    """`--foxglove`, and with `drives` (a command that drives a car) `--foxglove-drive`."""
     parser.add_argument(
         "--foxglove", metavar="[HOST:]PORT", help=HELP.replace("it live", f"{what} live", 1)
     )
+    if drives:
+        parser.add_argument("--foxglove-drive", action="store_true", help=DRIVE_HELP)
 
 
 @contextmanager
-def live_view(spec: str | None, layout: Layout) -> Iterator[LiveView | None]:
+def live_view(spec: str | None, layout: Layout, drive: bool = False) -> Iterator[LiveView | None]:
     """The live view `--foxglove` asks for (None if not asked), its address said on
-    stderr; stopped on the way out, after what it was fed is logged."""
+    stderr; stopped on the way out, after what it was fed is logged. With `drive`, its
+    viewers may drive and tune the car (`attach` gives them the session)."""
+    from appmode.errors import AppmodeError
+
     if spec is None:
+        if drive:
+            raise AppmodeError("--foxglove-drive needs --foxglove PORT (the viewers' server)")
         yield None
         return
     from appmode.ports.endpoints import parse_listen
@@ -37,7 +55,13 @@ def live_view(spec: str | None, layout: Layout) -> Iterator[LiveView | None]:
     from appmode.web.access import is_loopback
 
     host, port = parse_listen(spec, "--foxglove")
-    view = LiveView(host, port, layout)
+    if drive and not is_loopback(host):
+        raise AppmodeError(
+            f"--foxglove-drive serves this machine only (a Foxglove viewer shows no owner's "
+            f"token): serve on a loopback address (--foxglove {port}), and from another "
+            f"machine reach it through SSH (ssh -L {port}:localhost:{port} THIS-MACHINE)"
+        )
+    view = LiveView(host, port, layout, drive=drive)
     print(
         f"foxglove: {view.url} (in Foxglove or Lichtblick: Open connection → Foxglove WebSocket)",
         file=sys.stderr,
@@ -59,3 +83,18 @@ def live_view(spec: str | None, layout: Layout) -> Iterator[LiveView | None]:
                 f"appmode: the live view dropped {view.dropped} units it had no room for",
                 file=sys.stderr,
             )
+
+
+def attach(view: LiveView | None, session: BaseSession) -> None:
+    """Show `session` to `view`, and let its viewers drive and tune it where they may."""
+    if view is None:
+        return
+    session.add_viewer(view)
+    if view.desk is not None:
+        session.desks.append(view.desk)
+        print(
+            "foxglove: viewers on this machine may drive (Teleop on /cmd_vel, 0.5 s a "
+            "twist) and tune (Parameters)",
+            file=sys.stderr,
+            flush=True,
+        )

@@ -11,7 +11,7 @@ from contextlib import ExitStack
 from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.live_view import add_foxglove, live_view
+from appmode.cli.live_view import add_foxglove, attach, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -103,7 +103,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="stop the car after this long without a cmd_vel (default 0.5)",
     )
     add_profile(ros, f"the car's profile, {HOLDS}", default=None)
-    add_foxglove(ros, "the car")
+    add_foxglove(ros, "the car", drives=True)
     return ros
 
 
@@ -155,11 +155,12 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
             )
         choice = board_choice(args, both=True)  # a sim:// board's records give odom
         timeout = args.cmd_vel_timeout
-        view = stack.enter_context(live_view(args.foxglove, choice.profile.a_layout))
+        view = stack.enter_context(
+            live_view(args.foxglove, choice.profile.a_layout, args.foxglove_drive)
+        )
         session = open_car(choice, HoldToDrive(first_timeout=timeout, repeat_timeout=timeout))
         session.lease, session.lease_source = timeout, "cmd_vel"
-        if view is not None:
-            session.add_viewer(view)
+        attach(view, session)
         graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
         topics = TOPIC_SETS[args.topics].placed(
             ns, args.frame_prefix or "", args.odom_frame, args.base_frame

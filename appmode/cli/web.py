@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
-from appmode.cli.live_view import live_view
+from appmode.cli.live_view import attach, live_view
 from appmode.cli.options import Subparsers, board_choice, target
 from appmode.errors import AppmodeError
 
@@ -93,10 +93,9 @@ def run(args: argparse.Namespace) -> int:
     if args.connect or args.fleet_key is not None:
         raise AppmodeError("--connect and --fleet-key go with --fleet")
     choice = board_choice(args)
-    with live_view(args.foxglove, choice.profile.a_layout) as view:
+    with live_view(args.foxglove, choice.profile.a_layout, args.foxglove_drive) as view:
         session = open_session(choice, driving(), record=args.record)
-        if view is not None:
-            session.add_viewer(view)
+        attach(view, session)
         return serve_web(session, host, port, tls, tuple(addresses), fingerprint)
 
 

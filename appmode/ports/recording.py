@@ -75,4 +75,3 @@ def open_recorder(
                 os.unlink(path)
         raise
     return recorder
-

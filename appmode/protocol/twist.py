@@ -37,8 +37,7 @@ class Twist:
             raise BadTwist(f"a twist of {forward}, {left}, {turn}: each part must be a number")
         if max(map(abs, parts)) > LIMIT:
             raise BadTwist(
-                f"a twist of {forward:g}, {left:g}, {turn:g}: over {LIMIT:g} m/s or rad/s, "
-                "no car's"
+                f"a twist of {forward:g}, {left:g}, {turn:g}: over {LIMIT:g} m/s or rad/s, no car's"
             )
         return cls(*parts)
 

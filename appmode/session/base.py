@@ -32,9 +32,9 @@ from appmode.session.command_line import (
     MAX_COMMAND,
     CommandSpec,
     Step,
+    help_lines,
 )
 from appmode.session.hold import TWIST, HoldToDrive
-from appmode.text import wrapped
 from appmode.writer import CLOSE_WAIT
 
 if TYPE_CHECKING:
@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from appmode.host.app.state import HostState
     from appmode.host.chassis.client import ChassisHost
     from appmode.host.control.client import ControlHost
+    from appmode.session.desk import Desk
     from appmode.session.instruments import Instruments
     from appmode.session.rows import Row
 
@@ -80,6 +81,8 @@ class BaseSession(ABC):
         self.viewers: list[Viewer] = []
         """Live views beside the session's own (`--foxglove`): each a tap that never
         blocks (`viewers.live.LiveView`)."""
+        self.desks: list[Desk] = []
+        """What viewers that may drive and tune ask (`--foxglove-drive`), served at each tick."""
         self.names_files = True
         """The command line may name files (`record FILE`); a page's may not: its
         recordings go to `recordings_folder()` under names appmode makes."""
@@ -156,19 +159,20 @@ class BaseSession(ABC):
         """Whether motion is in force, whatever started it (a key, a command, a stick,
         raw bytes, a turn)."""
 
-    def move(self, twist: Twist, source: str = TWIST) -> None:
+    def move(self, twist: Twist, source: str = TWIST, timeout: float | None = None) -> None:
         """Drive `twist` (SI units, REP 103) for as long as its source repeats it: each
         call keeps it alive as a held key's repeats do (and `keepalive`, where a lease
         is set, must come too; a program's twist never latches, a typed one as a key
         does); a still twist stops the car. Every port takes it: the APP port as its
-        nearest direction and speed, the control port as frames."""
+        nearest direction and speed, the control port as frames. `timeout`: how long
+        each call keeps it alive, where the source has its own (else hold-to-drive's)."""
         if twist.still:
             if self.moving:
                 self.stop()
             return
         if self.link_down():
             return
-        self.driving.press(source, self.now())
+        self.driving.press(source, self.now(), timeout)
         self._move(twist)
 
     @abstractmethod
@@ -206,8 +210,7 @@ class BaseSession(ABC):
     # ------------------------------------------------------------ the stop authority
 
     def _stoppable(self) -> bool:
-        """Motion is in force and a stop can go out now (a link that is down sends its
-        stop first when it is back: `Link._stop_after_outage`)."""
+        """Motion is in force and a stop can go out now (a link down stops when back)."""
         return self.moving and self.host.connected
 
     def keepalive(self) -> None:
@@ -218,7 +221,9 @@ class BaseSession(ABC):
     def watch(self) -> bool:
         """At each tick: end motion whose source has gone quiet (`lease`), and take note
         of a stop the guard sent (the ticks stalled, or the source went quiet while the
-        session could not tick); whether the car was stopped."""
+        session could not tick); whether the car was stopped. Viewers' requests first."""
+        for desk in self.desks:
+            desk.serve(self)
         if self.guard.beat():
             self._forget_motion()
             if self.guard.why and not self.moving:
@@ -299,6 +304,14 @@ class BaseSession(ABC):
         as the board applies them (the control port's frames); None elsewhere."""
         return None
 
+    def parameters(self) -> dict[str, int | float]:
+        """The car's parameters as last read, in the user's units (none: not yet, or none)."""
+        return {}
+
+    def set_parameter(self, name: str, value: str) -> None:
+        """Set a parameter (`value` in the user's units), verified by reading back."""
+        raise AppmodeError("this port has no parameters to set")
+
     @abstractmethod
     def unsaved_warning(self) -> str | None:
         """What was set in this session and not saved since, in a line; None if nothing."""
@@ -306,8 +319,7 @@ class BaseSession(ABC):
     # ------------------------------------------------------------ messages
 
     def link_down(self) -> bool:
-        """Whether the link is down, saying so at the first key of each outage (keys
-        repeat many times a second: one line says it)."""
+        """Whether the link is down, said once an outage (keys repeat many times a second)."""
         if self.host.connected:
             self._down_said = False
             return False
@@ -330,19 +342,7 @@ class BaseSession(ABC):
 
     def help_lines(self) -> list[str]:
         """The commands, a line each, then the keys."""
-        specs = (*self.commands, *COMMON)
-        usages = [f"{spec.name} {spec.args}".strip() for spec in specs]
-        width = max(map(len, usages)) + 2
-        lines = [
-            wrapped(usage.ljust(width) + spec.help, indent=" " * width)
-            for usage, spec in zip(usages, specs, strict=True)
-        ]
-        return [
-            *lines,
-            "",
-            *self.keys_help.splitlines(),
-            "PgUp/PgDn scroll the messages · End: the newest",
-        ]
+        return help_lines((*self.commands, *COMMON), self.keys_help)
 
     # ------------------------------------------------------------ recording
 

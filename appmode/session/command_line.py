@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from appmode.errors import AppmodeError
 from appmode.files import new_recording, recordings_folder
@@ -15,6 +15,7 @@ from appmode.host.waits import Wait
 from appmode.protocol.formats import TEXT
 from appmode.protocol.twist import BadTwist, Twist
 from appmode.session.hold import TYPED_TWIST
+from appmode.text import wrapped
 
 if TYPE_CHECKING:
     from appmode.session.base import BaseSession
@@ -139,3 +140,14 @@ COMMON: tuple[CommandSpec[BaseSession], ...] = (
 )
 """The commands every session takes, listed after its own."""
 COMMON_ALIASES = {"?": "help", **{word: "quit" for word in QUIT_WORDS}}
+
+
+def help_lines(specs: tuple[CommandSpec[Any], ...], keys_help: str) -> list[str]:
+    """The commands, a line each, then the keys."""
+    usages = [f"{spec.name} {spec.args}".strip() for spec in specs]
+    width = max(map(len, usages)) + 2
+    lines = [
+        wrapped(usage.ljust(width) + spec.help, indent=" " * width)
+        for usage, spec in zip(usages, specs, strict=True)
+    ]
+    return [*lines, "", *keys_help.splitlines(), "PgUp/PgDn scroll the messages · End: the newest"]

@@ -28,23 +28,29 @@ class HoldToDrive:
     latched: bool = False
     current: str | None = None
     deadline: float = field(default=0.0)
+    timed: bool = False
+    """The direction in force has a timeout of its own (`press`'s): it never latches."""
 
-    def press(self, letter: str, now: float) -> str | None:
-        """A key for `letter` was pressed (or repeated): the letter to send, if any."""
+    def press(self, letter: str, now: float, timeout: float | None = None) -> str | None:
+        """A key for `letter` was pressed (or repeated): the letter to send, if any.
+        `timeout`: how long this press lasts, first or repeated (a source with a
+        deadline of its own, such as a viewer's twists), instead of the two timeouts."""
         if letter == STOP_LETTER:
             self.current = None
             return STOP_LETTER
+        self.timed = timeout is not None
         if letter == self.current:
-            self.deadline = now + self.repeat_timeout
+            self.deadline = now + (self.repeat_timeout if timeout is None else timeout)
             return None
-        self.deadline = now + self.first_timeout  # first: the stop guard reads both
+        first = self.first_timeout if timeout is None else timeout
+        self.deadline = now + first  # first: the stop guard reads both
         self.current = letter
         return letter
 
     def late(self, now: float) -> float | None:
         """Seconds a held direction is past its deadline (below 0: not yet); None when
-        none is held, or it is latched (a twist never is)."""
-        if self.current is None or (self.latched and self.current != TWIST):
+        none is held, or it is latched (a twist never is, nor a press with a timeout)."""
+        if self.current is None or (self.latched and self.current != TWIST and not self.timed):
             return None
         return now - self.deadline
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import queue
 import threading
 import time
@@ -23,6 +24,7 @@ from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.reader import SENT_DIRECTIONS, PortsReader
+from appmode.session.desk import Desk, Values
 
 QUEUE = 4096
 """Units and notes waiting for the worker at most (seconds of a flood: they are small)."""
@@ -54,10 +56,17 @@ class LiveView:
     `view.note(text)` for what the session says."""
 
     def __init__(
-        self, host: str, port: int, layout: Layout = VELOCITY, name: str = "appmode"
+        self,
+        host: str,
+        port: int,
+        layout: Layout = VELOCITY,
+        name: str = "appmode",
+        drive: bool = False,
     ) -> None:
         try:
             import foxglove
+
+            from appmode.viewers import listener
         except ImportError:
             raise AppmodeError(
                 "--foxglove needs the foxglove SDK: pip install 'appmode[foxglove]'"
@@ -66,6 +75,10 @@ class LiveView:
         self._context = foxglove.Context()
         self.watched = threading.Event()
         """Set when a viewer first subscribes to a channel."""
+        self.desk = Desk(self._publish_values) if drive else None
+        """What viewers ask of the session (`--foxglove-drive`: drive and tune), if they may."""
+        self._listener = listener.Listener(self.watched, self.desk, self.note)
+        _quiet_sdk(listener.SdkLog(self._listener))
         try:
             self._server = foxglove.start_server(
                 name=name,
@@ -73,7 +86,9 @@ class LiveView:
                 port=port,
                 context=self._context,
                 message_backlog_size=BACKLOG,
-                server_listener=_listener(self.watched),
+                server_listener=self._listener,
+                capabilities=listener.DRIVING if drive else None,
+                supported_encodings=listener.ENCODINGS if drive else None,
             )
         except Exception as exc:  # the SDK raises its own errors: a port in use, say
             raise AppmodeError(
@@ -125,6 +140,12 @@ class LiveView:
             self._queue.put_nowait(item)
         except queue.Full:
             self.dropped += 1
+
+    def _publish_values(self, values: Values) -> None:
+        """The parameters read back, to the viewers that watch them."""
+        from appmode.viewers.listener import listed
+
+        self._server.publish_parameter_values(listed(values, []))
 
     def close(self, wait: float = 1.0) -> None:
         """Log what is queued (at most `wait` seconds), then stop the server."""
@@ -181,15 +202,13 @@ class LiveView:
         )
 
 
-def _listener(watched: threading.Event) -> Any:
-    """The server's listener: sets `watched` when a viewer subscribes."""
-    from foxglove.websocket import ServerListener
-
-    class Watched(ServerListener):
-        def on_subscribe(self, client: Any, channel: Any) -> None:
-            watched.set()
-
-    return Watched()
+def _quiet_sdk(handler: logging.Handler) -> None:
+    """The SDK's log to `handler` alone (its lines would land over a console's screen)."""
+    sdk = logging.getLogger("foxglove")
+    for old in sdk.handlers[:]:
+        sdk.removeHandler(old)
+    sdk.addHandler(handler)
+    sdk.propagate = False
 
 
 def _ns(when: float) -> int:

@@ -20,6 +20,7 @@ if typing.TYPE_CHECKING:  # as the modules that use it write it
 else:
     from appmode.protocol.tuples import NamedTuple
 
+
 def test_a_bad_toml_is_one_error() -> None:
     with pytest.raises(profile_file.ProfileError, match="not TOML"):
         profile_file.parse("name = ", "x")

@@ -73,3 +73,78 @@ async def watch(
 
 def watch_sync(url: str, seconds: float, topics: set[str] | None = None, until: Any = None) -> Seen:
     return asyncio.run(watch(url, seconds, topics, until))
+
+
+CLIENT_MESSAGE_DATA = 0x01
+
+
+class Driver:
+    """A viewer that drives and tunes, as Foxglove's Teleop and Parameters panels do:
+    it advertises a channel, publishes JSON on it, asks for and sets parameters; every
+    text message the server sends is kept (`said`), in order."""
+
+    def __init__(self, ws: Any) -> None:
+        self.ws = ws
+        self.said: list[dict[str, Any]] = []
+        self.info: dict[str, Any] = {}
+        self._reader = asyncio.get_running_loop().create_task(self._read())
+
+    @classmethod
+    async def open(cls, url: str) -> Driver:
+        ws = await websockets.connect(url, subprotocols=SUBPROTOCOLS, max_size=None)
+        driver = cls(ws)
+        await driver.wait_for(lambda m: m.get("op") == "serverInfo")
+        return driver
+
+    async def _read(self) -> None:
+        try:
+            async for frame in self.ws:
+                if isinstance(frame, str):
+                    message = json.loads(frame)
+                    if message.get("op") == "serverInfo":
+                        self.info = message
+                    self.said.append(message)
+        except websockets.ConnectionClosed:
+            pass
+
+    async def wait_for(self, check: Any, seconds: float = 5.0) -> dict[str, Any]:
+        """The first message the server said (or says within `seconds`) that `check` takes."""
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            for message in self.said:
+                if check(message):
+                    return message
+            await asyncio.sleep(0.02)
+        raise AssertionError(f"the server did not say it in {seconds} s: {self.said[-5:]}")
+
+    async def advertise(self, channel: int, topic: str = "/cmd_vel") -> None:
+        await self.send(
+            {
+                "op": "advertise",
+                "channels": [
+                    {
+                        "id": channel,
+                        "topic": topic,
+                        "encoding": "json",
+                        "schemaName": "geometry_msgs/msg/Twist",
+                    }
+                ],
+            }
+        )
+
+    async def publish(self, channel: int, message: Any) -> None:
+        data = message if isinstance(message, bytes) else json.dumps(message).encode()
+        await self.ws.send(struct.pack("<BI", CLIENT_MESSAGE_DATA, channel) + data)
+
+    async def twist(self, channel: int, x: float, y: float = 0.0, z: float = 0.0) -> None:
+        zero = {"x": 0.0, "y": 0.0, "z": 0.0}
+        await self.publish(
+            channel, {"linear": {**zero, "x": x, "y": y}, "angular": {**zero, "z": z}}
+        )
+
+    async def send(self, message: dict[str, Any]) -> None:
+        await self.ws.send(json.dumps(message))
+
+    async def close(self) -> None:
+        await self.ws.close()
+        await self._reader

@@ -22,8 +22,7 @@ def _set(session: AppSession, args: list[str]) -> None:
         first = specs[0]
         example = f"{first.name} {param_values.to_user(first, first.default)}"
         raise AppmodeError(f"usage: set NAME VALUE, e.g. set {example}")
-    index = param_values.lookup(specs, args[0])
-    session.set_param(index, param_values.from_user(specs[index], args[1]))
+    session.set_parameter(args[0], args[1])
 
 
 def _drive(session: AppSession, args: list[str]) -> None:

@@ -252,6 +252,20 @@ class AppSession(BaseSession):
         param_values.check(self.specs, index, value)
         self._query(ParamQuery((index, value), where=self.url, specs=self.specs))
 
+    def parameters(self) -> dict[str, int | float]:
+        current = self.host.state.params
+        if current is None:
+            return {}
+        specs = self.specs
+        return {
+            s.name: param_values.user_number(s, v)
+            for s, v in zip(specs, current.values, strict=True)
+        }
+
+    def set_parameter(self, name: str, value: str) -> None:
+        index = param_values.lookup(self.specs, name)
+        self.set_param(index, param_values.from_user(self.specs[index], value))
+
     def _speed_index(self) -> int:
         index = self.host.state.layout.speed_index
         if index is None:
