@@ -15,6 +15,7 @@ from typing import Any, Protocol
 
 from appmode.protocol import app, chassis, control
 from appmode.protocol.control_view import view
+from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import Layout
 from appmode.protocol.odometry import Odometry, Pose2D
 from appmode.protocol.reader import (
@@ -40,6 +41,23 @@ RAW = {
     "c<": "/raw/chassis/received",
 }
 """Each direction's raw channel: a message a unit, its bytes as they went."""
+RAW_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "text": {"type": "string", "description": "the bytes as transcripts show them"},
+        "hex": {"type": "string", "description": "the bytes, exactly"},
+        "length": {"type": "integer"},
+    },
+}
+IN_FORCE = "/session/in_force"
+IN_FORCE_SCHEMA = {
+    "type": "object",
+    "properties": {
+        "command": {"type": "string", "description": "the letter or frame in force"},
+        "text": {"type": "string"},
+        "moving": {"type": "boolean"},
+    },
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -131,6 +149,7 @@ def channels(layout: Layout) -> dict[str, ChannelSpec]:
         ),
         ChannelSpec("/pose", "foxglove.PoseInFrame", POSE_SCHEMA, "dead reckoning"),
         ChannelSpec("/tf", "foxglove.FrameTransform", TRANSFORM_SCHEMA, "dead reckoning"),
+        ChannelSpec(IN_FORCE, "appmode.in_force", IN_FORCE_SCHEMA, "the command in force"),
     ]
     return {spec.topic: spec for spec in specs}
 
@@ -147,6 +166,15 @@ class Decoded:
 
     def unit(self, time: float, direction: str, event: Any) -> list[tuple[str, dict[str, Any]]]:
         """The messages one decoded unit makes (`time`: seconds, the session's)."""
+        found = self._unit(time, direction, event)
+        moves = _moves(event) if direction in (SENT, SENT2, SENT_CHASSIS) else None
+        if moves is not None:
+            text = view(event, self.layout)[1]
+            command = escape(event.raw)
+            found.append((IN_FORCE, {"command": command, "text": text, "moving": moves}))
+        return found
+
+    def _unit(self, time: float, direction: str, event: Any) -> list[tuple[str, dict[str, Any]]]:
         if direction in (SENT_CHASSIS, RECEIVED_CHASSIS):
             return self._chassis(time, direction, event)
         body = view(event, self.layout)[0]
@@ -203,6 +231,21 @@ class Decoded:
         by_name = {f.name: v / f.scale for f, v in zip(self.layout.a_fields, values, strict=False)}
         twist = Twist.from_units(by_name["x"], by_name["y"], by_name["z"], self.si)
         return self.odometry.step(time, twist)
+
+
+def _moves(event: Any) -> bool | None:
+    """Whether a command sets the car moving (True), stops it (False), or neither."""
+    if isinstance(event, chassis.Command):
+        return not event.twist.still
+    if isinstance(event, app.Move):
+        return event.direction != 0
+    if isinstance(event, app.Stop):
+        return False
+    if isinstance(event, control.VelocityFrame | control.MotorFrame):
+        return any(event.values) and not (isinstance(event, control.VelocityFrame) and event.angle)
+    if isinstance(event, control.PositionFrame):
+        return any((event.x, event.y, event.z))
+    return None
 
 
 def _stamp(time: float) -> dict[str, int]:

@@ -7,6 +7,7 @@ recorder or `convert` hands it, and reads from a stream it is handed. A new form
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Iterator
 from typing import BinaryIO
 
@@ -18,6 +19,7 @@ from appmode.protocol.recorder import Lines, TextLines
 from appmode.protocol.transcript import (
     HEADER,
     SUFFIX,
+    Directive,
     Entry,
     Line,
     format_line,
@@ -110,7 +112,8 @@ class Mcap(Format):
             from appmode.protocol.mcap_format import McapLines, is_pattern
         except ImportError:
             raise _missing("writing MCAP") from None
-        lines = McapLines(layout, library="appmode convert")
+        items, start_ns = _recorded(items)
+        lines = McapLines(layout, library="appmode convert", start_ns=start_ns)
         reader = PortsReader(drive=drive, layout=layout)
         yield lines.start()
         time = 0.0
@@ -130,10 +133,26 @@ class Mcap(Format):
         self, handle: BinaryIO, name: str, warn: Warn, whole: bool | None, partial: bool
     ) -> Iterator[Line]:
         try:
-            from appmode.protocol.mcap_format import read_items
+            from appmode.protocol.mcap_reading import read_items
         except ImportError:
             raise _missing(f"{name} is MCAP: reading it") from None
         return read_items(handle, name, warn, whole, partial)
+
+
+def _recorded(items: Iterator[Line]) -> tuple[Iterator[Line], int]:
+    """When the transcript was recorded (its `@recorded`, before its first entry), in ns
+    since 1970 (0: it does not say), and its lines, all of them."""
+    from appmode.protocol.mcap_format import RECORDED, start_of
+
+    head: list[Line] = []
+    start = 0
+    for item in items:
+        head.append(item)
+        if isinstance(item, Directive) and item.name == RECORDED:
+            start = start_of(" ".join(item.args), f"line {item.lineno}")
+        if isinstance(item, Entry):
+            break
+    return itertools.chain(head, items), start
 
 
 def _missing(doing: str) -> AppmodeError:
@@ -154,6 +173,12 @@ def written_as(name: str) -> Format:
     return WRITERS.get(base[base.rfind(".") :].lower() if "." in base else "", TEXT)
 
 
-def read_as(first: bytes) -> Format:
-    """The format of a file that begins with `first` (MAGIC_SIZE bytes, or fewer)."""
-    return next((f for magic, f in READERS.items() if first.startswith(magic)), TEXT)
+def read_as(first: bytes, name: str = "") -> Format:
+    """The format of a file named `name` that begins with `first` (MAGIC_SIZE bytes, or
+    fewer): the one whose magic it begins with, or with part of (a file cut short);
+    an empty file's, by its name's suffix; else a transcript."""
+    for magic, form in READERS.items():
+        if first.startswith(magic) or (first and magic.startswith(first)):
+            return form
+    suffixed = WRITERS.get("." + name.rpartition(".")[2].lower()) if "." in name else None
+    return suffixed if not first and suffixed is not None else TEXT

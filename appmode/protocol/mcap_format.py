@@ -2,30 +2,35 @@
 record, for whoever writes them (a bounded writer, a file); the reader's side maps MCAP
 messages back to a transcript's items.
 
-The raw bytes of both directions of both ports, with their times, are the lossless
+The raw bytes of both directions of every port, with their times, are the lossless
 source of truth: one channel per direction (`/raw/app/sent` …), each message a unit's
-bytes, its log time the unit's, its sequence number the transcript line it was (a
-UART2 unit in APP mode, text in a transcript, on `…/as_text`; an expectation that no
-bytes stand for, `??` in a `2<` line, on `…/pattern` as its text). Directives and
-comments ride on `/transcript/directives` and `/transcript/comments`. Beside them, for
-viewers, the decoded channels of `protocol.channels`, JSON with JSON schemas."""
+bytes (JSON: `hex` exact, `text` as a transcript shows them), its sequence number the
+transcript line it was (a UART2 unit in APP mode, text in a transcript, on `…/as_text`;
+an expectation that no bytes stand for, `??` in a `2<` line, on `…/pattern` as its
+text). Directives and comments ride on `/transcript/directives` and
+`/transcript/comments`. Beside them, for viewers, the decoded channels of
+`protocol.channels` and `/log`. Every channel is JSON with a JSON schema, so a generic
+viewer decodes each; the file is chunked (zstd) and indexed, a chunk at least every
+FLUSH seconds so that a file cut short keeps all but its last ones.
+
+Log times are the wall clock, in ns since 1970: the session's time plus its start, which
+the `appmode` metadata record keeps (and a `@recorded` directive, so that a transcript
+converted from the file keeps it); a reader gets the transcript's own times back. Files
+of appmode's before these (raw bytes, `appmode.bytes`, log times from 0) read as before."""
 
 from __future__ import annotations
 
 import json
-import struct
-import zlib
-from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, replace
-from typing import Any, BinaryIO
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass
+from datetime import datetime, timedelta, timezone
+from typing import Any
 
-from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
-from mcap.opcode import Opcode
-from mcap.records import Channel, Chunk, DataEnd, Footer, Header, Message
-from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
-from appmode.protocol.channels import RAW, Decoded, channels
+from appmode.protocol.channels import RAW, RAW_SCHEMA, Decoded, channels
+from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
 from appmode.protocol.transcript import (
@@ -38,8 +43,6 @@ from appmode.protocol.transcript import (
     Entry,
     Line,
     TranscriptError,
-    parse_directive,
-    parse_entry,
     uart2_payload,
 )
 
@@ -50,10 +53,36 @@ PATTERN = "/pattern"
 COMMENTS = "/transcript/comments"
 DIRECTIVES = "/transcript/directives"
 BYTES = "appmode.bytes"
-"""A message that is a unit's bytes, as they went."""
+"""Before JSON: a message that is a unit's bytes, as they went (still read)."""
 TEXT = "appmode.text"
-"""A message that is UTF-8 text: a comment, a directive, a pattern's payload."""
+"""Before JSON: a message that is UTF-8 text (still read)."""
 NS = 10**9
+START = "appmode"
+"""The metadata record that says when the session's time 0 was (`start_ns`)."""
+RECORDED = "recorded"
+"""The directive that says it in a transcript: `@recorded 2026-11-29T08:00:00.000000Z`."""
+LOG = "/log"
+TEXT_SCHEMA = {"type": "object", "properties": {"text": {"type": "string"}}}
+LOG_SCHEMA = {
+    "title": "foxglove.Log",
+    "type": "object",
+    "properties": {
+        "timestamp": {
+            "type": "object",
+            "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}},
+        },
+        "level": {"type": "integer", "description": "1 debug, 2 info, 3 warning, 4 error"},
+        "message": {"type": "string"},
+        "name": {"type": "string"},
+        "file": {"type": "string"},
+        "line": {"type": "integer"},
+    },
+}
+DEBUG = 1
+CHUNK = 256 * 1024
+"""Bytes of messages a chunk holds at most before it is written."""
+FLUSH = 1.0
+"""Seconds of messages a chunk spans at most (what a file cut short loses)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -99,8 +128,6 @@ class _Sink:
     def __init__(self) -> None:
         self._data = bytearray()
         self._count = 0
-        self.crc = 0
-        """CRC-32 of every byte taken so far (the data section, until `finish`)."""
 
     def flush(self) -> None:
         """Nothing to flush: `take` hands out every byte written."""
@@ -117,66 +144,119 @@ class _Sink:
     def take(self) -> bytes:
         data = bytes(self._data)
         self._data.clear()
-        self.crc = zlib.crc32(data, self.crc)
         return data
 
 
-class McapLines:
-    """An MCAP file made a record at a time: each method returns the bytes it adds
-    (unchunked, so that a file cut short keeps every message written before)."""
+def recorded(start_ns: int) -> str:
+    """The `@recorded` directive's argument for a start (UTC, to the microsecond)."""
+    moment = datetime(1970, 1, 1, tzinfo=timezone.utc) + timedelta(microseconds=start_ns // 1000)
+    return moment.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
 
-    def __init__(self, layout: Layout = VELOCITY, library: str = "appmode") -> None:
+
+def start_of(text: str, where: str) -> int:
+    """The start a `@recorded` argument says, in ns since 1970; TranscriptError if none."""
+    try:
+        moment = datetime.strptime(text, "%Y-%m-%dT%H:%M:%S.%fZ").replace(tzinfo=timezone.utc)
+    except ValueError:
+        raise TranscriptError(
+            f"{where}: @recorded takes a UTC time such as 2026-11-29T08:00:00.000000Z"
+        ) from None
+    return (moment - datetime(1970, 1, 1, tzinfo=timezone.utc)) // timedelta(microseconds=1) * 1000
+
+
+class McapLines:
+    """An MCAP file made a record at a time: each method returns the bytes it adds (a
+    chunk's when one is done, else nothing). `start_ns`: the wall-clock time of the
+    session's time 0 (None: now, a recording's; a `@recorded` directive among
+    `start`'s sets it too, a converted transcript's)."""
+
+    def __init__(
+        self, layout: Layout = VELOCITY, library: str = "appmode", start_ns: int | None = None
+    ) -> None:
         self._sink = _Sink()
         self._writer = Writer(
             self._sink,  # type: ignore[arg-type]  # a stream to it: write, tell, flush
-            use_chunking=False,
-            compression=CompressionType.NONE,
+            chunk_size=CHUNK,
+            compression=CompressionType.ZSTD,
+            enable_data_crcs=True,
         )
         self._library = library
         self._decoded = Decoded(layout)
         self._layout = layout
         self._ids: dict[str, int] = {}
         self._time = 0
+        self._flushed = 0
+        self._given = start_ns is not None
+        self.start_ns = time.time_ns() // 1000 * 1000 if start_ns is None else start_ns
 
     def _taken(self) -> bytes:
         return self._sink.take()
 
     def start(self, directives: Iterable[str] = ()) -> bytes:
-        """The header, every channel, and `directives` (`board profile=…`)."""
+        """The header, the start's metadata, every channel, and `directives` (`board
+        profile=…`; a recording adds `recorded …`)."""
+        directives = list(directives)
+        for directive in directives:
+            name, _, rest = directive.partition(" ")
+            if name == RECORDED:
+                self.start_ns = start_of(rest.strip(), "@recorded")
+                self._given = True
+        if not self._given:
+            directives.append(f"{RECORDED} {recorded(self.start_ns)}")
+        self._time = self._flushed = self.start_ns
         self._writer.start(profile=PROFILE, library=self._library)
+        self._writer.add_metadata(
+            START, {"start_ns": str(self.start_ns), "start": recorded(self.start_ns)}
+        )
+        raw = self._schema("appmode.bytes", RAW_SCHEMA)
+        text = self._schema("appmode.text", TEXT_SCHEMA)
         for channel in RAW_CHANNELS:
-            encoding = TEXT if channel.form == "pattern" else BYTES
             self._ids[channel.topic] = self._writer.register_channel(
-                channel.topic, encoding, 0, {"direction": channel.direction}
+                channel.topic,
+                "json",
+                text if channel.form == "pattern" else raw,
+                {"direction": channel.direction},
             )
         for topic in (COMMENTS, DIRECTIVES):
-            self._ids[topic] = self._writer.register_channel(topic, TEXT, 0, {})
-        for spec in channels(self._layout).values():
-            schema = self._writer.register_schema(
-                spec.schema_name, "jsonschema", json.dumps(spec.schema).encode()
-            )
-            self._ids[spec.topic] = self._writer.register_channel(
-                spec.topic, "json", schema, {"description": spec.description}
+            self._ids[topic] = self._writer.register_channel(topic, "json", text, {})
+        views = [
+            (s.topic, s.schema_name, s.schema, s.description)
+            for s in channels(self._layout).values()
+        ]
+        for topic, name, schema, description in [*views, (LOG, "foxglove.Log", LOG_SCHEMA, "")]:
+            self._ids[topic] = self._writer.register_channel(
+                topic, "json", self._schema(name, schema), {"description": description}
             )
         for number, directive in enumerate(directives, start=2):
-            self._put(DIRECTIVES, f"@{directive}".encode(), 0, number)
+            self._put(DIRECTIVES, {"text": f"@{directive}"}, 0, number)
         return self._taken()
 
-    def _put(self, topic: str, data: bytes, ns: int, sequence: int = 0) -> None:
-        self._time = max(self._time, ns)  # the file's messages in time order
+    def _schema(self, name: str, schema: dict[str, Any]) -> int:
+        return int(self._writer.register_schema(name, "jsonschema", json.dumps(schema).encode()))
+
+    def _put(self, topic: str, body: dict[str, Any], ns: int, sequence: int = 0) -> None:
+        """A message at `ns` of the session's time (the file's in time order)."""
+        self._time = max(self._time, self.start_ns + ns)
         self._writer.add_message(
             self._ids[topic],
             log_time=self._time,
-            data=data,
+            data=json.dumps(body, ensure_ascii=False).encode(),
             publish_time=self._time,
             sequence=sequence & 0xFFFFFFFF,
         )
+        if self._time - self._flushed >= FLUSH * NS:
+            self._flushed = self._time
+            self._writer.flush()  # type: ignore[no-untyped-call]
+
+    def _raw(self, topic: str, data: bytes, ns: int, sequence: int = 0) -> None:
+        body = {"text": escape(data), "hex": data.hex(), "length": len(data)}
+        self._put(topic, body, ns, sequence)
 
     def line(self, time: float, raw: bytes, direction: str, text: bool, event: Any = None) -> bytes:
         """A unit as it happened (`text`: a UART2 unit shown as APP text), timed to the
         transcript's 0.1 ms, and its decoded views."""
         form = "as_text" if text and direction in UART2_DIRECTIONS else ""
-        self._put(RawChannel(direction, form).topic, raw, log_time(time))
+        self._raw(RawChannel(direction, form).topic, raw, log_time(time))
         if event is not None:
             self._views(time, direction, event)
         return self._taken()
@@ -187,42 +267,40 @@ class McapLines:
         return self._taken()
 
     def _views(self, time: float, direction: str, event: Any) -> None:
-        for topic, body in self._decoded.unit(time, direction, event):
-            self._put(topic, json.dumps(body).encode(), exact_time(time))
+        ns = exact_time(time)
+        wall = (self.start_ns + ns) / NS
+        for topic, body in self._decoded.unit(wall, direction, event):
+            self._put(topic, body, ns)
+        line = f"{direction} {escape(event.raw)}  {view(event, self._layout)[1]}"
+        stamp = {"sec": (self.start_ns + ns) // NS, "nsec": (self.start_ns + ns) % NS}
+        log = {"timestamp": stamp, "level": DEBUG, "message": line, "name": "appmode"}
+        self._put(LOG, {**log, "file": "", "line": 0}, ns)
 
     def comment(self, time: float, text: str, lineno: int = 0) -> bytes:
-        self._put(COMMENTS, text.encode(), log_time(time), lineno)
+        self._put(COMMENTS, {"text": text}, log_time(time), lineno)
         return self._taken()
 
     def item(self, item: Line, time: float) -> bytes:
         """A transcript's line, as it reads (an entry's bytes where they stand for its
         text, else its text: a `??` pattern); a comment or directive at `time`."""
         if isinstance(item, Comment):
-            self._put(COMMENTS, item.text.encode(), exact_time(time), item.lineno)
+            self._put(COMMENTS, {"text": item.text}, exact_time(time), item.lineno)
         elif isinstance(item, Directive):
             text = " ".join(("@" + item.name, *item.args))
-            self._put(DIRECTIVES, text.encode(), exact_time(time), item.lineno)
+            self._put(DIRECTIVES, {"text": text}, exact_time(time), item.lineno)
         else:
             form = _form(item)
-            data = item.text.encode() if form == "pattern" else item.data
             channel = RawChannel(item.direction, form)
-            self._put(channel.topic, data, exact_time(item.time), item.lineno)
+            if form == "pattern":
+                self._put(channel.topic, {"text": item.text}, exact_time(item.time), item.lineno)
+            else:
+                self._raw(channel.topic, item.data, exact_time(item.time), item.lineno)
         return self._taken()
 
     def finish(self) -> bytes:
-        """The file's end: its Data End record carries the CRC of all before it (the
-        writer leaves it 0 in a file it does not chunk), so a reader finds a flipped
-        byte."""
-        crc = self._sink.crc
+        """The last chunk, the file's indexes and summary, its end."""
         self._writer.finish()  # type: ignore[no-untyped-call]
-        data = bytearray(self._sink.take())
-        at = 0
-        while data[at] != Opcode.DATA_END:  # channels registered and not yet written
-            (length,) = struct.unpack_from("<Q", data, at + 1)
-            crc = zlib.crc32(data[at : at + 9 + length], crc)
-            at += 9 + length
-        struct.pack_into("<I", data, at + 9, crc)
-        return bytes(data)
+        return self._taken()
 
 
 def is_pattern(entry: Entry) -> bool:
@@ -240,152 +318,3 @@ def _form(entry: Entry) -> str:
             return ""
         return "as_text" if entry.text == uart2_payload(entry.data, True) else "pattern"
     return "" if entry.text == escape(entry.data) else "pattern"
-
-
-RECORD_LIMIT = 16 * 1024 * 1024
-"""Bytes one MCAP record (a chunk, compressed or not) may take: a reader's memory bound."""
-
-
-def read_items(
-    handle: BinaryIO,
-    name: str,
-    warn: Callable[[str], None],
-    whole: bool | None = None,
-    partial: bool = False,
-) -> Iterator[Line]:
-    """The transcript lines an MCAP file holds, in file order, in bounded memory: its
-    raw channels' messages as entries, its comments and directives; the decoded
-    channels are for viewers and skipped. TranscriptError (one line) if the file is no
-    appmode MCAP, is corrupt or cut short (a recording stopped by a full disk: with
-    `partial`, what it holds, and `warn` says it was cut). `whole`: whether the file ends as MCAP
-    files end (then a bad record is corruption), None if that could not be seen (a
-    pipe: a bad record at its end is taken for an end cut short)."""
-    topics: dict[int, str] = {}
-    last = 1  # the header's line
-    try:
-        for record in _records(handle):
-            if isinstance(record, Header) and record.profile != PROFILE:
-                said = f"profile {record.profile!r}" if record.profile else "no profile"
-                raise TranscriptError(
-                    f"{name}: an MCAP file of {_shown(said)}, not an appmode recording "
-                    "(appmode reads the files it writes: --record FILE.mcap, appmode convert)"
-                )
-            if isinstance(record, Channel):
-                topics[record.id] = record.topic
-            elif isinstance(record, Message):
-                topic = topics.get(record.channel_id)
-                if topic is None:
-                    raise TranscriptError(
-                        f"{name}: a message on channel {record.channel_id}, which no "
-                        "channel record declares: the file is corrupt"
-                    )
-                if topic in LINE_TOPICS:
-                    last = record.sequence if record.sequence > last else last + 1
-                    yield _item_of(topic, record, last, name)
-    except (McapError, struct.error, ValueError, KeyError) as exc:
-        if isinstance(exc, RecordLengthLimitExceeded):
-            whole = True  # no cut makes a record longer
-        if not whole and (whole is False or isinstance(exc, EndOfFile) or not handle.read(1)):
-            if not partial:
-                raise TranscriptError(
-                    f"{name}: the MCAP file is cut short (it has no end): appmode convert "
-                    f"--partial {name} OUT writes what it holds"
-                ) from None
-            warn(f"{name}: the MCAP file is cut short (it has no end): read what it holds")
-            return
-        raise TranscriptError(f"{name}: not a readable MCAP file ({_shown(str(exc))})") from None
-
-
-def _shown(text: str, limit: int = 100) -> str:
-    """Text from a file, fit for a message: one line of printable characters."""
-    text = "".join(c if c.isprintable() else "?" for c in text)
-    return text if len(text) <= limit else text[: limit - 1] + "…"
-
-
-class _Summed:
-    """A stream read through, keeping the CRC-32 of what was read since `mark`, but for
-    the last 4 bytes (a Footer's own CRC, when it was the last record read)."""
-
-    def __init__(self, handle: BinaryIO) -> None:
-        self._handle = handle
-        self._tail = b""
-        self.crc = 0
-
-    def read(self, size: int = -1) -> bytes:
-        data = self._handle.read(size)
-        both = self._tail + data
-        self.crc = zlib.crc32(both[:-4], self.crc)
-        self._tail = both[-4:]
-        return data
-
-    def mark(self) -> None:
-        self.crc, self._tail = 0, b""
-
-
-def _records(handle: BinaryIO) -> Iterator[object]:
-    """The file's records, chunks opened (each at most RECORD_LIMIT bytes, whatever its
-    header claims), their CRCs checked: the data section's, each chunk's, the
-    summary's."""
-    summed = _Summed(handle)
-    reader = StreamReader(
-        summed,  # type: ignore[arg-type]  # a stream: read
-        emit_chunks=True,
-        validate_crcs=True,
-        record_size_limit=RECORD_LIMIT,
-    )
-    for record in reader.records:
-        if isinstance(record, Chunk):
-            yield from breakup_chunk(_opened(record), validate_crc=True)
-            continue
-        if isinstance(record, DataEnd):
-            summed.mark()
-        elif isinstance(record, Footer) and record.summary_crc not in (0, summed.crc):
-            raise ValueError("the summary's CRC does not match: the file is corrupt")
-        yield record
-
-
-def _opened(chunk: Chunk) -> Chunk:
-    """`chunk` decompressed, in at most RECORD_LIMIT bytes."""
-    if chunk.uncompressed_size > RECORD_LIMIT:
-        raise ValueError(f"a chunk of {chunk.uncompressed_size:,} bytes")
-    if chunk.compression == "zstd":
-        import zstandard
-
-        data = zstandard.ZstdDecompressor().decompress(
-            chunk.data, max_output_size=chunk.uncompressed_size
-        )
-    elif chunk.compression == "lz4":
-        import lz4.frame
-
-        data = lz4.frame.LZ4FrameDecompressor().decompress(
-            chunk.data, max_length=chunk.uncompressed_size
-        )
-    elif chunk.compression:
-        raise ValueError(f"chunks compressed as {chunk.compression}")
-    else:
-        data = chunk.data
-    return replace(chunk, compression="", data=data)
-
-
-def _item_of(topic: str, message: Message, lineno: int, name: str) -> Line:
-    where = f"{name}:{lineno}"
-    if topic == COMMENTS:
-        return Comment(lineno, message.data.decode())
-    if topic == DIRECTIVES:
-        return parse_directive(message.data.decode(), lineno, where)
-    return entry_of(topic, message.data, message.log_time, lineno, where)
-
-
-def entry_of(topic: str, data: bytes, ns: int, lineno: int, where: str) -> Entry:
-    """The transcript line an MCAP raw message was; TranscriptError if it is no line."""
-    channel = BY_TOPIC[topic]
-    time = ns / NS
-    if channel.form == "pattern":
-        return parse_entry(f"{time} {channel.direction} {data.decode()}", lineno, where)
-    if channel.direction in CHASSIS_DIRECTIONS:
-        payload = data.hex(" ").upper()
-    elif channel.direction in UART2_DIRECTIONS:
-        payload = uart2_payload(data, channel.form == "as_text")
-    else:
-        payload = escape(data)
-    return Entry(lineno, time, channel.direction, data, payload)

@@ -70,6 +70,7 @@ DIRECTIVES = {
     "tolerance": "how early or late a '<' line may be matched, in seconds: @tolerance 0.3",
     "strict": "@strict on: every record must match the next '<' line (none ignored)",
     "align": "@align: time the '<' lines after the next one from when it is matched",
+    "recorded": "when the recording began (UTC): @recorded 2026-11-29T08:00:00.000000Z",
 }
 
 

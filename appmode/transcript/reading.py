@@ -73,7 +73,7 @@ def _items(
     directives_only: bool,
     partial: bool,
 ) -> Iterator[Line]:
-    form = read_as(handle.peek(MAGIC_SIZE)[:MAGIC_SIZE])
+    form = read_as(handle.peek(MAGIC_SIZE)[:MAGIC_SIZE], name)
     items = form.read(handle, name, warn, _ends_whole(handle, form), partial)
     if directives_only:
         return (item for item in items if isinstance(item, Directive))

@@ -19,35 +19,18 @@ import time
 from typing import Any
 
 from appmode.errors import AppmodeError
-from appmode.protocol.channels import RAW, channels
+from appmode.protocol.channels import RAW, RAW_SCHEMA, channels
 from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
-from appmode.protocol.reader import SENT_DIRECTIONS, PortsReader
+from appmode.protocol.reader import PortsReader
 from appmode.session.desk import Desk, Values
 
 QUEUE = 4096
 """Units and notes waiting for the worker at most (seconds of a flood: they are small)."""
 BACKLOG = 1024
 """Messages the SDK keeps for each viewer at most (the oldest are dropped)."""
-BYTES_SCHEMA = {
-    "type": "object",
-    "properties": {
-        "text": {"type": "string", "description": "the bytes as transcripts show them"},
-        "hex": {"type": "string"},
-        "length": {"type": "integer"},
-    },
-}
-IN_FORCE = "/session/in_force"
 LOG = "/log"
-IN_FORCE_SCHEMA = {
-    "type": "object",
-    "properties": {
-        "command": {"type": "string", "description": "the letter or frame in force"},
-        "text": {"type": "string"},
-        "moving": {"type": "boolean"},
-    },
-}
 
 
 class LiveView:
@@ -105,8 +88,7 @@ class LiveView:
         for spec in channels(layout).values():
             self._channel(spec.topic, spec.schema_name, spec.schema)
         for topic in RAW.values():
-            self._channel(topic, "appmode.bytes", BYTES_SCHEMA)
-        self._channel(IN_FORCE, "appmode.in_force", IN_FORCE_SCHEMA)
+            self._channel(topic, "appmode.bytes", RAW_SCHEMA)
         self._log = foxglove.channels.LogChannel(LOG, context=self._context)
         self._layout = layout
         self._queue: queue.Queue[tuple[Any, ...] | None] = queue.Queue(QUEUE)
@@ -172,19 +154,13 @@ class LiveView:
                     self._channels[topic].log(body, log_time=_ns(self.epoch + at))
 
     def _unit(self, when: float, direction: str, event: Any) -> None:
-        """A unit's bytes, its line in the log; a command that sets motion or stops it
-        on /session/in_force."""
+        """A unit's bytes, and its line in the log."""
         ns, raw = _ns(when), event.raw
         self._channels[RAW[direction]].log(
-            {"text": escape(raw), "hex": raw.hex(" "), "length": len(raw)}, log_time=ns
+            {"text": escape(raw), "hex": raw.hex(), "length": len(raw)}, log_time=ns
         )
         text = view(event, self._layout)[1]
         self._note(when, f"{direction} {escape(raw)}  {text}", level="Debug")
-        moves = _moves(event) if direction in SENT_DIRECTIONS else None
-        if moves is not None:
-            self._channels[IN_FORCE].log(
-                {"command": escape(raw), "text": text, "moving": moves}, log_time=ns
-            )
 
     def _note(self, when: float, text: str, level: str = "Info") -> None:
         fox = self._foxglove
@@ -213,20 +189,3 @@ def _quiet_sdk(handler: logging.Handler) -> None:
 
 def _ns(when: float) -> int:
     return round(when * 1e9)
-
-
-def _moves(event: Any) -> bool | None:
-    """Whether a command sets the car moving (True), stops it (False), or neither."""
-    from appmode.protocol import app, chassis, control
-
-    if isinstance(event, chassis.Command):
-        return not event.twist.still
-    if isinstance(event, app.Move):
-        return event.direction != 0
-    if isinstance(event, app.Stop):
-        return False
-    if isinstance(event, control.VelocityFrame | control.MotorFrame):
-        return any(event.values) and not (isinstance(event, control.VelocityFrame) and event.angle)
-    if isinstance(event, control.PositionFrame):
-        return any((event.x, event.y, event.z))
-    return None

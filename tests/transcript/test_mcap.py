@@ -61,7 +61,10 @@ def test_a_recording_named_mcap_is_mcap_with_decoded_channels(tmp_path: Path) ->
         assert {"/raw/app/sent", "/raw/app/received", "/app/A", "/pose", "/tf"} <= topics
         schema = next(json.loads(s.data) for s in summary.schemas.values() if s.name == "appmode.A")
         assert {"x", "y", "z"} <= set(schema["properties"])
-        sent = [m.data for _, c, m in reader.iter_messages(topics=["/raw/app/sent"])]
+        sent = [
+            bytes.fromhex(json.loads(m.data)["hex"])
+            for _, c, m in reader.iter_messages(topics=["/raw/app/sent"])
+        ]
         poses = [json.loads(m.data) for _, _, m in reader.iter_messages(topics=["/pose"])]
     assert b"A" in sent and sent[-1] == b"Z"
     assert poses[-1]["frame_id"] == "odom" and poses[-1]["pose"]["position"]["x"] > 0.1
@@ -114,12 +117,13 @@ def test_a_corrupt_mcap_is_one_line(recording: Path, tmp_path: Path) -> None:
         assert line.startswith(f"appmode: error: {bad}"), line
 
 
-def test_a_cut_mcap_says_so_and_partial_keeps_what_it_holds(
-    recording: Path, tmp_path: Path
-) -> None:
+def test_a_cut_mcap_says_so_and_partial_keeps_what_it_holds(tmp_path: Path) -> None:
+    recording = tmp_path / "rec.mcap"  # 3 s of records: a chunk a second
+    done = run("record", "sim://", str(recording), "--count", "60")
+    assert done.returncode == 0, done.stderr
     cut = tmp_path / "cut.mcap"
     whole = recording.read_bytes()
-    cut.write_bytes(whole[: len(whole) * 2 // 3])
+    cut.write_bytes(whole[: len(whole) // 3])  # within the chunks: the summary is after
     line = one_line_error("dump", str(cut))
     assert "cut short" in line and "--partial" in line
     out = tmp_path / "kept.transcript"
@@ -177,3 +181,81 @@ def test_convert_refuses_to_write_over_its_input(recording: Path) -> None:
     line = one_line_error("convert", str(recording), str(recording))
     assert "is the file being read" in line
     assert recording.read_bytes() == before
+
+
+def test_a_recording_is_indexed_wall_clocked_and_every_channel_has_a_schema(
+    tmp_path: Path,
+) -> None:
+    """Issue 78.3: what an indexed reader (a seeking one, from the summary) reads is every
+    message; log times are the wall clock; /log and /session/in_force are there."""
+    import time
+
+    from mcap.reader import SeekingReader
+    from mcap.stream_reader import StreamReader
+
+    path = tmp_path / "drive.mcap"
+    before = time.time()
+    done = run("drive", "sim://", "--record", str(path), stdin=b"drive A\nwait 0.6\nstop\n")
+    assert done.returncode == 0, done.stderr
+    with path.open("rb") as handle:
+        streamed = sum(1 for r in StreamReader(handle).records if type(r).__name__ == "Message")
+    with path.open("rb") as handle:
+        reader = SeekingReader(handle)
+        summary = reader.get_summary()
+        assert summary is not None and summary.chunk_indexes  # chunked and indexed
+        assert {c.compression for c in summary.chunk_indexes} == {"zstd"}
+        indexed = list(reader.iter_messages())
+        metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+    assert len(indexed) == streamed > 50
+    assert all(c.schema_id != 0 for c in summary.channels.values())  # every one decodes
+    assert {c.message_encoding for c in summary.channels.values()} == {"json"}
+    times = [m.log_time / 1e9 for _, _, m in indexed]
+    assert before - 1 <= min(times) and max(times) <= time.time() + 1
+    start = int(metadata["appmode"]["start_ns"]) / 1e9
+    assert before - 1 <= start <= min(times)
+    topics = {c.topic for _, c, _ in indexed}
+    assert {"/log", "/session/in_force"} <= topics
+    in_force = [json.loads(m.data) for _, c, m in indexed if c.topic == "/session/in_force"]
+    assert in_force[0]["command"] == "A" and not in_force[-1]["moving"]
+    # its transcript keeps its own clock, and the date in a directive; back, the same times
+    back, again = tmp_path / "back.transcript", tmp_path / "again.mcap"
+    run_convert(str(path), str(back), None, False)
+    text = back.read_text()
+    assert "\n@recorded 20" in text and "\n0.0" in text
+    run_convert(str(back), str(again), None, False)
+    with again.open("rb") as handle:
+        times_again = [m.log_time / 1e9 for _, _, m in SeekingReader(handle).iter_messages()]
+    raw = [t for t, (_, c, _) in zip(times, indexed, strict=True) if c.topic.startswith("/raw/")]
+    assert set(raw) <= set(times_again)
+
+
+@pytest.mark.parametrize("data", [b"", b"\x89MCAP", b"\x89MCAP0\r\n\x01"], ids=len)
+def test_an_empty_or_headless_mcap_is_one_line_and_exit_2(data: bytes, tmp_path: Path) -> None:
+    path = tmp_path / "empty.mcap"
+    path.write_bytes(data)
+    done = run("dump", str(path))
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert (
+        done.stderr.strip() == f"appmode: error: {path}: an empty or broken MCAP file (no "
+        "whole header): nothing to read"
+    )
+
+
+def _one_channel(path: Path, encoding: str, data: bytes) -> None:
+    with path.open("wb") as handle:
+        writer = Writer(handle, compression=CompressionType.NONE)
+        writer.start(profile="appmode", library="another writer")
+        channel = writer.register_channel("/raw/app/sent", encoding, 0)
+        writer.add_message(channel, log_time=10**9, data=data, publish_time=10**9, sequence=2)
+        writer.finish()
+
+
+def test_the_reader_honours_each_channels_encoding(tmp_path: Path) -> None:
+    path = tmp_path / "live.mcap"
+    _one_channel(path, "json", b'{"text": "A", "hex": "41", "length": 1}')
+    assert [(e.time, e.data) for e in read_transcript(path).entries] == [(1.0, b"A")]
+    _one_channel(path, "cbor", b"\xa1")
+    line = one_line_error("dump", str(path))
+    assert "/raw/app/sent is encoded as 'cbor', not as appmode writes it (json)" in line
+    _one_channel(path, "json", b"A")
+    assert "not appmode's JSON" in one_line_error("dump", str(path))

@@ -11,7 +11,7 @@ from typing import Any
 
 from appmode.protocol.channels import channels
 from appmode.protocol.layouts import VELOCITY
-from appmode.viewers.live import IN_FORCE, IN_FORCE_SCHEMA, LOG
+from appmode.viewers.live import LOG
 
 LAYOUT = Path(__file__).resolve().parents[2] / "docs" / "foxglove" / "appmode-layout.json"
 
@@ -25,7 +25,6 @@ def placed(node: Any) -> set[str]:
 def test_every_path_is_a_field_appmode_serves() -> None:
     layout = json.loads(LAYOUT.read_text())
     schemas = {topic: spec.schema for topic, spec in channels(VELOCITY).items()}
-    schemas[IN_FORCE] = IN_FORCE_SCHEMA
     paths = [
         path["value"]
         for config in layout["configById"].values()
