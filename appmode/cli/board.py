@@ -203,7 +203,8 @@ def run(args: argparse.Namespace) -> int:
         quiet=args.quiet,
         baud=args.baud,
     )
-    with live_view(args.foxglove, options.profile.a_layout) as view:
+    drive = options.drive or (None if args.flash else DriveType.OMNI)  # else: the flash says
+    with live_view(args.foxglove, options.profile.a_layout, drive_type=drive) as view:
         if view is not None:
             view.epoch = time.time()  # the board's clock starts now
         return run_board(options, view)

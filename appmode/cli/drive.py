@@ -121,7 +121,9 @@ def run(args: argparse.Namespace) -> int:
     interactive = sys.stdin.isatty() and sys.stdout.isatty()
     driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
     on_message = None if interactive else _print_message
-    with live_view(args.foxglove, choice.profile.a_layout, args.foxglove_drive) as view:
+    with live_view(
+        args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
+    ) as view:
         session = open_session(choice, driving, on_message, args.record)
         attach(view, session)
         script = command_lines(sys.stdin, MAX_COMMAND)

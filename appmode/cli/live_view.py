@@ -10,6 +10,7 @@ from contextlib import contextmanager
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:
     from appmode.protocol.layouts import Layout
+    from appmode.protocol.params import DriveType
     from appmode.session.base import BaseSession
     from appmode.viewers.live import LiveView
 
@@ -39,10 +40,13 @@ def add_foxglove(
 
 
 @contextmanager
-def live_view(spec: str | None, layout: Layout, drive: bool = False) -> Iterator[LiveView | None]:
+def live_view(
+    spec: str | None, layout: Layout, drive: bool = False, drive_type: DriveType | None = None
+) -> Iterator[LiveView | None]:
     """The live view `--foxglove` asks for (None if not asked), its address said on
     stderr; stopped on the way out, after what it was fed is logged. With `drive`, its
-    viewers may drive and tune the car (`attach` gives them the session)."""
+    viewers may drive and tune the car (`attach` gives them the session); `drive_type`
+    signs the A records' magnitudes by the control port's frames (the pose)."""
     from appmode.errors import AppmodeError
 
     if spec is None:
@@ -61,7 +65,7 @@ def live_view(spec: str | None, layout: Layout, drive: bool = False) -> Iterator
             f"token): serve on a loopback address (--foxglove {port}), and from another "
             f"machine reach it through SSH (ssh -L {port}:localhost:{port} THIS-MACHINE)"
         )
-    view = LiveView(host, port, layout, drive=drive)
+    view = LiveView(host, port, layout, drive=drive, drive_type=drive_type)
     print(
         f"foxglove: {view.url} (in Foxglove or Lichtblick: Open connection → Foxglove WebSocket)",
         file=sys.stderr,

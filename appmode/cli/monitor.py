@@ -149,7 +149,9 @@ def run_monitor(
     from appmode.cli.live_view import live_view
 
     with ExitStack() as stack:
-        view = stack.enter_context(live_view(foxglove, choice.profile.a_layout))
+        view = stack.enter_context(
+            live_view(foxglove, choice.profile.a_layout, drive_type=choice.known_drive)
+        )
         host = open_host(stack, choice, record, stop_on_close=stop_on_exit, view=view)
         url = choice.target
         doing = f"recording {url} to {record}" if out is None else f"monitoring {url}"

@@ -29,6 +29,13 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     name = show.add_argument("name", metavar="NAME|PATH", help="a shipped profile or a file")
     name.completer = profiles_offered  # type: ignore[attr-defined]  # argcomplete's
     show.add_argument("--toml", action="store_true", help="print its file as it is")
+    layout = actions.add_parser(
+        "layout",
+        help="a Foxglove layout for one profile (JSON: in Foxglove or Lichtblick, Layouts → "
+        "Import from file)",
+    )
+    named = layout.add_argument("name", metavar="NAME|PATH", help="a shipped profile or a file")
+    named.completer = profiles_offered  # type: ignore[attr-defined]  # argcomplete's
     check = actions.add_parser("check", help="check a profile file: one line a mistake")
     path = check.add_argument("path", metavar="FILE", help="the profile file (TOML)")
     path.completer = profiles_offered  # type: ignore[attr-defined]  # argcomplete's
@@ -51,6 +58,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.path}: profile {profile.name}: {fields} record fields, "
               f"{len(profile.params)} parameters: fine")  # fmt: skip
         return 0
+    if args.action == "layout":
+        return _layout(args.name)
     try:
         profile = load(args.name)
     except ProfileError as exc:
@@ -60,6 +69,18 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write(profile.text)
         return 0
     sys.stdout.write(shown(profile))
+    return 0
+
+
+def _layout(name: str) -> int:
+    """The Foxglove layout of profile `name`, as JSON on stdout."""
+    import json
+
+    from appmode.board.profiles import profile_named
+    from appmode.viewers.layout import foxglove_layout
+
+    made = foxglove_layout(profile_named(name).a_layout)
+    sys.stdout.write(json.dumps(made, indent=2, ensure_ascii=False) + "\n")
     return 0
 
 

@@ -156,7 +156,9 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
         choice = board_choice(args, both=True)  # a sim:// board's records give odom
         timeout = args.cmd_vel_timeout
         view = stack.enter_context(
-            live_view(args.foxglove, choice.profile.a_layout, args.foxglove_drive)
+            live_view(
+                args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
+            )
         )
         session = open_car(choice, HoldToDrive(first_timeout=timeout, repeat_timeout=timeout))
         session.lease, session.lease_source = timeout, "cmd_vel"

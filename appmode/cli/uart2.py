@@ -202,7 +202,9 @@ def run_monitor(
     live to Foxglove on `foxglove` ([HOST:]PORT)."""
     seen = errors = bursts = 0
     with ExitStack() as stack:
-        view = stack.enter_context(live_view(foxglove, choice.profile.a_layout))
+        view = stack.enter_context(
+            live_view(foxglove, choice.profile.a_layout, drive_type=choice.known_drive)
+        )
         host = open_control_host(stack, choice, record, stop_on_exit, view)
         print(f"monitoring {host.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
         host.watch = Shown(host, out, as_json)

@@ -93,7 +93,9 @@ def run(args: argparse.Namespace) -> int:
     if args.connect or args.fleet_key is not None:
         raise AppmodeError("--connect and --fleet-key go with --fleet")
     choice = board_choice(args)
-    with live_view(args.foxglove, choice.profile.a_layout, args.foxglove_drive) as view:
+    with live_view(
+        args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
+    ) as view:
         session = open_session(choice, driving(), record=args.record)
         attach(view, session)
         return serve_web(session, host, port, tls, tuple(addresses), fingerprint)

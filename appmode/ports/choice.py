@@ -34,6 +34,14 @@ class BoardChoice:
     """Driven over a WHEELTEC board's chassis port (`7B … 7D` frames), alone."""
 
     @property
+    def known_drive(self) -> DriveType | None:
+        """The drive type known before the board is read: given, fixed by the profile, or
+        the simulated board's (omni unless its URL says); None for a board to be read."""
+        if self.drive is not None or not self.target.simulated:
+            return self.drive
+        return DriveType.from_cli_name(self.target.sim_drive or "omni")
+
+    @property
     def port(self) -> str:
         """The port driven, by name (`app`, `uart2`, `chassis`): the key of a command's
         table of what it does on each port."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import threading
+from collections import deque
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -18,6 +19,7 @@ from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import Layout
 from appmode.protocol.odometry import Odometry, Pose2D
+from appmode.protocol.params import DriveType
 from appmode.protocol.reader import (
     RECEIVED,
     RECEIVED2,
@@ -26,8 +28,10 @@ from appmode.protocol.reader import (
     SENT2,
     SENT_CHASSIS,
 )
-from appmode.protocol.twist import Twist
+from appmode.protocol.sensed import Sensing, signs_in_force, yaw_rate
 
+YAWS = 64
+"""B records' yaws kept for a turn rate (a YAW_WINDOW's worth, and more)."""
 POSE_FRAME = "odom"
 """The frame the dead-reckoned pose is in (its origin: where the session began)."""
 BASE_FRAME = "base_link"
@@ -155,14 +159,17 @@ def channels(layout: Layout) -> dict[str, ChannelSpec]:
 
 
 class Decoded:
-    """Decoded units, in `layout`'s terms, as (topic, JSON message) pairs."""
+    """Decoded units, in `layout`'s terms, as (topic, JSON message) pairs; the pose from
+    each A record that says the car's twist (`protocol.sensed`: magnitudes signed by the
+    control port's frame in force, where `drive` says how; a turn from the yaw)."""
 
-    def __init__(self, layout: Layout) -> None:
+    def __init__(self, layout: Layout, drive: DriveType | None = None) -> None:
         self.layout = layout
         self.odometry = Odometry()
-        self.si = layout.profile.velocity_si
-        motion = {f.name: f for f in layout.a_fields}
-        self._dead_reckons = all(k in motion and motion[k].signed for k in ("x", "y", "z"))
+        self._sensing = Sensing(layout)
+        self._drive = drive
+        self._signs: tuple[float, float, float] | None = None  # until a frame says
+        self._yaws: deque[tuple[float, float]] = deque(maxlen=YAWS)
 
     def unit(self, time: float, direction: str, event: Any) -> list[tuple[str, dict[str, Any]]]:
         """The messages one decoded unit makes (`time`: seconds, the session's)."""
@@ -181,6 +188,8 @@ class Decoded:
         if direction == SENT:
             return [("/app/commands", body)]
         if direction == SENT2:
+            if isinstance(event, control.VelocityFrame | control.MotorFrame):
+                self._signs = signs_in_force(event, self._drive)
             return [("/uart2/commands", body)]
         if direction == RECEIVED2:
             encoders = isinstance(event, control.EncoderReport)
@@ -191,8 +200,12 @@ class Decoded:
         if letter not in "ABC":
             return [("/app/other", body)]
         found = [(f"/app/{letter}", self._scaled(letter, values, event.raw))]
-        if letter == "A" and self._dead_reckons:
-            pose = self._pose(time, values)
+        if letter == "B" and self._sensing.yaw is not None:
+            self._yaws.append((time, values[self._sensing.yaw]))
+        rate = yaw_rate(self._yaws, time) if self._sensing.turn_from_yaw else None
+        twist = self._sensing.twist(values, self._signs, rate) if letter == "A" else None
+        if twist is not None:
+            pose = self.odometry.step(time, twist)
             found += [("/pose", pose_message(pose, time)), ("/tf", transform(pose, time))]
         return found
 
@@ -226,11 +239,6 @@ class Decoded:
         }
         body["raw"] = raw.decode("latin-1")
         return body
-
-    def _pose(self, time: float, values: tuple[int, ...]) -> Pose2D:
-        by_name = {f.name: v / f.scale for f, v in zip(self.layout.a_fields, values, strict=False)}
-        twist = Twist.from_units(by_name["x"], by_name["y"], by_name["z"], self.si)
-        return self.odometry.step(time, twist)
 
 
 def _moves(event: Any) -> bool | None:

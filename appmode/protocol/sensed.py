@@ -14,7 +14,9 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from appmode.protocol import control
 from appmode.protocol.layouts import Layout
+from appmode.protocol.params import DriveType
 from appmode.protocol.profile_file import Field
 from appmode.protocol.twist import Twist
 
@@ -76,6 +78,31 @@ class Sensing:
                 value = math.copysign(abs(value), signs[axis]) if signs[axis] else 0.0
             units.append(value)
         return Twist.from_units(units[0], units[1], units[2], self.si)
+
+
+Frame = control.VelocityFrame | control.MotorFrame | control.PositionFrame
+
+
+def signs_in_force(
+    frame: Frame | None, drive: DriveType | None
+) -> tuple[float, float, float] | None:
+    """The signs (−1, 0, 1) of x, y and z that the frame in force drives (None: not
+    known: the drive type is not, or the frame is no velocity frame)."""
+    if frame is None:
+        return (0.0, 0.0, 0.0)
+    if drive is None or not isinstance(frame, control.VelocityFrame):
+        return None
+    a, b, c = frame.values
+    if drive is DriveType.DIFF_GYRO:  # left and right duties
+        b, c = a + b, a - b
+        a = 0
+    elif drive.differential:  # reserved, y, z
+        a = 0
+    return (_sign(a), _sign(b), 0.0 if frame.angle else _sign(c))
+
+
+def _sign(value: int) -> float:
+    return float((value > 0) - (value < 0))
 
 
 def yaw_rate(points: Sequence[tuple[float, float]], at: float) -> float | None:

@@ -23,6 +23,7 @@ from appmode.protocol.channels import RAW, RAW_SCHEMA, channels
 from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
+from appmode.protocol.params import DriveType
 from appmode.protocol.reader import PortsReader
 from appmode.session.desk import Desk, Values
 
@@ -45,6 +46,7 @@ class LiveView:
         layout: Layout = VELOCITY,
         name: str = "appmode",
         drive: bool = False,
+        drive_type: DriveType | None = None,
     ) -> None:
         try:
             import foxglove
@@ -91,6 +93,7 @@ class LiveView:
             self._channel(topic, "appmode.bytes", RAW_SCHEMA)
         self._log = foxglove.channels.LogChannel(LOG, context=self._context)
         self._layout = layout
+        self._drive_type = drive_type
         self._queue: queue.Queue[tuple[Any, ...] | None] = queue.Queue(QUEUE)
         self._thread = threading.Thread(target=self._run, name="foxglove", daemon=True)
         self._thread.start()
@@ -142,7 +145,7 @@ class LiveView:
         from appmode.protocol.channels import Decoded
 
         reader = PortsReader(layout=self._layout)
-        decoded = Decoded(self._layout)
+        decoded = Decoded(self._layout, self._drive_type)
         while (item := self._queue.get()) is not None:
             if item[0] == "note":
                 self._note(item[1], item[2])

@@ -220,3 +220,28 @@ def test_replay_needs_somewhere_to_play() -> None:
         cwd=ROOT,
     )
     assert done.returncode != 0 and "--to URL" in done.stderr
+
+
+def test_a_board_whose_records_are_magnitudes_shows_the_pose_its_frames_sign() -> None:
+    """Issue 78.4: minibalance's A record carries |0.7·x| and |0.7·y|; the control port's
+    frame in force signs them, and the yaw gives the turn: the board's view has a pose."""
+    with serving("board", "--profile", "minibalance") as (board, url):
+        assert board.stdout is not None
+        ports = dict(board.stdout.readline().strip().split(": ", 1) for _ in range(2))
+        seen: list[Seen] = []
+        watcher = threading.Thread(target=lambda: seen.append(watch_sync(url, 5)))
+        watcher.start()
+        time.sleep(0.5)
+        script = "wait 0.5\ntwist 0.2 0 0\nwait 1.5\nstop\nwait 0.3\n"
+        done = subprocess.run(
+            appmode_cmd("drive", ports["uart2"], "--uart2", "--profile", "minibalance"),
+            input=script,
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+        )
+        watcher.join()
+    assert done.returncode == 0, done.stderr
+    poses = seen[0].json_on("/pose")
+    assert len(poses) > 10
+    assert poses[-1]["pose"]["position"]["x"] > 0.15  # forward, from magnitudes signed

@@ -24,6 +24,7 @@ from appmode.ports.choice import BoardChoice
 from appmode.protocol import control, params, settings
 from appmode.protocol.directions import MOTIONS, Motion
 from appmode.protocol.params import DriveType
+from appmode.protocol.sensed import signs_in_force
 from appmode.protocol.twist import Twist
 from appmode.session.control.commands import COMMANDS, KEYS, KEYS_HELP, SETTING_NAMES
 from appmode.session.control.motion import velocity_for
@@ -34,7 +35,7 @@ from appmode.session.control.status import (
     control_lit,
     control_rows,
 )
-from appmode.session.control.velocity import frame_fields, signs_in_force
+from appmode.session.control.velocity import frame_fields
 from appmode.session.hold import HoldToDrive
 from appmode.session.instruments import Instruments
 from appmode.session.motion_grid import MotionGridSession

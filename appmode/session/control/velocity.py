@@ -32,28 +32,3 @@ def frame_fields(
 def _within(value: float, limit: int) -> int:
     """`value` rounded, within ±limit (clamped first: no number is too large to round)."""
     return round(max(-limit, min(limit, value)))
-
-
-Frame = control.VelocityFrame | control.MotorFrame | control.PositionFrame
-
-
-def signs_in_force(
-    frame: Frame | None, drive: DriveType | None
-) -> tuple[float, float, float] | None:
-    """The signs (−1, 0, 1) of x, y and z that the frame in force drives (None: not
-    known: the drive type is not, or the frame is no velocity frame)."""
-    if frame is None:
-        return (0.0, 0.0, 0.0)
-    if drive is None or not isinstance(frame, control.VelocityFrame):
-        return None
-    a, b, c = frame.values
-    if drive is DriveType.DIFF_GYRO:  # left and right duties
-        b, c = a + b, a - b
-        a = 0
-    elif drive.differential:  # reserved, y, z
-        a = 0
-    return (_sign(a), _sign(b), 0.0 if frame.angle else _sign(c))
-
-
-def _sign(value: int) -> float:
-    return float((value > 0) - (value < 0))
