@@ -175,10 +175,13 @@ def written_as(name: str) -> Format:
 
 def read_as(first: bytes, name: str = "") -> Format:
     """The format of a file named `name` that begins with `first` (MAGIC_SIZE bytes, or
-    fewer): the one whose magic it begins with, or with part of (a file cut short);
-    an empty file's, by its name's suffix; else a transcript."""
+    fewer): the one its name's suffix says (a `.mcap` file is read as MCAP, whatever its
+    first bytes), else the one whose magic it begins with, or with part of (a file cut
+    short); else a transcript."""
+    suffixed = WRITERS.get("." + name.rpartition(".")[2].lower()) if "." in name else None
+    if suffixed is not None and suffixed is not TEXT:
+        return suffixed
     for magic, form in READERS.items():
         if first.startswith(magic) or (first and magic.startswith(first)):
             return form
-    suffixed = WRITERS.get("." + name.rpartition(".")[2].lower()) if "." in name else None
-    return suffixed if not first and suffixed is not None else TEXT
+    return TEXT

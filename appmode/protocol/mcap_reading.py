@@ -165,23 +165,35 @@ def _opened(chunk: Chunk) -> Chunk:
     """`chunk` decompressed, in at most RECORD_LIMIT bytes."""
     if chunk.uncompressed_size > RECORD_LIMIT:
         raise ValueError(f"a chunk of {chunk.uncompressed_size:,} bytes")
+    if chunk.compression and chunk.compression not in ("zstd", "lz4"):
+        raise ValueError(f"chunks compressed as {chunk.compression}")
+    try:
+        data = _decompressed(chunk)
+    except Exception as exc:  # each library raises its own: a corrupt chunk, whatever it says
+        if isinstance(exc, ImportError):
+            raise
+        raise ValueError(f"a {chunk.compression} chunk that does not decompress") from None
+    return replace(chunk, compression="", data=data)
+
+
+def _decompressed(chunk: Chunk) -> bytes:
     if chunk.compression == "zstd":
         import zstandard
 
-        data = zstandard.ZstdDecompressor().decompress(
-            chunk.data, max_output_size=chunk.uncompressed_size
+        return bytes(
+            zstandard.ZstdDecompressor().decompress(
+                chunk.data, max_output_size=chunk.uncompressed_size
+            )
         )
-    elif chunk.compression == "lz4":
+    if chunk.compression == "lz4":
         import lz4.frame
 
-        data = lz4.frame.LZ4FrameDecompressor().decompress(
-            chunk.data, max_length=chunk.uncompressed_size
+        return bytes(
+            lz4.frame.LZ4FrameDecompressor().decompress(
+                chunk.data, max_length=chunk.uncompressed_size
+            )
         )
-    elif chunk.compression:
-        raise ValueError(f"chunks compressed as {chunk.compression}")
-    else:
-        data = chunk.data
-    return replace(chunk, compression="", data=data)
+    return chunk.data
 
 
 def _item_of(channel: Channel, message: Message, ns: int, lineno: int, name: str) -> Line:

@@ -394,3 +394,44 @@ def test_a_test_process_killed_outright_leaves_no_console_behind() -> None:
     while subprocess.run(alive, capture_output=True, check=False).returncode == 0:
         assert time.monotonic() < end, "the killed test's tmux session still runs"
         time.sleep(0.1)
+
+
+def test_the_viewers_server_never_writes_over_the_console() -> None:
+    """Issue 78.5: 20 malformed messages and a viewer killed mid-connection: the SDK's
+    complaints are the session's messages, one of a kind, and the screen stays whole."""
+    pytest.importorskip("foxglove", reason="the foxglove extra is not installed")
+    import asyncio
+    import socket
+
+    from tests.support.foxglove_client import Driver
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+
+    async def garbage() -> None:
+        driver = await Driver.open(f"ws://127.0.0.1:{port}")
+        await driver.advertise(1)
+        for number in range(20):
+            await driver.send({"op": f"bogus{number}"})
+            await driver.publish(1, b"\xff not json")
+        assert driver.ws.transport is not None
+        driver.ws.transport.abort()
+
+    with board_process() as board:
+        command = appmode_in_tmux(f"drive {board.url} --foxglove {port} --foxglove-drive")
+        tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
+        try:
+            wait_screen(r"params\s+max_speed")
+            asyncio.run(garbage())
+            wait_screen(r"foxglove: Error receiving from client")
+            time.sleep(1.0)
+            lines = screen().splitlines()
+            assert lines[0].startswith(" appmode drive"), lines[:3]  # the frame is whole
+            assert any("q H ↖ front-left" in line for line in lines)
+            server = [line for line in lines if re.search("Invalid message|Error receiving", line)]
+            assert len(server) == 2 and all(line.startswith("foxglove: ") for line in server)
+            assert sum("a /cmd_vel message was ignored" in line for line in lines) == 1
+            tmux("send-keys", "-t", SESSION, "C-q")
+        finally:
+            subprocess.run([*TMUX, "kill-session", "-t", SESSION], capture_output=True, check=False)

@@ -259,3 +259,23 @@ def test_the_reader_honours_each_channels_encoding(tmp_path: Path) -> None:
     assert "/raw/app/sent is encoded as 'cbor', not as appmode writes it (json)" in line
     _one_channel(path, "json", b"A")
     assert "not appmode's JSON" in one_line_error("dump", str(path))
+
+
+def test_no_corrupt_byte_makes_an_unclear_message(recording: Path, tmp_path: Path) -> None:
+    """Issue 78.3: a byte flipped anywhere is one line that names the file and says what
+    is wrong, never a bare "()" or a struct module's words, and never a traceback."""
+    data = recording.read_bytes()
+    bad = tmp_path / "bad.mcap"
+    said: set[str] = set()
+    for offset in range(0, len(data), max(1, len(data) // 150)):
+        flipped = bytearray(data)
+        flipped[offset] ^= 0x5A
+        bad.write_bytes(bytes(flipped))
+        try:
+            list(iter_lines(bad, lambda text: None))
+        except TranscriptError as exc:
+            text = str(exc)
+            assert text.startswith(f"{bad}: ") and "\n" not in text, text
+            assert "()" not in text and "unpack requires" not in text, text
+            said.add(text.split(": ", 1)[1][:40])
+    assert said  # the CRCs catch flips: some of them are refused
