@@ -403,27 +403,18 @@ def test_the_viewers_server_never_writes_over_the_console() -> None:
     import asyncio
     import socket
 
-    from tests.support.foxglove_client import Driver
+    from tests.support.foxglove_client import malformed
 
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-
-    async def garbage() -> None:
-        driver = await Driver.open(f"ws://127.0.0.1:{port}")
-        await driver.advertise(1)
-        for number in range(20):
-            await driver.send({"op": f"bogus{number}"})
-            await driver.publish(1, b"\xff not json")
-        assert driver.ws.transport is not None
-        driver.ws.transport.abort()
 
     with board_process() as board:
         command = appmode_in_tmux(f"drive {board.url} --foxglove {port} --foxglove-drive")
         tmux("new-session", "-d", "-s", SESSION, "-x", "140", "-y", "40", command)
         try:
             wait_screen(r"params\s+max_speed")
-            asyncio.run(garbage())
+            asyncio.run(malformed(f"ws://127.0.0.1:{port}"))
             wait_screen(r"foxglove: Error receiving from client")
             time.sleep(1.0)
             lines = screen().splitlines()

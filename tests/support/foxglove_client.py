@@ -6,13 +6,20 @@ from __future__ import annotations
 
 import asyncio
 import json
+import re
 import struct
+import subprocess
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
 import websockets
 from websockets.typing import Subprotocol
+
+from tests.support.processes import ROOT, appmode_cmd
 
 SUBPROTOCOLS = [Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1")]
 MESSAGE_DATA = 0x01
@@ -148,3 +155,49 @@ class Driver:
     async def close(self) -> None:
         await self.ws.close()
         await self._reader
+
+
+@contextmanager
+def serving(*args: str, stdin: str | None = None) -> Iterator[tuple[subprocess.Popen[str], str]]:
+    """`appmode ARGS --foxglove 0`, and the ws:// URL it says; `stdin` fed after 0.3 s."""
+    proc = subprocess.Popen(
+        appmode_cmd(*args, "--foxglove", "0"),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert proc.stderr is not None and proc.stdin is not None
+        said = ""
+        while (line := proc.stderr.readline()) and "ws://" not in line:
+            said += line
+        found = re.search(r"ws://\S+", line)
+        assert found, said
+        if stdin is not None:
+            writer = proc.stdin
+
+            def feed() -> None:
+                time.sleep(0.3)
+                writer.write(stdin)
+                writer.close()
+
+            threading.Thread(target=feed, daemon=True).start()
+        yield proc, found.group(0)
+    finally:
+        if proc.poll() is None:
+            proc.terminate()
+        proc.wait(15)
+
+
+async def malformed(url: str, count: int = 20) -> None:
+    """A viewer that sends `count` unknown ops and non-JSON twists, then is killed (its
+    connection dropped without a close)."""
+    driver = await Driver.open(url)
+    await driver.advertise(1)
+    for number in range(count):
+        await driver.send({"op": f"bogus{number}"})
+        await driver.publish(1, b"\xff not json")
+    assert driver.ws.transport is not None
+    driver.ws.transport.abort()

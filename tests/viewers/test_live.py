@@ -13,8 +13,6 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -23,44 +21,10 @@ pytest.importorskip("foxglove", reason="the foxglove extra is not installed")
 pytest.importorskip("websockets", reason="the test extra (websockets) is not installed")
 
 from appmode.transcript.reading import read_transcript
-from tests.support.foxglove_client import Seen, watch_sync
+from tests.support.foxglove_client import Seen, serving, watch_sync
 from tests.support.processes import ROOT, appmode_cmd, board_process, timed_sent
 
 SCRIPT = "wait 0.6\ndrive A\nwait 1\nstop\nwait 0.3\n"
-
-
-@contextmanager
-def serving(*args: str, stdin: str | None = None) -> Iterator[tuple[subprocess.Popen[str], str]]:
-    """`appmode ARGS --foxglove 0`, and the ws:// URL it says; `stdin` fed after 0.3 s."""
-    proc = subprocess.Popen(
-        appmode_cmd(*args, "--foxglove", "0"),
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    try:
-        assert proc.stderr is not None and proc.stdin is not None
-        said = ""
-        while (line := proc.stderr.readline()) and "ws://" not in line:
-            said += line
-        found = re.search(r"ws://\S+", line)
-        assert found, said
-        if stdin is not None:
-            writer = proc.stdin
-
-            def feed() -> None:
-                time.sleep(0.3)
-                writer.write(stdin)
-                writer.close()
-
-            threading.Thread(target=feed, daemon=True).start()
-        yield proc, found.group(0)
-    finally:
-        if proc.poll() is None:
-            proc.terminate()
-        proc.wait(10)
 
 
 def test_drive_serves_the_session_with_schemas_the_command_in_force_and_the_pose() -> None:

@@ -9,8 +9,7 @@ import asyncio
 import re
 import subprocess
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any
 
@@ -19,40 +18,18 @@ import pytest
 pytest.importorskip("foxglove", reason="the foxglove extra is not installed")
 pytest.importorskip("websockets", reason="the test extra (websockets) is not installed")
 
-from tests.support.foxglove_client import Driver
-from tests.support.processes import ROOT, appmode_cmd, board_process, run, timed_sent
+from tests.support.foxglove_client import Driver, malformed, serving
+from tests.support.processes import board_process, run, timed_sent
 
 TWIST_LAPSE = 0.5
 
 
-@contextmanager
 def driving(
     url: str, *extra: str, seconds: float = 8
-) -> Iterator[tuple[subprocess.Popen[str], str]]:
+) -> AbstractContextManager[tuple[subprocess.Popen[str], str]]:
     """`appmode drive URL --foxglove 0 --foxglove-drive` in script mode for `seconds`, and
     the ws:// URL it says."""
-    proc = subprocess.Popen(
-        appmode_cmd("drive", url, "--foxglove", "0", "--foxglove-drive", *extra),
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    try:
-        assert proc.stderr is not None and proc.stdin is not None
-        said = ""
-        while (line := proc.stderr.readline()) and "ws://" not in line:
-            said += line
-        found = re.search(r"ws://\S+", line)
-        assert found, said
-        proc.stdin.write(f"wait {seconds}\n")
-        proc.stdin.close()
-        yield proc, found.group(0)
-    finally:
-        if proc.poll() is None:
-            proc.terminate()
-        proc.wait(15)
+    return serving("drive", url, "--foxglove-drive", *extra, stdin=f"wait {seconds}\n")
 
 
 def finish(proc: subprocess.Popen[str]) -> tuple[str, str]:
@@ -182,17 +159,7 @@ def test_garbage_and_a_killed_viewer_say_a_line_each_never_the_servers_log(
     tmp_path: Path,
 ) -> None:
     with board_process() as board, driving(board.url, seconds=4) as (proc, url):
-
-        async def garbage() -> None:
-            driver = await Driver.open(url)
-            await driver.advertise(1)
-            for number in range(20):
-                await driver.send({"op": f"bogus{number}"})
-                await driver.publish(1, b"\xff not json")
-            assert driver.ws.transport is not None
-            driver.ws.transport.abort()
-
-        asyncio.run(garbage())
+        asyncio.run(malformed(url))
         out, err = finish(proc)
     assert proc.returncode == 0, err
     assert "Error receiving" not in err and "Invalid message" not in err, err
