@@ -21,9 +21,9 @@ from foxglove.websocket import (
     ServerListener,
 )
 
-from appmode.protocol.escaping import escape
 from appmode.protocol.twist import BadTwist, Twist
 from appmode.session.desk import Desk, Values
+from appmode.text import escaped
 from appmode.throttle import Throttle
 
 CMD_VEL = "/cmd_vel"
@@ -81,7 +81,7 @@ class Listener(ServerListener):
         if not drives:
             self.say(
                 "topic",
-                f"viewer {client.id}: {escape(channel.topic.encode())[:80]} is not "
+                f"viewer {client.id}: {escaped(channel.topic[:80])} is not "
                 f"taken (appmode drives on {CMD_VEL})",
             )
 
@@ -123,10 +123,10 @@ class Listener(ServerListener):
             if isinstance(value, bool) or not isinstance(value, int | float):
                 self.say(
                     "parameter",
-                    f"viewer {client.id}: {escape(parameter.name.encode())[:40]} takes a number",
+                    f"viewer {client.id}: {escaped(parameter.name[:40])} takes a number",
                 )
                 continue
-            asked.append((parameter.name[:40], _number(value)))
+            asked.append((escaped(parameter.name[:40]), _number(value)))
         self._desk.set(asked)
         return listed(self._desk.values(), [p.name for p in parameters])
 
@@ -183,5 +183,6 @@ class SdkLog(logging.Handler):
         self._listener = listener
 
     def emit(self, record: logging.LogRecord) -> None:
-        text = " ".join(record.getMessage().split())[:200]
-        self._listener.say(record.name + text[:30], f"foxglove: {text}")
+        text = " ".join(record.getMessage().split())[:200]  # a client's text in it, too:
+        shown = escaped(text)
+        self._listener.say(record.name + text[:30], f"foxglove: {shown}")

@@ -192,12 +192,12 @@ def serving(*args: str, stdin: str | None = None) -> Iterator[tuple[subprocess.P
 
 
 async def malformed(url: str, count: int = 20) -> None:
-    """A viewer that sends `count` unknown ops and non-JSON twists, then is killed (its
-    connection dropped without a close)."""
+    """A viewer that sends `count` unknown ops (with a terminal's escape sequence) and
+    non-JSON twists, then is killed (its connection dropped without a close)."""
     driver = await Driver.open(url)
     await driver.advertise(1)
     for number in range(count):
-        await driver.send({"op": f"bogus{number}"})
+        await driver.send({"op": f"bogus{number}\x1b[2J"})  # an escape sequence, too
         await driver.publish(1, b"\xff not json")
     assert driver.ws.transport is not None
     driver.ws.transport.abort()

@@ -163,6 +163,7 @@ def test_garbage_and_a_killed_viewer_say_a_line_each_never_the_servers_log(
         out, err = finish(proc)
     assert proc.returncode == 0, err
     assert "Error receiving" not in err and "Invalid message" not in err, err
+    assert "\x1b" not in out + err and "bogus0\\x1b[2J" in out  # shown escaped
     complaints = [line for line in out.splitlines() if line.startswith("foxglove: ")]
     assert 1 <= len(complaints) <= 3, out  # one of a kind, not one a message
     assert out.count("a /cmd_vel message was ignored") == 1, out
