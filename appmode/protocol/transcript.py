@@ -74,6 +74,10 @@ DIRECTIVES = {
 }
 
 
+RECORDED_TIME = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{6}Z")
+"""What `@recorded` takes: when the recording began, UTC, to the microsecond."""
+
+
 @dataclass(frozen=True, slots=True)
 class Entry:
     """One `TIME DIR PAYLOAD` line."""
@@ -211,6 +215,10 @@ def parse_directive(text: str, lineno: int, where: str) -> Directive:
     if name not in DIRECTIVES:
         known = ", ".join(f"@{d}" for d in DIRECTIVES)
         raise TranscriptError(f"{where}: unknown directive @{_cut(name)} (known: {known})")
+    if name == "recorded" and (len(args) != 1 or not RECORDED_TIME.fullmatch(args[0])):
+        raise TranscriptError(
+            f"{where}: @recorded takes a UTC time such as 2026-11-29T08:00:00.000000Z"
+        )
     return Directive(lineno, name, tuple(args))
 
 

@@ -279,3 +279,14 @@ def test_no_corrupt_byte_makes_an_unclear_message(recording: Path, tmp_path: Pat
             assert "()" not in text and "unpack requires" not in text, text
             said.add(text.split(": ", 1)[1][:40])
     assert said  # the CRCs catch flips: some of them are refused
+
+
+def test_a_bad_recorded_directive_is_one_line_at_its_place(tmp_path: Path) -> None:
+    source = tmp_path / "bad.transcript"
+    source.write_text("# appmode transcript v1\n@recorded yesterday\n0.1 > A\n")
+    line = one_line_error("convert", str(source), str(tmp_path / "bad.mcap"))
+    assert line == (
+        f"appmode: error: {source}:2: @recorded takes a UTC time such as "
+        "2026-11-29T08:00:00.000000Z"
+    )
+    assert not (tmp_path / "bad.mcap").exists()
