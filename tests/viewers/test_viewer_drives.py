@@ -176,3 +176,28 @@ def test_driving_from_a_viewer_is_asked_for_and_this_machines_only() -> None:
     assert "ssh -L" in done.stderr and "Traceback" not in done.stderr
     done = run("drive", "sim://", "--foxglove-drive")
     assert done.returncode == 2 and "needs --foxglove PORT" in done.stderr
+
+
+def test_without_foxglove_drive_a_viewer_cannot_drive_or_tune(tmp_path: Path) -> None:
+    record = tmp_path / "board.txt"
+    with (
+        board_process("--record", str(record)) as board,
+        serving("drive", board.url, stdin="wait 3\n") as (proc, url),
+    ):
+
+        async def try_it() -> dict[str, Any]:
+            driver = await Driver.open(url)
+            await driver.advertise(1)
+            await _publish(driver, 1, 0.3, 1.0)
+            await driver.send(
+                {"op": "setParameters", "parameters": [{"name": "max_speed", "value": 800}]}
+            )
+            await asyncio.sleep(0.5)
+            await driver.close()
+            return driver.info
+
+        info = asyncio.run(try_it())
+        finish(proc)
+    assert info["capabilities"] == []
+    payloads = [p for _, p in timed_sent(record)]
+    assert "A" not in payloads and "{0:800}" not in payloads, payloads
