@@ -44,7 +44,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.cli.share import kept_key
+    from appmode.cli.share import a_clients_key
     from appmode.errors import AppmodeError
     from appmode.net.config import close_session, open_session, zenoh_module
     from appmode.ports.remote import BadRemote, check_endpoint
@@ -54,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
         connect = tuple(check_endpoint(e) for e in args.connect)
     except BadRemote as exc:
         raise AppmodeError(f"--connect: {exc}") from None
-    session = open_session("client", args.key or kept_key(), connect=connect, scout=not connect)
+    key = a_clients_key(args.key, "fleet")
+    session = open_session("client", key, connect=connect, scout=not connect)
     try:
         if args.action == "stop":
             return _stop(session, args.json)

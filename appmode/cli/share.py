@@ -180,17 +180,40 @@ def _lan_address() -> str:
 
 def kept_key() -> str:
     """appmode's own share key: made on first use, the user's alone, then the same."""
+    key = own_key()
+    if key is None:
+        key = secrets.token_urlsafe(KEY_BYTES)
+        _write_private(key_path(), key)
+    return key
+
+
+def key_path() -> Path:
     from appmode.files import data_folder
 
-    path = data_folder() / KEY_FILE
+    return data_folder() / KEY_FILE
+
+
+def own_key() -> str | None:
+    """This machine's share key, None if it has none (nothing is made)."""
+    path = key_path()
     try:
         return path.read_text(encoding="utf-8").strip()
     except FileNotFoundError:
-        pass
+        return None
     except OSError as exc:
         raise AppmodeError(f"cannot read the share key {path}: {exc.strerror}") from None
-    key = secrets.token_urlsafe(KEY_BYTES)
-    _write_private(path, key)
+
+
+def a_clients_key(given: str | None, command: str) -> str:
+    """The key a client command uses: the one given, else this machine's own (a share's
+    here); AppmodeError, saying where a key comes from, when there is neither."""
+    key = given if given is not None else own_key()
+    if key is None:
+        raise AppmodeError(
+            f"{command}: no key: give the cars' key with --key KEY (the key= part of the "
+            f"URL appmode share printed); this machine has shared no car ({key_path()} "
+            "does not exist)"
+        )
     return key
 
 

@@ -177,6 +177,12 @@ def opening_failed(
             f"cannot reach {', '.join(connect)}: nothing listens there, or it refused this "
             "key (use the URL appmode share printed, key included)"
         )
+    if not connect and not listen and "timeout" in why.lower():  # a client that scouts
+        return (
+            "found no car's host on this network with this key: no share runs, the key "
+            "is not its own (give --key: the key= part of the URL appmode share printed), "
+            "or multicast is blocked here (give --connect tcp/HOST:7447)"
+        )
     if listen and ("bind" in why.lower() or "in use" in why.lower()):
         return f"cannot listen on {', '.join(listen)} ({why}): pick another with --listen"
     return f"cannot open the Zenoh session: {why}"

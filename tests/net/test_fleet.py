@@ -7,11 +7,12 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 from tests.support.netns import lan, why_not
-from tests.support.processes import ROOT, stop_process
+from tests.support.processes import ROOT, run, stop_process
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
 WHY = why_not()
@@ -46,7 +47,19 @@ def test_twenty_cars_on_one_host_are_found_by_scouting_and_stopped_together() ->
             assert stopped.returncode == 0, stopped.stdout + stopped.stderr
             assert stopped.stdout.count("stopped (confirmed)") == CARS, stopped.stdout
             stranger = laptop.run("fleet", "--key", "not the key", "--json")
-            assert stranger.stdout.strip() in ("", "[]"), stranger.stdout
+            assert stranger.stdout.strip() == "" and stranger.returncode == 2, stranger.stdout
+            assert "found no car's host on this network with this key" in stranger.stderr
         finally:
             err = stop_process(host)
         assert host.returncode == 0 and "Traceback" not in err, err
+
+
+def test_fleet_without_a_key_says_where_a_key_comes_from(tmp_path: Path) -> None:
+    """Issue 79.6: no --key and no share key of this machine's: one line, and no key is
+    made (a new one would match no car)."""
+    done = run("fleet", env={"XDG_DATA_HOME": str(tmp_path)})
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert line.startswith("appmode: error: fleet: no key: give the cars' key with --key KEY")
+    assert str(tmp_path / "appmode" / "share.key") in line
+    assert not (tmp_path / "appmode").exists()
