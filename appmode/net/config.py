@@ -106,7 +106,36 @@ def open_session(
             return zenoh.open(config)
         except zenoh.ZError as exc:
             bare = any(e.startswith("tls/") for e in connect) and (tls is None or not tls.root_ca)
-            raise AppmodeError(opening_failed(str(exc), listen, connect, bare)) from None
+            ca = None if tls is None else tls.root_ca
+            stale = None if ca is None else certificate_refused(connect, ca)
+            raise AppmodeError(stale or opening_failed(str(exc), listen, connect, bare)) from None
+
+
+def certificate_refused(connect: tuple[str, ...], ca: str) -> str | None:
+    """Why a `tls/` endpoint was not reached, when it is its certificate: a TLS handshake
+    of our own against each, trusting `ca` alone (Zenoh's own error does not say)."""
+    import socket
+    import ssl
+
+    for endpoint in (e for e in connect if e.startswith("tls/")):
+        host, _, port = endpoint.removeprefix("tls/").rpartition(":")
+        context = ssl.create_default_context(cafile=ca)
+        context.check_hostname = False  # the share's certificate names its machine
+        try:
+            with (
+                socket.create_connection((host.strip("[]"), int(port)), timeout=2) as raw,
+                context.wrap_socket(raw),
+            ):
+                pass
+        except ssl.SSLCertVerificationError:
+            return (
+                f"cannot reach {endpoint}: its certificate is not the one in ca={ca} (the "
+                "share's certificate changed, or the file is another's): copy share-cert.pem "
+                "from the car's host again, and check its fingerprint"
+            )
+        except (OSError, ValueError):
+            continue  # nothing listens, or another failure: Zenoh's error says it
+    return None
 
 
 def _auth(key: str, folder: Path, admits: bool) -> dict[str, str]:

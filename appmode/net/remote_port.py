@@ -32,6 +32,7 @@ from appmode.ports.modemless import Modemless
 from appmode.ports.remote import RemoteTarget, WriteRefused
 from appmode.ports.urls import port_target
 from appmode.protocol.reader import RECEIVED_DIRECTIONS
+from appmode.text import escaped
 
 if TYPE_CHECKING:
     import zenoh
@@ -45,6 +46,10 @@ SILENT = 3.0
 which the port is lost: the network between is cut (its host stops the car)."""
 WRITE_TIMEOUT = 1.0
 """Seconds a write waits for the car's host to say the bytes left."""
+LINK_DOWN = (
+    "the car's host has lost its serial link to the car: check the car is on and its "
+    "cable or adapter on that machine (appmode share says what it lost in its log)"
+)
 CLIENT = f"{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(3)}"
 """This process, as the car's host knows it (its machine's name first)."""
 _TOOK: set[str] = set()
@@ -116,6 +121,9 @@ class RemoteSerial(Modemless):
         info = json.loads(found.payload.to_string())
         self.simulated = info.get("simulated") is True
         """The car shared is a simulated board (the views say so)."""
+        self.car_link_down = LINK_DOWN if info.get("links", {}).get(self._side) is False else None
+        """Why nothing can come from the car: the car's host has lost its link to this
+        port (None while it has it)."""
         if self._side not in info.get("ports", ()):
             shared = ", ".join(info.get("ports", ()))
             raise SerialException(f"{name} shares no {self._side} port (it shares {shared})")
@@ -163,6 +171,9 @@ class RemoteSerial(Modemless):
         event = json.loads(sample.payload.to_string())
         if event.get("t") == "dropped" and event.get("client") == CLIENT:
             self._lose(str(event.get("why")))
+        elif event.get("t") == "link" and event.get("port") == self._side:
+            said = escaped(str(event.get("text", ""))[:200])
+            self.car_link_down = None if event.get("up") else f"{LINK_DOWN} ({said})"
 
     def _on_presence(self, sample: zenoh.Sample) -> None:
         import zenoh

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from appmode.web.certificate import own_certificate
 from tests.support.processes import ROOT, appmode_cmd, run, stop_process
 from tests.support.shares import KEY, shared_board
 from tests.testing.test_plugin import pytest_in
@@ -21,12 +22,14 @@ def test_tls_checks_the_key_and_needs_the_share_s_certificate(tmp_path: Path) ->
     with shared_board(tmp_path, "car", "--tls") as car:
         assert "connect=tls/127.0.0.1:" in car.url
         cert = tmp_path / "data" / "appmode" / "share-cert.pem"
+        stale, _ = own_certificate(["127.0.0.1"], tmp_path, server="stale")  # another's
         done = run("params", f"{car.url}&ca={cert}", "--json")
         assert done.returncode == 0 and '"max_speed": 500' in done.stdout, done.stderr
         for url, said in (
             (car.url, "a tls/ endpoint needs the share's certificate: add &ca=FILE"),
             (f"{car.url}&ca={tmp_path / 'none.pem'}", "no such file"),
             (f"{car.url.replace('key=fleet', 'key=wrong')}&ca={cert}", "refused this key"),
+            (f"{car.url}&ca={stale}", f"its certificate is not the one in ca={stale}"),
         ):
             refused = run("params", url)
             assert refused.returncode == 2 and said in refused.stderr, refused.stderr
@@ -166,3 +169,16 @@ def test_the_page_and_the_share_keep_certificates_of_their_own(tmp_path: Path) -
         assert cert.read_bytes() == held, "the page's certificate is not the share's"
         done = run("params", f"{car.url}&ca={cert}", "--json")
         assert done.returncode == 0, done.stderr
+
+
+def test_a_shared_car_whose_serial_link_is_down_is_said_so_remotely(tmp_path: Path) -> None:
+    """Issue 79.6: params of a shared car whose board is gone says the car's host lost
+    its serial link, not to check the baud rate."""
+    with shared_board(tmp_path, "car") as car:
+        car.board.proc.kill()
+        car.board.proc.wait()
+        done = run("params", car.url)
+        car.stop()
+    assert done.returncode == 2 and len(done.stderr.splitlines()) == 1, done.stderr
+    assert "the car's host has lost its serial link to the car" in done.stderr
+    assert "baud rate" not in done.stderr

@@ -87,6 +87,8 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
                 events += self._take_pending()  # "is back" before what proved it
             events += new
         outcome = self.state.tick(self.now())
+        if isinstance(outcome, QueryFailed) and (far := self.far_end_down()) is not None:
+            outcome = QueryFailed(f"{outcome.text.split(': ', 1)[0]}: {far}")
         if outcome is not None:
             events.append(outcome)
         self._flush_outbox()
