@@ -145,12 +145,6 @@ class Link(Generic[E]):
         """The open port (None while the link is down)."""
         return self._port
 
-    def far_end_down(self) -> str | None:
-        """Why nothing can come however long one waits, where the port knows it (a
-        shared car whose host has lost its serial link to the car); else None."""
-        why = getattr(self._port, "car_link_down", None)
-        return why if isinstance(why, str) else None
-
     def _on_lost(self) -> None:
         """What the protocol forgets when the link drops (a decoder's partial bytes)."""
 

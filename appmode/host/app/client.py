@@ -87,7 +87,7 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
                 events += self._take_pending()  # "is back" before what proved it
             events += new
         outcome = self.state.tick(self.now())
-        if isinstance(outcome, QueryFailed) and (far := self.far_end_down()) is not None:
+        if isinstance(outcome, QueryFailed) and (far := _far_end_down(self.link)) is not None:
             outcome = QueryFailed(f"{outcome.text.split(': ', 1)[0]}: {far}")
         if outcome is not None:
             events.append(outcome)
@@ -188,3 +188,9 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
                     f"the car still moved {SETTLE:g} s after the stop: sent {escape(again)}"
                 )
                 self.send(again)
+
+
+def _far_end_down(port: object) -> str | None:
+    """Why nothing can come, where the port knows it (a shared car's lost serial link)."""
+    why = getattr(port, "car_link_down", None)
+    return why if isinstance(why, str) else None
