@@ -15,7 +15,7 @@ from appmode.host.app.client import Event, Host
 from appmode.host.app.query import QueryDone
 from appmode.host.chassis.client import ChassisHost
 from appmode.host.control.client import ControlHost
-from appmode.host.events import BoardWarning, LinkStatus
+from appmode.host.events import BoardWarning, FarStop, LinkStatus
 from appmode.host.outcomes import QueryFailed
 from appmode.line.wire import every
 from appmode.ports.recording import open_recorder
@@ -82,6 +82,10 @@ def show(host: Host, event: Event, out: TextIO, as_json: bool) -> None:
         return
     if isinstance(event, BoardWarning):
         print(f"appmode: WARNING: {event.text}", file=sys.stderr, flush=True)
+        return
+    if isinstance(event, FarStop):
+        said = "stopped the car" if event.stopped else "could not stop the car"
+        print(f"appmode: the car's host {said}: {event.text}", file=sys.stderr, flush=True)
         return
     if isinstance(event, (QueryDone, QueryFailed)):
         return

@@ -18,3 +18,11 @@ class BoardWarning:
     """The board does not do what it was told: the car still moves after a stop."""
 
     text: str
+
+
+@dataclass(frozen=True, slots=True)
+class FarStop:
+    """The far end (a shared car's host) stopped the car (`stopped`), or could not."""
+
+    text: str
+    stopped: bool = True

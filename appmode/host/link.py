@@ -87,6 +87,8 @@ class Link(Generic[E]):
     sent = ">"
     received = "<"
     stop_on_close = True
+    stopped_far = False
+    """The link was lost after the far end stopped the car (a share that ended)."""
     proves_return = False
     """A reopened link is back only once the protocol has decoded the board's output
     (`_proven`): a path left by a board that died (a pty's) may now lead to another
@@ -149,6 +151,7 @@ class Link(Generic[E]):
         """What the protocol forgets when the link drops (a decoder's partial bytes)."""
 
     def _lost(self, exc: Exception) -> None:
+        self.stopped_far = getattr(self._port, "host_stopped_car", False) is True
         if self._port is not None:
             with contextlib.suppress(serial.SerialException, OSError):
                 self._port.close()

@@ -46,6 +46,8 @@ SILENT = 3.0
 which the port is lost: the network between is cut (its host stops the car)."""
 WRITE_TIMEOUT = 1.0
 """Seconds a write waits for the car's host to say the bytes left."""
+CLOSING = 0.3
+"""Seconds the share's token may go before its last word, that it ends, is heard."""
 LINK_DOWN = (
     "the car's host has lost its serial link to the car: check the car is on and its "
     "cable or adapter on that machine (appmode share says what it lost in its log)"
@@ -82,6 +84,13 @@ class RemoteSerial(Modemless):
         start: bytes before the first `{` are the tail of a record sent before)."""
         self._host_heard = time.monotonic()
         self._lost: str | None = None
+        self._closing = threading.Event()
+        """Set when the share said it ends (`_host_closed`: having stopped the car)."""
+        self._host_closed = False
+        self.host_stopped_car = False
+        """The car's host stopped the car last (and nothing was written since), or ended
+        its share having stopped it (`Link.stopped_far`)."""
+        self._far_stops: deque[tuple[str, bool]] = deque(maxlen=8)
         self.latency: float | None = None
         """Milliseconds the last write took to be acknowledged by the car's host."""
         self.written_at = 0.0
@@ -171,6 +180,15 @@ class RemoteSerial(Modemless):
         event = json.loads(sample.payload.to_string())
         if event.get("t") == "dropped" and event.get("client") == CLIENT:
             self._lose(str(event.get("why")))
+        elif event.get("t") in ("stopped", "unstopped"):
+            stopped = event["t"] == "stopped"
+            with self._ready:
+                said = str(event.get("text", "")).removeprefix("stopped: ")
+                self._far_stops.append((escaped(said[:200]), stopped))
+                self.host_stopped_car = stopped
+        elif event.get("t") == "closed":
+            self._host_closed = event.get("stopped") is True
+            self._closing.set()
         elif event.get("t") == "link" and event.get("port") == self._side:
             said = escaped(str(event.get("text", ""))[:200])
             self.car_link_down = None if event.get("up") else f"{LINK_DOWN} ({said})"
@@ -178,11 +196,25 @@ class RemoteSerial(Modemless):
     def _on_presence(self, sample: zenoh.Sample) -> None:
         import zenoh
 
-        if sample.kind == zenoh.SampleKind.DELETE:
-            self._lose(
-                f"the car's host is gone (appmode share of {self._remote.name} ended, or its "
-                "machine or network is down): the car keeps its last command"
+        if sample.kind != zenoh.SampleKind.DELETE:
+            return
+        name = self._remote.name
+        if self._closing.wait(CLOSING):  # the share said why it goes, before it went
+            self.host_stopped_car = self._host_closed
+            done = (
+                "it stopped the car first"
+                if self._host_closed
+                else (
+                    "its stop was NOT delivered (its link to the car was down): the car may "
+                    "keep its last command"
+                )
             )
+            self._lose(f"the car's host ended its share of {name}: {done}")
+            return
+        self._lose(
+            f"the car's host is gone (appmode share of {name} was killed, or its machine "
+            "or network is down): the car keeps its last command"
+        )
 
     def _lose(self, why: str) -> None:
         with self._ready:
@@ -245,8 +277,17 @@ class RemoteSerial(Modemless):
                     self._rx_times.popleft()
         return data
 
+    def far_stops(self) -> list[tuple[str, bool]]:
+        """The stops the car's host made (or failed to) since the last look: (what it
+        said, whether the stop went out)."""
+        with self._ready:
+            taken = list(self._far_stops)
+            self._far_stops.clear()
+        return taken
+
     def write(self, data: bytes) -> int:
         self._check()
+        self.host_stopped_car = False  # what is written now may move the car again
         payload = serial.to_bytes(data)
         if self._remote.take and self._remote.name not in _TOOK:
             self._take()

@@ -428,9 +428,12 @@ class Share:
         self._closed.set()
         self._stops += 1
         stopping = self._stopping()
+        delivered = True
         for name, port in self.ports.items():
             port.host.stop_on_close = name in stopping
-            port.host.close()
+            delivered &= port.host.close() is not None or name not in stopping
+        if self._events is not None:  # before the token goes: clients hear why it went
+            self._events.put(json.dumps({"t": "closed", "stopped": delivered}))
         for declared in [*getattr(self, "_declared", []), self._host_token]:
             if declared is not None:
                 declared.undeclare()

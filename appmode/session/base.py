@@ -196,7 +196,7 @@ class BaseSession(ABC):
     def _close_link(self, link: Link[Any]) -> None:
         """Close the driving link (its stop last); note a stop that could not be sent."""
         moving = self.moving
-        if link.close() is not None or not link.stop_on_close:
+        if link.close() is not None or not link.stop_on_close or link.stopped_far:
             return
         self.left_moving = moving
         self.undelivered = (

@@ -5,6 +5,7 @@ pytest plugin on a zenoh:// URL — each judged on the board's own recording."""
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 from pathlib import Path
 
@@ -182,3 +183,67 @@ def test_a_shared_car_whose_serial_link_is_down_is_said_so_remotely(tmp_path: Pa
     assert done.returncode == 2 and len(done.stderr.splitlines()) == 1, done.stderr
     assert "the car's host has lost its serial link to the car" in done.stderr
     assert "baud rate" not in done.stderr
+
+
+def _driving(url: str, script: str) -> subprocess.Popen[str]:
+    proc = subprocess.Popen(
+        appmode_cmd("drive", url),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None
+    proc.stdin.write(script)
+    proc.stdin.flush()
+    return proc
+
+
+def _ended(proc: subprocess.Popen[str]) -> tuple[str, str]:
+    assert proc.stdin is not None and proc.stdout is not None and proc.stderr is not None
+    proc.stdin.close()
+    out, err = proc.stdout.read(), proc.stderr.read()
+    proc.wait(30)
+    return out, err
+
+
+@pytest.mark.parametrize("ending", ["SIGTERM", "SIGKILL"])
+def test_a_driver_is_told_truly_how_its_share_ended(ending: str, tmp_path: Path) -> None:
+    """Issue 80.12: a share that ends (SIGTERM) stops the car first and its driver says
+    so, with no "may still be moving"; one killed leaves the car as it was, and says so."""
+    import time
+
+    with shared_board(tmp_path, "car") as car:
+        driver = _driving(car.url, "drive A\nwait 4\n")
+        time.sleep(2.5)
+        if ending == "SIGKILL":
+            car.share.kill()
+        car.stop()
+        out, err = _ended(driver)
+        sent = car.sent()
+    if ending == "SIGTERM":
+        assert sent[-1] == "Z", sent
+        assert "the car's host ended its share of car: it stopped the car first" in out
+        assert driver.returncode == 0 and "may still be moving" not in err, err
+    else:
+        assert sent[-1] == "A", sent  # the board's own recording: nobody stopped it
+        assert "was killed, or its machine or network is down" in out
+        assert driver.returncode == 1 and "may still be moving" in err
+
+
+def test_a_take_over_is_said_as_the_hosts_stop_not_as_the_control_port(tmp_path: Path) -> None:
+    """Issue 80.12: the driver taken over is told why, and no "UART2 may have taken over"
+    follows; the one that took it is told the car's host stopped the car."""
+    import time
+
+    with shared_board(tmp_path, "car") as car:
+        first = _driving(car.url, "drive A\nwait 5\n")
+        time.sleep(2)
+        second = _driving(f"{car.url}&take=1", "wait 3\n")
+        out, _ = _ended(first)
+        taken, _ = _ended(second)
+        sent = car.sent()
+    assert "took the driving over" in out and "may have taken over" not in out, out
+    assert re.search(r"the car's host stopped the car: \S+ took the driving over", taken), taken
+    assert "A" in sent and sent[-1] == "Z"

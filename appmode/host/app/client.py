@@ -14,7 +14,7 @@ from appmode.errors import AppmodeError
 from appmode.host.app.query import TIMEOUT, Outcome, ParamQuery, QueryDone
 from appmode.host.app.state import HostState
 from appmode.host.app.stop_check import SETTLE, StopCheck
-from appmode.host.events import BoardWarning, LinkStatus
+from appmode.host.events import BoardWarning, FarStop, LinkStatus
 from appmode.host.link import Link, LinkLost, Opener
 from appmode.host.outcomes import TRIES, QueryFailed
 from appmode.line.wire import UART2, Tap
@@ -31,10 +31,10 @@ CONFIRM_STEP = 0.05
 REFUSALS = 2
 """Connections in a row closed before a byte after which a query gives up at once."""
 
-Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning
+Event = app.BoardEvent | LinkStatus | Outcome | BoardWarning | FarStop
 
 
-class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
+class Host(Link[app.BoardEvent | Outcome | BoardWarning | FarStop]):
     """A session with one board's APP port."""
 
     proves_return = True  # back at the first record (the board streams them)
@@ -86,6 +86,10 @@ class Host(Link[app.BoardEvent | Outcome | BoardWarning]):
                 self._proven_by_output()
                 events += self._take_pending()  # "is back" before what proved it
             events += new
+        for stop in _far_stops(self.link):
+            if stop.stopped:
+                self.state.stopped_far(self.now())
+            events.append(stop)
         outcome = self.state.tick(self.now())
         if isinstance(outcome, QueryFailed) and (far := _far_end_down(self.link)) is not None:
             outcome = QueryFailed(f"{outcome.text.split(': ', 1)[0]}: {far}")
@@ -194,3 +198,9 @@ def _far_end_down(port: object) -> str | None:
     """Why nothing can come, where the port knows it (a shared car's lost serial link)."""
     why = getattr(port, "car_link_down", None)
     return why if isinstance(why, str) else None
+
+
+def _far_stops(port: object) -> list[FarStop]:
+    """The stops the far end made since the last look, where the port tells them."""
+    taken = getattr(port, "far_stops", None)
+    return [FarStop(text, stopped) for text, stopped in taken()] if callable(taken) else []

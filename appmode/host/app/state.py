@@ -115,6 +115,12 @@ class HostState:
                 self.stopped_at, self._warned = now, False
                 self.moving_since = None
 
+    def stopped_far(self, now: float) -> None:
+        """The far end (a shared car's host) stopped the car: as if this host sent Z."""
+        list(self.end.sent(b"Z"))
+        self.stopped_at, self._warned = now, False
+        self.moving_since = None
+
     def _disobeyed(self, velocity: app.Velocity, now: float) -> BoardWarning | None:
         stopped = self.stopped_at
         if stopped is None or self._warned or now - stopped < STILL_MOVING_AFTER:
@@ -190,10 +196,12 @@ class HostState:
         return outcome
 
     def reset_decoder(self) -> None:
-        """Forget a partial record (after the link was lost: the board may restart)."""
+        """Forget a partial record, and whether the letters are followed (after the link
+        was lost: the board may restart, or the far end stop the car)."""
         self.decoder = self.layout.board_decoder()
         self.in_step = False
         self.letters_ignored = False
+        self.moving_since = None
 
     def _apply(self, event: app.BoardEvent, now: float) -> Outcome | None:
         if isinstance(event, app.Garbage) and event.raw in self.layout.replies:

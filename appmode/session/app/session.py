@@ -15,7 +15,7 @@ from appmode.host.app.client import Host
 from appmode.host.app.query import ParamQuery, QueryDone
 from appmode.host.app.state import HostState
 from appmode.host.app.tokens import parse_token
-from appmode.host.events import BoardWarning, LinkStatus
+from appmode.host.events import BoardWarning, FarStop, LinkStatus
 from appmode.host.link import LinkLost, Refused
 from appmode.host.outcomes import QueryFailed
 from appmode.host.waits import Wait
@@ -100,6 +100,8 @@ class AppSession(BaseSession):
                     self.driving.stop()  # what the car was last told stays in force
             elif isinstance(event, BoardWarning):
                 self.say(f"WARNING: {event.text}")
+            elif isinstance(event, FarStop):
+                self._far_stop(event)
             elif isinstance(event, QueryDone):
                 if self.baseline is None:
                     self.baseline = event.values
@@ -177,6 +179,14 @@ class AppSession(BaseSession):
 
     def _forget_motion(self) -> None:
         self.driving.stop()
+
+    def _far_stop(self, stop: FarStop) -> None:
+        """The car's host (a share) stopped the car, or could not: said, and forgotten."""
+        if stop.stopped:
+            self._forget_motion()
+            self.say(f"the car's host stopped the car: {stop.text}")
+        else:
+            self.say(f"WARNING: the car's host could not stop the car: {stop.text}")
 
     def switch_page(self, letter: str) -> None:
         self.driving.stop()
