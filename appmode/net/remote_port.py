@@ -87,6 +87,7 @@ class RemoteSerial(Modemless):
         self._closing = threading.Event()
         """Set when the share said it ends (`_host_closed`: having stopped the car)."""
         self._host_closed = False
+        self._closed_at = 0.0
         self.host_stopped_car = False
         """The car's host stopped the car last (and nothing was written since), or ended
         its share having stopped it (`Link.stopped_far`)."""
@@ -188,6 +189,7 @@ class RemoteSerial(Modemless):
                 self.host_stopped_car = stopped
         elif event.get("t") == "closed":
             self._host_closed = event.get("stopped") is True
+            self._closed_at = time.monotonic()
             self._closing.set()
         elif event.get("t") == "link" and event.get("port") == self._side:
             said = escaped(str(event.get("text", ""))[:200])
@@ -199,7 +201,8 @@ class RemoteSerial(Modemless):
         if sample.kind != zenoh.SampleKind.DELETE:
             return
         name = self._remote.name
-        if self._closing.wait(CLOSING):  # the share said why it goes, before it went
+        said = self._closing.wait(CLOSING)  # the share says why it goes, before it goes
+        if said and time.monotonic() - self._closed_at <= 2 * CLOSING:  # and just before
             self.host_stopped_car = self._host_closed
             done = (
                 "it stopped the car first"
