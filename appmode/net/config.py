@@ -184,6 +184,11 @@ def _tls(config: zenoh.Config, tls: Tls) -> None:
     for name, value in parts.items():
         if value is not None:
             config.insert_json5(f"transport/link/tls/{name}", json.dumps(value))
+    if tls.certificate is not None:  # a TLS listener joins no peer it hears of: nothing
+        # plain reaches it through another share of its key, nor it through a plain one
+        none = json.dumps({"router": [], "peer": [], "client": ["router", "peer"]})
+        config.insert_json5("scouting/multicast/autoconnect", none)
+        config.insert_json5("scouting/gossip/enabled", "false")
 
 
 def trimmed(text: str) -> str:

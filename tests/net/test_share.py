@@ -378,3 +378,30 @@ def test_a_write_its_client_gave_up_never_reaches_the_car(shared: SharedCar) -> 
     assert "A" not in shared.sent(), shared.sent()
     sent = shared.laptop.run("send", shared.url, "J", "A", "wait:0.3", timeout=30)
     assert sent.returncode == 0 and "A" in shared.sent(), sent.stderr  # a client's own, in time
+
+
+def test_a_tls_share_is_not_reached_through_a_plain_share_of_its_key(shared: SharedCar) -> None:
+    """Issue 80.12: a --tls share beside a plain share of the same key on the LAN: no
+    plain client reaches it through the plain one, and a plain fleet does not list it."""
+    record2 = shared.record.with_name("secure.transcript")
+    board2 = BoardProcess("--pty", "--quiet", "--record", str(record2))
+    secure = shared.machines["stranger"].popen(
+        "share", board2.url, "--name", "secure", "--listen", "tcp/0.0.0.0:7451", "--key", KEY,
+        "--tls",
+    )  # fmt: skip
+    try:
+        assert secure.stdout is not None
+        assert secure.stdout.readline().startswith("zenoh://secure?connect=tls/")
+        time.sleep(3)  # scouting's time to find each other, if they would
+        listed = shared.laptop.run("fleet", "--key", KEY, "--json", timeout=30)
+        assert listed.returncode == 0, listed.stderr
+        assert [car["name"] for car in json.loads(listed.stdout)] == ["car"]
+        plain = shared.url.replace("zenoh://car?", "zenoh://secure?")
+        reached = shared.laptop.run("send", plain, "J", "A", timeout=30)
+        assert reached.returncode != 0 and "no car named secure answers" in reached.stderr
+        assert "A" not in sent_lines(record2)
+    finally:
+        if secure.poll() is None:
+            secure.terminate()
+        secure.communicate(timeout=10)
+        board2.stop()
