@@ -52,7 +52,14 @@ LINK_DOWN = (
     "the car's host has lost its serial link to the car: check the car is on and its "
     "cable or adapter on that machine (appmode share says what it lost in its log)"
 )
-CLIENT = f"{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(3)}"
+
+
+def new_client() -> str:
+    """A link's client id: its machine, its process, and a token of the link's own (a
+    client revoked by the car's host drives again on its next link, never this one)."""
+    return f"{socket.gethostname()}-{os.getpid()}-{secrets.token_hex(3)}"
+
+
 """This process, as the car's host knows it (its machine's name first)."""
 _TOOK: set[str] = set()
 """The cars this process took the driving of (take=1 takes once: a reconnection after
@@ -75,6 +82,7 @@ class RemoteSerial(Modemless):
             raise SerialException(f"{target.url!r} names no shared car")
         self._remote, self._side = remote, target.sim_port
         self._keys = Keys(remote.name)
+        self._client = new_client()
         self._ready = threading.Condition()
         self._rx = bytearray()
         self._rx_times: deque[list[float]] = deque()
@@ -148,7 +156,7 @@ class RemoteSerial(Modemless):
             session.declare_subscriber(keys.bytes(self._side), self._on_bytes),
             session.declare_subscriber(keys.events, self._on_event),
             session.liveliness().declare_subscriber(keys.presence, self._on_presence, history=True),
-            session.liveliness().declare_token(keys.driver(CLIENT)),
+            session.liveliness().declare_token(keys.driver(self._client)),
         ]
         self._writer = session.declare_querier(keys.write(self._side), timeout=WRITE_TIMEOUT)
         self._beating = threading.Event()
@@ -179,7 +187,7 @@ class RemoteSerial(Modemless):
     def _on_event(self, sample: zenoh.Sample) -> None:
         self._host_heard = time.monotonic()
         event = json.loads(sample.payload.to_string())
-        if event.get("t") == "dropped" and event.get("client") == CLIENT:
+        if event.get("t") == "dropped" and event.get("client") == self._client:
             self._lose(str(event.get("why")))
         elif event.get("t") in ("stopped", "unstopped"):
             stopped = event["t"] == "stopped"
@@ -234,7 +242,7 @@ class RemoteSerial(Modemless):
                 )
                 return
             try:
-                self._session.put(alive, CLIENT)
+                self._session.put(alive, self._client)
             except Exception:  # a session closing under it: the port is closing too
                 return
 
@@ -296,7 +304,7 @@ class RemoteSerial(Modemless):
             self._take()
         sent = time.monotonic()
         until = sent - self._origin + WRITE_TIMEOUT  # the car's clock: after it, not written
-        replies = list(self._writer.get(payload=payload, attachment=f"{CLIENT} {until:.3f}"))
+        replies = list(self._writer.get(payload=payload, attachment=f"{self._client} {until:.3f}"))
         self.latency = (time.monotonic() - sent) * 1000
         if not replies:
             self._lose(f"the car's host did not answer within {WRITE_TIMEOUT:g} s")
@@ -312,7 +320,7 @@ class RemoteSerial(Modemless):
         body = json.dumps({"take": True})
         replies = list(
             self._session.get(
-                self._keys.lease, payload=body, attachment=CLIENT, timeout=WRITE_TIMEOUT
+                self._keys.lease, payload=body, attachment=self._client, timeout=WRITE_TIMEOUT
             )
         )
         error = replies[0].err if replies else None
@@ -352,7 +360,11 @@ class RemoteSerial(Modemless):
         self._beating.set()
         with contextlib.suppress(Exception):  # a session already gone has nothing to close
             body = json.dumps({"let_go": True})
-            list(self._session.get(self._keys.lease, payload=body, attachment=CLIENT, timeout=0.5))
+            list(
+                self._session.get(
+                    self._keys.lease, payload=body, attachment=self._client, timeout=0.5
+                )
+            )
             for declared in self._declared:
                 declared.undeclare()
             close_session(self._session)

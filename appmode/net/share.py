@@ -24,7 +24,7 @@ from appmode.host.kinds import AnyHost, open_hosts
 from appmode.host.link import Cut, LinkLost
 from appmode.net.asked import NOT_ASKED, asked_by, json_of, text_of, write_refusal
 from appmode.net.hosts import claim
-from appmode.net.lease import Driver, Granted, Lease, Refused
+from appmode.net.lease import Driver, Granted, Lease, Refused, Revoked
 from appmode.net.names import ANY_STOP, Keys
 from appmode.protocol import app
 from appmode.protocol.reader import SENT_DIRECTIONS
@@ -179,6 +179,11 @@ class Share:
         """None when `client` may drive (the lease granted it), else why not."""
         machine = client.rsplit("-", 2)[0]
         answer = self.lease.ask(client, machine, self.now(), take)
+        if isinstance(answer, Revoked):
+            return (
+                f"this client's lease on {self.keys.name} was revoked (it went silent, or was "
+                "stopped or taken over): it drives no more; reconnect to drive again"
+            )
         if isinstance(answer, Refused):
             held = self.now() - answer.driver.since
             return (
@@ -247,7 +252,7 @@ class Share:
             with self._lock:
                 driver = self.lease.driver
                 if driver is not None:
-                    self.lease.let_go(driver.client)
+                    self.lease.revoke(driver.client)
                 sent = self._stop_car(f"stopped by {who} (fleet stop)")
                 if driver is not None:
                     self._dropped(driver, f"{who} stopped every car (fleet stop)")

@@ -405,3 +405,18 @@ def test_a_tls_share_is_not_reached_through_a_plain_share_of_its_key(shared: Sha
             secure.terminate()
         secure.communicate(timeout=10)
         board2.stop()
+
+
+def test_a_frozen_driver_that_wakes_up_drives_no_more(shared: SharedCar) -> None:
+    """Issue 80.8: after SIGSTOP and SIGCONT a script's next letter reached the board
+    though its lease had lapsed. The car's host revokes the lease of a client that went
+    silent: its next write is refused, and the board gets no letter after its stop."""
+    frozen = _raw_writes(shared, 1, 3, "", "1.5")  # a letter, frozen 1.5 s, then more
+    out, err = frozen.communicate(timeout=30)
+    lines = out.splitlines()
+    assert lines[0] == "ok" and lines[1].startswith("error "), out + err
+    assert "lease on car was revoked" in lines[1] and "reconnect to drive again" in lines[1]
+    sent = shared.sent()
+    assert sent.index("A") < len(sent) - 1 and "A" not in sent[sent.index("A") + 1 :], sent
+    again = shared.laptop.run("send", shared.url, "J", "A", "wait:0.3", timeout=30)
+    assert again.returncode == 0, again.stderr  # another link of the laptop's drives

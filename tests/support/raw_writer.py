@@ -2,7 +2,9 @@
 tests.support.raw_writer ENDPOINT KEY NAME SIZE COUNT [UNTIL]` sends COUNT writes of
 SIZE bytes of `A` to the car's APP port one after another (each given up at UNTIL on
 the car's clock, if given), with the heartbeats that keep its lease, and prints each
-answer as a line (`ok`, or the error) as it comes, until the first error."""
+answer as a line (`ok`, or the error) as it comes, until the first error. With FREEZE
+seconds, it stops (heartbeats too) after its first write for that long, as a process
+sent SIGSTOP and then SIGCONT."""
 
 from __future__ import annotations
 
@@ -15,13 +17,18 @@ from appmode.net.names import Keys
 CLIENT = "raw-writer-1-abc"
 
 
-def main(endpoint: str, key: str, name: str, size: int, count: int, until: str = "") -> None:
+def main(
+    endpoint: str, key: str, name: str, size: int, count: int, until: str = "", freeze: str = "0"
+) -> None:
     session = open_session("client", key, connect=(endpoint,))
     keys = Keys(name)
     done = threading.Event()
+    awake = threading.Event()
+    awake.set()
 
     def beat() -> None:
         while not done.wait(0.1):
+            awake.wait()
             session.put(keys.alive, CLIENT)
 
     threading.Thread(target=beat, daemon=True).start()
@@ -37,6 +44,10 @@ def main(endpoint: str, key: str, name: str, size: int, count: int, until: str =
             else:
                 print(f"error {reply.err.payload.to_string()}", flush=True)
                 return  # as a client does once its write is refused
+            if float(freeze) and awake.is_set():
+                awake.clear()  # frozen: no heartbeat, no write
+                done.wait(float(freeze))
+                awake.set()
     finally:
         done.set()
         close_session(session)

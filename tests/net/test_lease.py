@@ -1,0 +1,28 @@
+"""Who drives a shared car (`net.lease`, no I/O): a client whose lease was taken from it
+drives no more (issue 80.8: a frozen driver woke up and drove again)."""
+
+from __future__ import annotations
+
+from appmode.net.lease import LAPSE, Granted, Lease, Refused, Revoked
+
+
+def test_a_lapsed_driver_is_revoked_and_another_link_drives() -> None:
+    lease = Lease()
+    assert lease.ask("laptop-1-aaa", "laptop", 0.0) == Granted()
+    assert isinstance(lease.ask("phone-2-bbb", "phone", 0.1), Refused)
+    assert lease.lapsed(LAPSE + 0.2) is not None  # its heartbeats stopped: the car stops
+    assert lease.ask("laptop-1-aaa", "laptop", LAPSE + 0.3) == Revoked()  # it wakes up
+    assert lease.ask("laptop-1-ccc", "laptop", LAPSE + 0.4) == Granted()  # its next link
+
+
+def test_one_taken_over_or_stopped_is_revoked_one_that_let_go_is_not() -> None:
+    lease = Lease()
+    lease.ask("a-1-x", "a", 0.0)
+    taken = lease.ask("b-1-y", "b", 0.1, take=True)
+    assert isinstance(taken, Granted) and taken.took_from is not None
+    assert lease.ask("a-1-x", "a", 0.2, take=True) == Revoked()
+    assert lease.revoke("b-1-y") is not None  # a fleet stop
+    assert lease.ask("b-1-y", "b", 0.3) == Revoked()
+    lease.ask("c-1-z", "c", 0.4)
+    assert lease.let_go("c-1-z") is not None  # it closed
+    assert lease.ask("c-1-z", "c", 0.5) == Granted()
