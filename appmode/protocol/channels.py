@@ -54,6 +54,10 @@ RAW_SCHEMA = {
     },
 }
 IN_FORCE = "/session/in_force"
+LOG = "/log"
+"""What a session says, and a line per unit (`foxglove.Log`)."""
+CMD_VEL = "/cmd_vel"
+"""Where a viewer that may drive publishes its twists (`--foxglove-drive`)."""
 IN_FORCE_SCHEMA = {
     "type": "object",
     "properties": {

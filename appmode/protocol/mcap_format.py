@@ -29,7 +29,7 @@ from typing import Any
 
 from mcap.writer import CompressionType, Writer
 
-from appmode.protocol.channels import RAW, RAW_SCHEMA, Decoded, channels
+from appmode.protocol.channels import LOG, RAW, RAW_SCHEMA, Decoded, channels
 from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
@@ -61,7 +61,6 @@ START = "appmode"
 """The metadata record that says when the session's time 0 was (`start_ns`)."""
 RECORDED = "recorded"
 """The directive that says it in a transcript: `@recorded 2026-11-29T08:00:00.000000Z`."""
-LOG = "/log"
 TEXT_SCHEMA = {"type": "object", "properties": {"text": {"type": "string"}}}
 LOG_SCHEMA = {
     "title": "foxglove.Log",

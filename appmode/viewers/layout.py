@@ -9,12 +9,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from appmode.protocol.channels import IN_FORCE, channels
+from appmode.protocol.channels import CMD_VEL, IN_FORCE, LOG, channels
 from appmode.protocol.layouts import Layout
 from appmode.protocol.sensed import Sensing
 
-LOG = "/log"
-CMD_VEL = "/cmd_vel"
 TELEOP_RATE = 10
 """Twists a second the Teleop panel sends (each lasts 0.5 s: `session.desk`)."""
 SPEED, TURN = 0.3, 0.5

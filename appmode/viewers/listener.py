@@ -21,13 +21,12 @@ from foxglove.websocket import (
     ServerListener,
 )
 
+from appmode.protocol.channels import CMD_VEL
 from appmode.protocol.twist import BadTwist, Twist
 from appmode.session.desk import Desk, Values
 from appmode.text import escaped
 from appmode.throttle import Throttle
 
-CMD_VEL = "/cmd_vel"
-"""The topic a viewer drives on (geometry_msgs/msg/Twist or TwistStamped, as JSON)."""
 DRIVING = [Capability.ClientPublish, Capability.Parameters]
 """What the server offers viewers that may drive and tune."""
 ENCODINGS = ["json"]
@@ -36,8 +35,6 @@ MAX_MESSAGE = 4096
 """Bytes a viewer's twist may take (a Twist in JSON is some 120)."""
 CHANNELS = 256
 """Channels viewers may advertise at once (the rest are ignored)."""
-LOG_EVERY = 10.0
-"""Seconds between two notes of one kind (a viewer's flood says one)."""
 
 
 class Listener(ServerListener):
@@ -50,14 +47,14 @@ class Listener(ServerListener):
     ) -> None:
         self._watched = watched
         self._desk = desk
-        self._throttle = Throttle(LOG_EVERY)
+        self._throttle = Throttle()
         self._note = note
         self._lock = threading.Lock()
         self._drives: dict[tuple[int, int], bool] = {}
         """Each advertised channel (client, channel): whether it is CMD_VEL."""
 
     def say(self, kind: str, text: str) -> None:
-        """`text` as a note, one of its `kind` every LOG_EVERY seconds."""
+        """`text` as a note, one of its `kind` every so often (`Throttle`)."""
         left_out = self._throttle.allow(kind)
         if left_out is None:
             return

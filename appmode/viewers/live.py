@@ -19,7 +19,7 @@ import time
 from typing import Any
 
 from appmode.errors import AppmodeError
-from appmode.protocol.channels import RAW, RAW_SCHEMA, channels
+from appmode.protocol.channels import LOG, RAW, RAW_SCHEMA, channels
 from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
 from appmode.protocol.layouts import VELOCITY, Layout
@@ -31,7 +31,6 @@ QUEUE = 4096
 """Units and notes waiting for the worker at most (seconds of a flood: they are small)."""
 BACKLOG = 1024
 """Messages the SDK keeps for each viewer at most (the oldest are dropped)."""
-LOG = "/log"
 
 
 class LiveView:
