@@ -166,8 +166,8 @@ def start_of(text: str, where: str) -> int:
 class McapLines:
     """An MCAP file made a record at a time: each method returns the bytes it adds (a
     chunk's when one is done, else nothing). `start_ns`: the wall-clock time of the
-    session's time 0 (None: now, a recording's; a `@recorded` directive among
-    `start`'s sets it too, a converted transcript's)."""
+    session's time 0 (None: now, a recording's, which `start` writes as a `@recorded`
+    directive; a converted transcript's is its own `@recorded`, or 0)."""
 
     def __init__(
         self, layout: Layout = VELOCITY, library: str = "appmode", start_ns: int | None = None
@@ -185,7 +185,7 @@ class McapLines:
         self._ids: dict[str, int] = {}
         self._time = 0
         self._flushed = 0
-        self._given = start_ns is not None
+        self._dated = start_ns is None  # a recording: its start is said in a directive
         self.start_ns = time.time_ns() // 1000 * 1000 if start_ns is None else start_ns
 
     def _taken(self) -> bytes:
@@ -195,12 +195,7 @@ class McapLines:
         """The header, the start's metadata, every channel, and `directives` (`board
         profile=…`; a recording adds `recorded …`)."""
         directives = list(directives)
-        for directive in directives:
-            name, _, rest = directive.partition(" ")
-            if name == RECORDED:
-                self.start_ns = start_of(rest.strip(), "@recorded")
-                self._given = True
-        if not self._given:
+        if self._dated:
             directives.append(f"{RECORDED} {recorded(self.start_ns)}")
         self._time = self._flushed = self.start_ns
         self._writer.start(profile=PROFILE, library=self._library)
