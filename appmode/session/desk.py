@@ -27,6 +27,8 @@ LAPSE = 0.5
 """Seconds a viewer's twist lasts unless it is sent again."""
 SETS = 64
 """Parameter sets waiting at most (the oldest are dropped)."""
+LOOK = 0.5
+"""Seconds between two looks at the parameters when no set is under way."""
 CLIENTS = 64
 """Viewers whose newest twist waits at most (a twist from one more is dropped)."""
 
@@ -45,6 +47,7 @@ class Desk:
         self._values: Values = {}
         self._on_values = on_values
         self._setting = False
+        self._looked = -LOOK
         self.driver: int | None = None
         """The viewer that drives (its client id), None when none does."""
         self._driven_at = 0.0
@@ -134,6 +137,9 @@ class Desk:
                 session.say(f"error: {name} = {value} refused: {exc}")
             if session.busy:
                 return
+        elif not self._setting and session.now() - self._looked < LOOK:
+            return  # the values change with a set, or a C record: looked at now and then
+        self._looked = session.now()
         values = session.parameters()
         with self._lock:
             changed, self._values = values != self._values, values
