@@ -148,5 +148,16 @@ class Stm32(threading.Thread):
             os.write(self.fd, body + bytes([check_sum(body), TAIL]))
 
     def stop(self) -> None:
+        """Stops the board, having taken every frame already written to it (the loop may
+        end between a host's last write and its next read)."""
         self._done.set()
         self.join(2)
+        while True:
+            try:
+                data = os.read(self.fd, 4096)
+            except OSError:  # BlockingIOError: nothing left
+                return
+            if not data:
+                return
+            for byte in data:
+                self._byte(byte)
