@@ -43,7 +43,9 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "over the control port as velocity frames (URL2, --uart2, or a sim:// board), on "
         "the APP port as the nearest of its eight directions at the speed asked; with no "
         "cmd_vel for --cmd-vel-timeout seconds the car stops. odom, tf (odom → "
-        "base_link), battery_state, imu and ~/raw come from its records. Ctrl-C or "
+        "base_link), battery_state, imu and ~/raw come from its records; the car's parameters "
+        "are the node's (ros2 param; a set is verified by reading it back, ~/save writes "
+        "them to flash); its lines go to /rosout. Ctrl-C or "
         "SIGTERM stops the car and withdraws the node. Needs the ros extra: "
         "pip install 'appmode[ros]'.",
     )
@@ -169,6 +171,7 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
         )
         options = Options(args.stamped, timeout, topics)
         ros = RosNode(session, zenoh, graph, options, _log)
+        session.on_message = ros.say  # the session's lines: stderr and /rosout
         ended = [False]
         try:
             session.start()

@@ -51,6 +51,8 @@ class Qos:
     reliability: Reliability = Reliability.RELIABLE
     durability: Durability = Durability.VOLATILE
     history: History = History.KEEP_LAST
+    lifespan: tuple[int, int] | None = None
+    """Seconds and nanoseconds a sample lives (None: for ever, rmw_zenoh's default)."""
 
     def text(self) -> str:
         """The QoS as a token writes it: `reliability:durability:history,depth:` then
@@ -64,10 +66,11 @@ class Qos:
             return "" if value == default else str(int(value))
 
         depth = "" if self.depth == DEFAULT_DEPTH else str(self.depth)
+        lifespan = "," if self.lifespan is None else "{},{}".format(*self.lifespan)
         return (
             f"{kind(self.reliability, Reliability.RELIABLE)}:"
             f"{kind(self.durability, Durability.VOLATILE)}:"
-            f"{kind(self.history, History.KEEP_LAST)},{depth}:,:,:,,"
+            f"{kind(self.history, History.KEEP_LAST)},{depth}:,:{lifespan}:,,"
         )
 
 

@@ -14,6 +14,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from appmode.protocol.odometry import Pose2D
 from appmode.protocol.sensed import YAW_WINDOW
+from appmode.ros import interfaces
 
 TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
@@ -23,7 +24,8 @@ IMU = "sensor_msgs/msg/Imu"
 TF = "tf2_msgs/msg/TFMessage"
 STRING = "std_msgs/msg/String"
 FLOAT32 = "std_msgs/msg/Float32"
-TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING, FLOAT32)
+LOG = "rcl_interfaces/msg/Log"
+TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING, FLOAT32, LOG)
 STORES = {"jazzy": Stores.ROS2_JAZZY, "humble": Stores.ROS2_HUMBLE}
 UNKNOWN = -1.0
 """A covariance's first element when the quantity is not measured (REP 145)."""
@@ -38,6 +40,29 @@ class Messages:
 
     def type_hash(self, ros_type: str) -> str:
         return str(self.store.hash_rihs01(ros_type))
+
+    def service_hash(self, ros_type: str) -> str:
+        return interfaces.service_hash(ros_type, self.store)
+
+    def request(self, payload: bytes, ros_type: str) -> Any:
+        """A service's request; ValueError if the payload is not one."""
+        try:
+            return self.store.deserialize_cdr(payload, f"{ros_type}_Request")
+        except Exception as exc:  # bytes from anyone: whatever rosbags raises of them
+            raise ValueError(f"not a {ros_type} request: {type(exc).__name__}") from None
+
+    def cdr(self, message: Any, ros_type: str) -> bytes:
+        return bytes(self.store.serialize_cdr(message, ros_type))
+
+    def log(self, level: int, name: str, text: str, time_ns: int) -> bytes:
+        """A line the node logs, as rcl_interfaces/Log (/rosout)."""
+        stamp = self._make(
+            "builtin_interfaces/msg/Time", sec=time_ns // 10**9, nanosec=time_ns % 10**9
+        )
+        message = self._make(
+            LOG, stamp=stamp, level=level, name=name, msg=text, file="", function="", line=0
+        )
+        return self._cdr(message, LOG)
 
     def _make(self, ros_type: str, **fields: Any) -> Any:
         return self.types[ros_type](**fields)
@@ -228,7 +253,10 @@ class Messages:
 
 @cache
 def _store(distro: str) -> Any:
-    return get_typestore(STORES[distro])
+    """The distro's type store, with the services' requests and responses."""
+    store = get_typestore(STORES[distro])
+    interfaces.register(store)
+    return store
 
 
 GYRO_VARIANCE = 1e-4

@@ -27,6 +27,7 @@ from appmode.ros.messages import (
     BATTERY,
     FLOAT32,
     IMU,
+    LOG,
     ODOMETRY,
     STRING,
     TF,
@@ -35,6 +36,8 @@ from appmode.ros.messages import (
     Messages,
     volts_of,
 )
+from appmode.ros.parameters import SERVICES, Parameters
+from appmode.ros.services import Request, Services
 from appmode.ros.wire import BadAttachment, attachment, gid, read_attachment
 
 if TYPE_CHECKING:
@@ -54,6 +57,10 @@ HEARTBEAT = 0.5
 SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD, sporadic)."""
 STILL = Pose2D(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 """No offset: base_footprint lies under base_link (a flat car's ground projection)."""
+ROSOUT = Qos(depth=1000, durability=Durability.TRANSIENT_LOCAL, lifespan=(10, 0))
+"""/rosout's QoS, as rcl's (rcl_qos_profile_rosout_default)."""
+LEVELS = {"error:": 40, "WARNING": 30}
+"""rcl_interfaces/Log levels of the lines that start so (else INFO, 20)."""
 BATTERY_EVERY = 10
 """IMU readings a battery_state is sent for (a chassis's 20 Hz status: 2 Hz)."""
 Log = Callable[[str], None]
@@ -179,6 +186,11 @@ class RosNode:
         self._declared: list[Any] = []
         self.publishers: dict[str, Publisher] = {}
         self._said: set[str] = set()
+        self.services = Services(zenoh_session, graph, self.messages, self._woken)
+        self.parameters = Parameters(session, self.messages.types)
+        ns = graph.namespace.strip("/").replace("/", ".")
+        self.logger = f"{ns}.{graph.name}" if ns else graph.name
+        """The node's logger, as rcl names it (`robot1.appmode`)."""
 
     # ------------------------------------------------------------ the graph
 
@@ -195,6 +207,7 @@ class RosNode:
             ("imu", names.imu, IMU, Qos(depth=10)),
             ("raw", names.raw, STRING, Qos(depth=10)),
             ("tf_static", names.tf_static, TF, STATIC),
+            ("rosout", "/rosout", LOG, ROSOUT),
         ]
         topics = [(name, topic, kind, qos) for name, topic, kind, qos in each if topic]
         for entity_id, (name, topic, ros_type, qos) in enumerate(topics, start=1):
@@ -214,6 +227,7 @@ class RosNode:
             self.zenoh.declare_subscriber(key, self._on_cmd_vel),
             liveliness.declare_token(token),
         ]
+        self._declared += self.services.declare(SERVICES, entity_id + 1)
         base = self.options.topics.base_frame  # the fixed frame, kept for late subscribers
         if footprint(base) != base:
             fixed = self.messages.transform(STILL, time.time_ns(), base, footprint(base))
@@ -264,6 +278,7 @@ class RosNode:
         while not ended():
             self.session.tick()
             self._take_commands()
+            self._answer()
             self._publish_records()
             self._woken.wait(TICK)
             self._woken.clear()
@@ -297,6 +312,33 @@ class RosNode:
             if ignored:
                 self._say_once("3d", "cmd_vel's angular x and y are ignored: a car turns in z")
             self.session.move(twist)
+
+    def _answer(self) -> None:
+        """The services' requests, and the sets under way."""
+        for request in self.services.take():
+            try:
+                message = self.messages.request(request.payload, request.ros_type)
+            except ValueError as exc:
+                self.services.refuse(request)
+                self._say_once("bad request", f"a request was left unanswered: {exc}")
+                continue
+            self.parameters.answer(request.ros_type, message, self._replier(request))
+        if self.services.unattached:
+            self._say_once(
+                "service attachment",
+                "a request with no rmw_zenoh attachment was dropped, as rmw_zenoh drops it",
+            )
+        self.parameters.serve()
+
+    def _replier(self, request: Request) -> Callable[[Any], None]:
+        return lambda response: self.services.reply(request, response)
+
+    def say(self, text: str) -> None:
+        """A line of the node's (or its session's): on stderr and /rosout."""
+        self.parameters.said(text)
+        self.log(text)
+        level = next((n for start, n in LEVELS.items() if text.startswith(start)), 20)
+        self._put("rosout", self.messages.log(level, self.logger, text, time.time_ns()))
 
     # ------------------------------------------------------------ the records
 
@@ -405,4 +447,4 @@ class RosNode:
     def _say_once(self, kind: str, text: str) -> None:
         if kind not in self._said:
             self._said.add(kind)
-            self.log(text)
+            self.say(text)

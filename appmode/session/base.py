@@ -20,6 +20,7 @@ from appmode.host.link import UNDELIVERED, Link
 from appmode.ports.recording import open_recorder
 from appmode.ports.target import Target
 from appmode.protocol.channels import Viewer
+from appmode.protocol.profile_file import ParamSpec
 from appmode.protocol.recorder import Recorder
 from appmode.protocol.sensed import Inertial
 from appmode.protocol.twist import Twist
@@ -100,8 +101,7 @@ class BaseSession(ABC):
         self.left_moving = False
         """The car was last told to move when the final stop could not be delivered."""
         self.lease: float | None = None
-        """Seconds any motion lasts without `keepalive` (a page's heartbeats); None: the
-        view's own ticks prove it alive (the console, a script)."""
+        """Seconds motion lasts without `keepalive` (None: the view's ticks prove it alive)."""
         self.lease_source = "the page"
         """What proves the motion alive, as messages name it (`cmd_vel` for a ROS node)."""
         self._alive_at = 0.0
@@ -156,16 +156,14 @@ class BaseSession(ABC):
     @property
     @abstractmethod
     def moving(self) -> bool:
-        """Whether motion is in force, whatever started it (a key, a command, a stick,
-        raw bytes, a turn)."""
+        """Whether motion is in force, whatever started it (key, command, stick, bytes, turn)."""
 
     def move(self, twist: Twist, source: str = TWIST, timeout: float | None = None) -> None:
         """Drive `twist` (SI units, REP 103) for as long as its source repeats it: each
         call keeps it alive as a held key's repeats do (and `keepalive`, where a lease
         is set, must come too; a program's twist never latches, a typed one as a key
-        does); a still twist stops the car. Every port takes it: the APP port as its
-        nearest direction and speed, the control port as frames. `timeout`: how long
-        each call keeps it alive, where the source has its own (else hold-to-drive's)."""
+        does); a still twist stops the car. Every port takes it (the APP port as its nearest
+        direction and speed). `timeout`: how long a call keeps it alive, if not hold's."""
         if twist.still:
             if self.moving:
                 self.stop()
@@ -241,9 +239,8 @@ class BaseSession(ABC):
         return True
 
     def _lapsed(self) -> str | None:
-        """For the stop guard (its thread): what to say when the motion's source is over
-        LAPSE past its own deadline — a held key's repeats ("": a key let go), a page's
-        heartbeats — though the session could not tick to act on it; else None."""
+        """For the stop guard's thread: what to say when the motion's source (a held key's
+        repeats, "": let go; a page's heartbeats) is over LAPSE late, untaken; else None."""
         now = self.now()
         late = self.driving.late(now)
         if late is not None and late > LAPSE:
@@ -290,8 +287,7 @@ class BaseSession(ABC):
         return sensing.gap(self.telemetry_state(), self._signs() is not None)
 
     def sensed(self, after: float) -> list[tuple[float, Twist]]:
-        """The car's twist as each A record since `after` (session seconds) shows it,
-        in time order (`session.sensing`)."""
+        """The car's twist as each A record since `after` (session s) shows it, in order."""
         state = self.telemetry_state()
         return [] if state is None else sensing.twists(state, self._signs, after)
 
@@ -311,6 +307,10 @@ class BaseSession(ABC):
     def set_parameter(self, name: str, value: str) -> None:
         """Set a parameter (`value` in the user's units), verified by reading back."""
         raise AppmodeError("this port has no parameters to set")
+
+    def parameter_specs(self) -> tuple[ParamSpec, ...]:
+        """The parameters `parameters` names: their ranges and scales (none: none)."""
+        return ()
 
     @abstractmethod
     def unsaved_warning(self) -> str | None:

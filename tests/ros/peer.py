@@ -1,6 +1,7 @@
 """A ROS 2 side on rmw_zenoh's wire, written from rmw_zenoh's docs/design.md alone (not
 from appmode's code), for the tests: it finds the graph's liveliness tokens, reads a
-topic's samples with their attachments, and publishes a Twist as a ROS publisher does.
+topic's samples with their attachments, publishes a Twist as a ROS publisher does, and
+calls a service as a ROS client does (rmw_client_data.cpp).
 zenoh and rosbags are its only tools."""
 
 from __future__ import annotations
@@ -9,9 +10,10 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import zenoh
 import zenoh.ext
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 JAZZY = get_typestore(Stores.ROS2_JAZZY)
 
@@ -121,3 +123,101 @@ def twist_payload(forward: float, turn: float = 0.0) -> bytes:
         linear=vector(x=forward, y=0.0, z=0.0), angular=vector(x=0.0, y=0.0, z=turn)
     )
     return bytes(JAZZY.serialize_cdr(twist, "geometry_msgs/msg/Twist"))
+
+
+SERVICES = {
+    # rcl_interfaces/srv/*.srv and std_srvs/srv/Trigger.srv: request, then response
+    "rcl_interfaces/srv/ListParameters": (
+        "uint64 DEPTH_RECURSIVE=0\nstring[] prefixes\nuint64 depth",
+        "rcl_interfaces/ListParametersResult result",
+    ),
+    "rcl_interfaces/srv/GetParameters": (
+        "string[] names",
+        "rcl_interfaces/ParameterValue[] values",
+    ),
+    "rcl_interfaces/srv/GetParameterTypes": ("string[] names", "uint8[] types"),
+    "rcl_interfaces/srv/DescribeParameters": (
+        "string[] names",
+        "rcl_interfaces/ParameterDescriptor[] descriptors",
+    ),
+    "rcl_interfaces/srv/SetParameters": (
+        "rcl_interfaces/Parameter[] parameters",
+        "rcl_interfaces/SetParametersResult[] results",
+    ),
+    "rcl_interfaces/srv/SetParametersAtomically": (
+        "rcl_interfaces/Parameter[] parameters",
+        "rcl_interfaces/SetParametersResult result",
+    ),
+    "std_srvs/srv/Trigger": ("", "bool success\nstring message"),
+}
+for _service, _parts in SERVICES.items():
+    for _suffix, _text in zip(("_Request", "_Response"), _parts, strict=True):
+        JAZZY.register(get_types_from_msg(_text, f"{_service}{_suffix}"))
+
+
+def srv_type(service: str, suffix: str) -> str:
+    """Where rosbags keeps a service's request or response (`pkg/srv/msg/Name_Request`)."""
+    package, _, name = service.split("/")
+    return f"{package}/srv/msg/{name}_{suffix}"
+
+
+class ServiceClient:
+    """A ROS 2 client as rmw_client_data.cpp sends a request: a get on the server's key
+    (its `SS` token tells where) with target ALL_COMPLETE, no consolidation, the
+    request's CDR as payload and the client's attachment (sequence number, time, GID)."""
+
+    GID = bytes(range(100, 116))
+
+    def __init__(self, ros: zenoh.Session, entity: Entity, service: str) -> None:
+        self.ros, self.entity, self.service = ros, entity, service
+        self.sequence = 0
+
+    def call(self, timeout: float = 10.0, **fields: Any) -> tuple[Any, tuple[int, int, bytes]]:
+        """The response, and its attachment's three fields."""
+        request = JAZZY.types[srv_type(self.service, "Request")](**fields)
+        payload = bytes(JAZZY.serialize_cdr(request, srv_type(self.service, "Request")))
+        self.sequence += 1
+        attachment = zenoh.ext.z_serialize(
+            (zenoh.ext.Int64(self.sequence), zenoh.ext.Int64(time.time_ns()), self.GID)
+        )
+        replies = self.ros.get(
+            self.entity.data_key,
+            target=zenoh.QueryTarget.ALL_COMPLETE,
+            consolidation=zenoh.ConsolidationMode.NONE,
+            payload=payload,
+            attachment=attachment,
+            timeout=timeout,
+        )
+        for reply in replies:
+            assert reply.ok is not None, f"an error reply: {reply.err}"
+            sample = reply.ok
+            assert sample.attachment is not None, "rmw_zenoh's server attaches every reply"
+            sequence, stamp, gid = zenoh.ext.z_deserialize(
+                tuple[zenoh.ext.Int64, zenoh.ext.Int64, bytes], sample.attachment
+            )
+            response_type = srv_type(self.service, "Response")
+            response = JAZZY.deserialize_cdr(sample.payload.to_bytes(), response_type)
+            return response, (int(sequence), int(stamp), bytes(gid))
+        raise AssertionError(f"no reply from {self.entity.data_key} in {timeout} s")
+
+
+def parameter(name: str, value: int | float) -> Any:
+    """An rcl_interfaces/Parameter as `ros2 param set` sends it (integer or double)."""
+    types = JAZZY.types
+    empty = {
+        "byte_array_value": np.zeros(0, dtype=np.uint8),
+        "bool_array_value": np.zeros(0, dtype=bool),
+        "integer_array_value": np.zeros(0, dtype=np.int64),
+        "double_array_value": np.zeros(0, dtype=np.float64),
+        "string_array_value": [],
+    }
+    kind = 2 if isinstance(value, int) else 3
+    parameter_value = types["rcl_interfaces/msg/ParameterValue"](
+        type=kind,
+        bool_value=False,
+        integer_value=value if kind == 2 else 0,
+        double_value=float(value) if kind == 3 else 0.0,
+        string_value="",
+        **empty,
+    )
+    return types["rcl_interfaces/msg/Parameter"](name=name, value=parameter_value)

@@ -17,7 +17,7 @@ pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed"
 from appmode.protocol import chassis
 from appmode.testing.process import BoardProcess
 from tests.ros import peer
-from tests.ros.test_node import free_endpoint
+from tests.ros.conftest import free_endpoint
 from tests.support.processes import serving, stop_process
 
 STOP = chassis.STOP.hex(" ").upper()

@@ -14,7 +14,7 @@ pytest.importorskip("zenoh", reason="the ros extra (eclipse-zenoh) is not instal
 pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed")
 
 from tests.ros import peer
-from tests.ros.test_node import free_endpoint
+from tests.ros.conftest import free_endpoint
 from tests.support.processes import serving, stop_process
 
 

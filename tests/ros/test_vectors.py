@@ -13,7 +13,7 @@ import pytest
 pytest.importorskip("rosbags", reason="the ros extra (rosbags) is not installed")
 zenoh_ext = pytest.importorskip("zenoh.ext", reason="the ros extra (eclipse-zenoh) is missing")
 
-from appmode.ros import messages  # noqa: E402
+from appmode.ros import interfaces, messages  # noqa: E402
 from appmode.ros.graph import Durability, Node, Qos, Reliability, namespace  # noqa: E402
 from appmode.ros.wire import attachment, gid, read_attachment  # noqa: E402
 
@@ -30,6 +30,36 @@ HASHES = {
     messages.TF: "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
     # PowerVoltage (--topics wheeltec): ROS 2's own golden value (rosidl's CHECK_GOLDEN_HASH)
     messages.FLOAT32: "RIHS01_7170d3d8f841f7be3172ce5f4f59f3a4d7f63b0447e8b33327601ad64d83d6e2",
+    # /rosout (as a `ros2` CLI node's token on rmw_zenoh shows it)
+    messages.LOG: "RIHS01_e28ce254ca8abc06abf92773b74602cdbf116ed34fbaf294fb9f81da9f318eac",
+}
+SERVICE_HASHES = {
+    # rmw_zenoh's docs/design.md, "Services": its example service
+    "example_interfaces/srv/AddTwoInts": (
+        "RIHS01_e118de6bf5eeb66a2491b5bda11202e7b68f198d6f67922cf30364858239c81a"
+    ),
+    # as `ros2 service info -v` prints them for any rclcpp node on Jazzy
+    "rcl_interfaces/srv/ListParameters": (
+        "RIHS01_3e6062bfbb27bfb8730d4cef2558221f51a11646d78e7bb30a1e83afac3aad9d"
+    ),
+    "rcl_interfaces/srv/GetParameters": (
+        "RIHS01_bf9803d5c74cf989a5de3e0c2e99444599a627c7ff75f97b8c05b01003675cbc"
+    ),
+    "rcl_interfaces/srv/GetParameterTypes": (
+        "RIHS01_da199c878688b3e530bdfe3ca8f74cb9fa0c303101e980a9e8f260e25e1c80ca"
+    ),
+    "rcl_interfaces/srv/DescribeParameters": (
+        "RIHS01_845b484d71eb0673dae682f2e3ba3c4851a65a3dcfb97bddd82c5b57e91e4cff"
+    ),
+    "rcl_interfaces/srv/SetParameters": (
+        "RIHS01_56eed9a67e169f9cb6c1f987bc88f868c14a8fc9f743a263bc734c154015d7e0"
+    ),
+    "rcl_interfaces/srv/SetParametersAtomically": (
+        "RIHS01_0e192ef259c07fc3c07a13191d27002222e65e00ccec653ca05e856f79285fcd"
+    ),
+    "std_srvs/srv/Trigger": (
+        "RIHS01_eeff2cd6fa5ad9d27cdf4dec64818317839b62f212a91e6b5304b634b2062c5f"
+    ),
 }
 
 
@@ -38,6 +68,17 @@ def test_the_type_hashes_of_every_type_used() -> None:
     assert set(HASHES) == set(messages.TYPES)
     for ros_type, expected in HASHES.items():
         assert jazzy.type_hash(ros_type) == expected, ros_type
+
+
+def test_the_type_hashes_of_every_service_served(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A service's hash: its request, response and event as REP-2016 describes them
+    (rmw_zenoh's example among them, its two fields each way given here)."""
+    example = {"example_interfaces/srv/AddTwoInts": ("int64 a\nint64 b", "int64 sum")}
+    monkeypatch.setattr(interfaces, "SERVICES", {**interfaces.SERVICES, **example})
+    jazzy = messages.Messages("jazzy")
+    assert set(SERVICE_HASHES) == set(interfaces.SERVICES)
+    for service, expected in SERVICE_HASHES.items():
+        assert interfaces.service_hash(service, jazzy.store) == expected, service
 
 
 def test_the_design_doc_s_topic_keys() -> None:

@@ -276,6 +276,9 @@ class AppSession(BaseSession):
         index = param_values.lookup(self.specs, name)
         self.set_param(index, param_values.from_user(self.specs[index], value))
 
+    def parameter_specs(self) -> param_values.Specs:
+        return self.specs
+
     def _speed_index(self) -> int:
         index = self.host.state.layout.speed_index
         if index is None:

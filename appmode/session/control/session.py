@@ -21,7 +21,7 @@ from appmode.host.control.tokens import Step, parse_token, perform
 from appmode.host.events import BoardWarning, LinkStatus
 from appmode.host.outcomes import QueryFailed
 from appmode.ports.choice import BoardChoice
-from appmode.protocol import control, params, settings
+from appmode.protocol import control, param_values, params, settings
 from appmode.protocol.directions import MOTIONS, Motion
 from appmode.protocol.params import DriveType
 from appmode.protocol.sensed import signs_in_force
@@ -331,6 +331,27 @@ class ControlSession(MotionGridSession):
             self.say(f"sent {{8:{value}}} (APP mode: the port reads APP frames)")
             if not self.host.state.app_mode:
                 self.query(["system_mode"])
+
+    def parameters(self) -> dict[str, int | float]:
+        """Settings 1–9 as last read: the APP port's nine parameters."""
+        values = self.host.state.values
+        return {
+            spec.name: param_values.user_number(spec, values[spec.name])
+            for spec in self.parameter_specs()
+            if spec.name in values
+        }
+
+    def set_parameter(self, name: str, value: str) -> None:
+        if not self.reads:
+            raise AppmodeError(f"a set cannot be verified: {NO_READS}")
+        specs = param_values.SHEET
+        index = param_values.lookup(specs, name)
+        number = param_values.from_user(specs[index], value)
+        param_values.check(specs, index, number)
+        self.set_setting(specs[index].name, number)
+
+    def parameter_specs(self) -> param_values.Specs:
+        return param_values.SHEET if self.reads else ()
 
     def store(self, op: str) -> None:
         if not self._send(lambda: self.host.store(op)):
