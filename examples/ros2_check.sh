@@ -27,4 +27,14 @@ timeout 2 ros2 topic pub --rate 10 "${ns}/cmd_vel" geometry_msgs/msg/Twist '{lin
 sleep 1
 step "odom's twist after the silence (expect linear.x near 0)"
 timeout 10 ros2 topic echo --once --field twist.twist.linear "${ns}/odom"
+step "ros2 param list ${ns}/appmode (expect the car's nine)"
+timeout 20 ros2 param list "${ns}/appmode"
+step "ros2 param describe and get max_speed"
+timeout 20 ros2 param describe "${ns}/appmode" max_speed
+timeout 20 ros2 param get "${ns}/appmode" max_speed
+step "ros2 param set max_speed to what it is (expect: Set parameter successful)"
+value=$(timeout 20 ros2 param get --hide-type "${ns}/appmode" max_speed 2>/dev/null)
+[ -n "$value" ] && timeout 20 ros2 param set "${ns}/appmode" max_speed "$value"
+step "one /rosout line"
+timeout 10 ros2 topic echo --once /rosout rcl_interfaces/msg/Log
 step "done: please send this output, and whether the car moved and stopped"

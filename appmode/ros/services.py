@@ -29,6 +29,8 @@ QOS = Qos(depth=1000)
 """rclcpp's parameter services' (rmw_qos_profile_parameters: reliable, volatile, 1000)."""
 QUEUE = 64
 """Requests waiting at most (the oldest go unanswered)."""
+LARGEST = 64 * 1024
+"""Bytes of the largest request taken (the parameter services' are a few hundred)."""
 
 
 @dataclass
@@ -87,6 +89,9 @@ class Services:
             query.drop()
             return
         payload = b"" if query.payload is None else query.payload.to_bytes()
+        if len(payload) > LARGEST:
+            query.drop()
+            return
         with self._lock:
             self._queue.append(Request(ros_type, payload, query, sequence, gid, key))
         self.woken.set()

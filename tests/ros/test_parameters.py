@@ -136,3 +136,18 @@ def test_humble_s_services_answer_on_their_keys(car: Car) -> None:
         prefixes=[], depth=0
     )
     assert "max_speed" in listed.result.names
+
+
+def test_requests_rmw_zenoh_would_drop_get_no_answer_and_the_node_goes_on(car: Car) -> None:
+    listing = services(car)["/appmode/list_parameters"]
+    for payload, attachment in (
+        (b"\x00\x01\x00\x00\x00\x00\x00\x00", None),  # no attachment
+        (b"junk", peer.ATTACHED),  # no request
+        (bytes(100_000), peer.ATTACHED),  # larger than any request
+    ):
+        replies = car.ros.get(listing.data_key, payload=payload, attachment=attachment, timeout=1)
+        assert not [r for r in replies if r.ok is not None]
+    listed, _ = peer.ServiceClient(car.ros, listing, "rcl_interfaces/srv/ListParameters").call(
+        prefixes=["max_speed", "max"], depth=0
+    )
+    assert list(listed.result.names) == ["max_speed"]  # a prefix is dot-separated, as rclcpp
