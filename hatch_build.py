@@ -1,8 +1,9 @@
-"""The wheel's build hook: the served board's hot modules compiled with mypyc where this
-machine can compile them (a C compiler and Python's headers), as aiohttp builds its C
-extensions; pure Python where it cannot, or with APPMODE_PURE=1 set (docs/simulated-board.md,
-"The compiled build"). The modules compile in a copy of the package, so the checkout is
-left as it was; a failed compile warns and builds pure Python."""
+"""The wheel's build hook: with APPMODE_COMPILE=1 set, the served board's hot modules
+compiled with mypyc where this machine can compile them (a C compiler and Python's
+headers); pure Python otherwise, and by default, so that an install, and every extra
+added later, takes seconds (docs/simulated-board.md, "The compiled build"). The modules
+compile in a copy of the package, so the checkout is left as it was; a failed compile
+warns and builds pure Python."""
 
 from __future__ import annotations
 
@@ -17,8 +18,8 @@ from typing import Any
 
 from hatchling.builders.hooks.plugin.interface import BuildHookInterface
 
-PURE = "APPMODE_PURE"
-"""Set to 1 in the environment, the build is pure Python whatever the machine."""
+COMPILE = "APPMODE_COMPILE"
+"""Set to 1 in the environment, the build is compiled where the machine can."""
 
 
 def compiler() -> str | None:
@@ -39,7 +40,7 @@ class CompiledBuild(BuildHookInterface):  # type: ignore[type-arg]
     """Where the compiled modules wait for the wheel (until `finalize`)."""
 
     def _wanted(self) -> bool:
-        return os.environ.get(PURE, "") in ("", "0") and compiler() is not None
+        return os.environ.get(COMPILE, "") == "1" and compiler() is not None
 
     def dependencies(self) -> list[str]:
         return ["mypy>=1.8", "setuptools>=61"] if self._wanted() else []

@@ -5,8 +5,10 @@ from __future__ import annotations
 import os
 import sys
 
+from appmode.errors import install_line
+
 STANDIN = "or, with no car, run appmode board --bluetooth and set DBUS_SYSTEM_BUS_ADDRESS"
-NO_BLEAK = "Bluetooth needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+NO_BLEAK = f"Bluetooth needs the bluetooth extra: {install_line('bluetooth')}"
 
 
 def no_bluez(reason: str) -> str:

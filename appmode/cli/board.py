@@ -17,7 +17,7 @@ from appmode.cli.options import (
     file_name,
     number_type,
 )
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 from appmode.protocol.drive_types import DRIVE_NAMES
 
 ADVERTISED_NAME = "HC-08"
@@ -100,7 +100,7 @@ def _add_where(board: argparse.ArgumentParser) -> None:
         action="store_true",
         help="serve as a Bluetooth module (BLE HC-08 and classic HC-05) through a BlueZ "
         "stand-in on a private D-Bus bus: prints 'bus: ADDRESS' for "
-        "DBUS_SYSTEM_BUS_ADDRESS (Linux, needs dbus-daemon and appmode[bluetooth])",
+        "DBUS_SYSTEM_BUS_ADDRESS (Linux, needs dbus-daemon and the bluetooth extra)",
     )
     where.add_argument(
         "--advertise",
@@ -252,7 +252,7 @@ def _bluetooth(option: str) -> ModuleType:
         from appmode.bluetooth.standin import endpoint
     except ImportError:
         raise AppmodeError(
-            f"{option} needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+            f"{option} needs the bluetooth extra: {install_line('bluetooth')}"
         ) from None
     return endpoint
 

@@ -8,7 +8,7 @@ import sys
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 
 SHELLS = ("bash", "zsh", "fish")
 
@@ -19,7 +19,7 @@ INSTALL = {
 }
 """The one command that installs completion for each shell (then open a new shell)."""
 
-MISSING = "shell completion needs argcomplete: pip install 'appmode[completion]'"
+MISSING = f"shell completion needs argcomplete: {install_line('completion')}"
 
 
 def register(sub: Subparsers) -> argparse.ArgumentParser:

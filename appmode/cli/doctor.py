@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, add_chassis, target
+from appmode.errors import install_line
 from appmode.text import counted, escaped, wrapped
 
 if TYPE_CHECKING:  # imported by `run`: `appmode --help` does not load the host
@@ -66,6 +67,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from appmode.ports.target import parse_target
 
+    _namesake()
     urls = {t.url: t for t in args.urls}
     if not urls:
         from appmode.ports.listing import serial_ports
@@ -99,6 +101,26 @@ def run(args: argparse.Namespace) -> int:
     return 0 if any(f.is_car for f in findings) else 1
 
 
+def _namesake() -> None:
+    """Say so when PyPI's other `appmode` (a Jupyter extension) is installed here too."""
+    from importlib import metadata
+
+    try:
+        metadata.distribution("appmode")
+    except metadata.PackageNotFoundError:
+        return
+    print(
+        wrapped(
+            "doctor: the Jupyter extension also named appmode is installed in this "
+            "environment: both install a package named appmode, and the one installed last "
+            "overwrote the other's files. pip uninstall appmode, then install appmode-car "
+            "again, or keep each in a virtual environment of its own",
+            indent="",
+        ),
+        file=sys.stderr,
+    )
+
+
 def _bluetooth() -> list[str]:
     """The URLs of the cars' Bluetooth modules near or paired; where none can be looked
     for, a line on stderr says why."""
@@ -108,7 +130,7 @@ def _bluetooth() -> list[str]:
         from appmode.bluetooth.availability import explain
         from appmode.bluetooth.links.scan import scan
     except ImportError:
-        print("doctor: Bluetooth not looked for: pip install 'appmode[bluetooth]'", file=sys.stderr)
+        print(f"doctor: Bluetooth not looked for: {install_line('bluetooth')}", file=sys.stderr)
         return []
     if sys.stderr.isatty():
         sys.stderr.write("doctor: listening for Bluetooth modules …")

@@ -21,7 +21,7 @@ from appmode.cli.options import (
     board_choice,
     target,
 )
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 
 if TYPE_CHECKING:
     pass
@@ -46,8 +46,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "base_link), battery_state, imu and ~/raw come from its records; the car's parameters "
         "are the node's (ros2 param; a set is verified by reading it back, ~/save writes "
         "them to flash); its lines go to /rosout. Ctrl-C or "
-        "SIGTERM stops the car and withdraws the node. Needs the ros extra: "
-        "pip install 'appmode[ros]'.",
+        "SIGTERM stops the car and withdraws the node. Needs the ros extra.",
     )
     ros.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
     ros.add_argument(
@@ -244,9 +243,7 @@ def _ros_module() -> None:
         import rosbags  # noqa: F401
         import xxhash  # noqa: F401
     except ImportError:
-        raise AppmodeError(
-            "appmode ros needs rosbags and xxhash: pip install 'appmode[ros]'"
-        ) from None
+        raise AppmodeError(f"appmode ros needs rosbags and xxhash: {install_line('ros')}") from None
 
 
 def _log(text: str) -> None:

@@ -19,7 +19,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help=COMMANDS["router"],
         description="Run a Zenoh router (no zenohd needed): appmode share --connect and every "
         "zenoh:// URL's connect= may name it, across networks a LAN's scouting does not "
-        "reach. It admits only clients with the key. Needs pip install 'appmode[net]'.",
+        "reach. It admits only clients with the key. Needs the net extra.",
     )
     router.add_argument(
         "--listen",

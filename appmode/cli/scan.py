@@ -19,8 +19,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         description="Listen for BLE modules (HM-10, HC-08, JDY-08, … : a UART service "
         "FFE0 or Nordic UART) and list the paired classic modules (HC-05, HC-06), each "
         "with its signal and the URL to give drive, web or params; --probe says which "
-        "firmware answers on each. Needs the bluetooth extra: pip install "
-        "'appmode[bluetooth]'.",
+        "firmware answers on each. Needs the bluetooth extra.",
     )
     scan.add_argument(
         "--time",

@@ -14,7 +14,7 @@ from urllib.parse import quote
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import HOLDS, Subparsers, add_chassis, add_profile, board_choice, target
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 
 if TYPE_CHECKING:
     from appmode.net.config import Tls
@@ -39,7 +39,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "driver's heartbeats stop (its process killed, its machine asleep, the network "
         "cut) it stops the car within half a second, and when share ends it stops the "
         "car. Only a client with the key gets in (Zenoh's user-password authentication; "
-        "--tls also encrypts). Needs the net extra: pip install 'appmode[net]'.",
+        "--tls also encrypts). Needs the net extra.",
     )
     share.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
     share.add_argument(
@@ -236,7 +236,7 @@ def _tls(host: str) -> Tls:
         from appmode.web.certificate import fingerprint, grouped, machine_names, own_certificate
     except ImportError:
         raise AppmodeError(
-            "--tls makes a certificate with cryptography: pip install 'appmode[web]'"
+            f"--tls makes a certificate with cryptography: {install_line('web')}"
         ) from None
     cert, key = own_certificate(machine_names(host), server="share")
     lines = "".join(f"\nappmode:   {line}" for line in grouped(fingerprint(cert)))

@@ -1,4 +1,4 @@
-"""A car on the network, over Eclipse Zenoh (the extra `appmode[net]`): `share.Share`
+"""A car on the network, over Eclipse Zenoh (the extra `net`): `share.Share`
 puts a car a machine reaches on Zenoh under `appmode/NAME/…` and is its stop authority
 (a driver holds a lease, renewed by its heartbeats: `lease`); `remote_port.RemoteSerial`
 is that car as a pyserial port on another machine (`zenoh://NAME?connect=…&key=…`, so

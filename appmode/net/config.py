@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 from appmode.net.names import USER
 
 if TYPE_CHECKING:
@@ -24,8 +24,8 @@ if TYPE_CHECKING:
 
 Mode = Literal["peer", "client", "router"]
 NO_ZENOH = (
-    "the network needs eclipse-zenoh: pip install 'appmode[net]' (wheels for Linux, "
-    "macOS and Windows on x86-64 and ARM: a Raspberry Pi too)"
+    f"the network needs eclipse-zenoh: {install_line('net')}; it has wheels for Linux, "
+    "macOS and Windows on x86-64 and ARM, a Raspberry Pi too"
 )
 CLOSING = 1.0
 """Seconds a session is given to close: Zenoh waits up to ten for a peer whose network

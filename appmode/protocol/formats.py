@@ -11,7 +11,7 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import BinaryIO
 
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 from appmode.protocol.layouts import Layout
 from appmode.protocol.params import DriveType
 from appmode.protocol.reader import PortsReader
@@ -157,7 +157,7 @@ def _recorded(items: Iterator[Line]) -> tuple[Iterator[Line], int]:
 
 def _missing(doing: str) -> AppmodeError:
     """What to install to do what needs the mcap package."""
-    return AppmodeError(f"{doing} needs the mcap package: pip install 'appmode[foxglove]'")
+    return AppmodeError(f"{doing} needs the mcap package: {install_line('foxglove')}")
 
 
 TEXT, MCAP = Text(), Mcap()

@@ -24,7 +24,7 @@ from pathlib import Path
 from appmode.board.firmware import Board
 from appmode.board.profiles import SHEET, profile_named
 from appmode.board.store import open_store
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 from appmode.line.faults import FaultSpec
 from appmode.line.wire import APP, CHASSIS, UART2
 from appmode.ports.endpoints import MakeEndpoint, PtyEndpoint, TcpEndpoint
@@ -256,7 +256,7 @@ def _bluetooth() -> MakeEndpoint:
         from appmode.bluetooth.standin.endpoint import BluetoothEndpoint
     except ImportError:
         raise AppmodeError(
-            "appmode_ble_board needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+            f"appmode_ble_board needs the bluetooth extra: {install_line('bluetooth')}"
         ) from None
     return BluetoothEndpoint
 

@@ -18,7 +18,7 @@ from typing import Protocol
 import serial
 
 from appmode.bluetooth.advertise.admission import ANY_PHONE, Admission
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 from appmode.line.pacing import Ahead
 from appmode.ports.recording import open_recorder
 from appmode.ports.urls import LinkLeft, new_pty, open_link
@@ -75,7 +75,7 @@ def _app_side(app_url: str, nus: bool, quiet: bool, admission: Admission | None)
         from appmode.bluetooth.uuids import UART_SERVICES
     except ImportError:
         raise AppmodeError(
-            f"tap {app_url} needs the bluetooth extra: pip install 'appmode[bluetooth]'"
+            f"tap {app_url} needs the bluetooth extra: {install_line('bluetooth')}"
         ) from None
 
     def log(text: str) -> None:

@@ -18,7 +18,7 @@ import threading
 import time
 from typing import Any
 
-from appmode.errors import AppmodeError
+from appmode.errors import AppmodeError, install_line
 from appmode.protocol.channels import LOG, RAW, RAW_SCHEMA, channels
 from appmode.protocol.control_view import view
 from appmode.protocol.escaping import escape
@@ -53,7 +53,7 @@ class LiveView:
             from appmode.viewers import listener
         except ImportError:
             raise AppmodeError(
-                "--foxglove needs the foxglove SDK: pip install 'appmode[foxglove]'"
+                f"--foxglove needs the foxglove SDK: {install_line('foxglove')}"
             ) from None
         self._foxglove = foxglove
         self._context = foxglove.Context()

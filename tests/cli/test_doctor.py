@@ -395,3 +395,17 @@ def test_bursts_heard_at_every_rate_are_the_control_port_s_at_its_own(
     target = parse_target("/dev/ttyUSB7")
     finding = probe.probe(target, threading.Event(), lambda text: None)
     assert finding.kind == "uart2" and finding.baud == probe.UART2_BAUD, finding
+
+
+def test_doctor_says_when_pypis_other_appmode_shares_the_environment(tmp_path: Path) -> None:
+    """Issue 79.1: PyPI's `appmode` is a Jupyter extension that installs a package of the
+    same import name; installed beside appmode-car, one overwrites the other's files."""
+    quiet = run("doctor", "--no-bluetooth", "--json", str(tmp_path / "no-port"))
+    assert "Jupyter" not in quiet.stderr, quiet.stderr
+    info = tmp_path / "site" / "appmode-1.3.0.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: appmode\nVersion: 1.3.0\n")
+    path = os.pathsep.join([str(ROOT), str(tmp_path / "site")])
+    done = run("doctor", "--no-bluetooth", str(tmp_path / "no-port"), env={"PYTHONPATH": path})
+    assert "Jupyter extension also named appmode is installed" in done.stderr, done.stderr
+    assert "pip uninstall appmode" in done.stderr and "Traceback" not in done.stderr
