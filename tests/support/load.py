@@ -6,11 +6,17 @@ import os
 import time
 
 
-def busy_cores(seconds: float = 0.25) -> float:
-    """Cores' worth of CPU in use now: on Linux measured over `seconds` (/proc/stat),
-    elsewhere the one-minute load average. The load average alone still counted a run
-    that had just ended: the next, started within a minute or so on an idle machine,
-    took two workers, not three, and ran 6 min 15 s, not 4 min 30."""
+def busy_cores(seconds: float = 0.25, looks: int = 1) -> float:
+    """Cores' worth of CPU in use now: on Linux measured over `seconds` (/proc/stat), the
+    least of `looks` such windows in a row (a program that keeps a core busy shows in
+    each; a run's last processes ending, in one or two), elsewhere the one-minute load
+    average. The load average alone still counted a run that had just ended: the next,
+    started within a minute or so on an idle machine, took two workers, not three, and
+    ran 6 min 15 s, not 4 min 30."""
+    return min(_busy(seconds) for _ in range(looks))
+
+
+def _busy(seconds: float) -> float:
     try:
         before = _cpu_times()
         time.sleep(seconds)
