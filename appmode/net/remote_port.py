@@ -25,6 +25,7 @@ import serial
 from serial import SerialException
 
 from appmode.errors import AppmodeError
+from appmode.host import far
 from appmode.net.config import Tls, close_session, open_session, zenoh_module
 from appmode.net.names import Keys
 from appmode.net.share import unstamp
@@ -304,7 +305,10 @@ class RemoteSerial(Modemless):
             self._take()
         sent = time.monotonic()
         until = sent - self._origin + WRITE_TIMEOUT  # the car's clock: after it, not written
-        replies = list(self._writer.get(payload=payload, attachment=f"{self._client} {until:.3f}"))
+        with far.acknowledging():  # the car's host is the stop authority while it waits
+            replies = list(
+                self._writer.get(payload=payload, attachment=f"{self._client} {until:.3f}")
+            )
         self.latency = (time.monotonic() - sent) * 1000
         if not replies:
             self._lose(f"the car's host did not answer within {WRITE_TIMEOUT:g} s")

@@ -12,7 +12,8 @@ that nothing the view blocks on can keep the car moving:
   terminal, a pipe, a disk) gets its port's stop from here, and the session forgets the
   motion at its next tick. Only time the process ran counts: a gap between the guard's
   own looks of over LATE (the whole process was not scheduled, on a loaded machine)
-  counts as LATE, so a session is judged on what it did while it could tick;
+  counts as LATE, so a session is judged on what it did while it could tick, and a
+  write a shared car's host has yet to acknowledge (`host.far`) is the link's wait;
 - after an ending signal (`signals.ending_since`), a session still not closed within
   GRACE seconds gets its stop from here, and the process ends (status 130): a signal
   ends the session within a second, whatever is blocked.
@@ -28,7 +29,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from appmode.host import signals
+from appmode.host import far, signals
 
 STALL = 0.25
 """Seconds without a tick, the car moving, before the guard stops it."""
@@ -136,6 +137,8 @@ class StopGuard:
             if beat != seen:
                 seen = beat
                 ran = could = min(now - beat, LATE)
+            elif far.waiting(ticker):
+                pass  # the link's wait for the car's own stop authority, not a view's stall
             else:
                 ran += step
                 could = max(0.0, could + step - queued)  # a wait is told when it ends

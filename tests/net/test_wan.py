@@ -1,0 +1,69 @@
+"""Driving a shared car over a slow WAN (issue 80.9): the car's host and a laptop joined
+by a link of 150 ms each way (tests/support/wan.py: TUN devices and a forwarder, the
+kernel's own TCP in each namespace). A write waits 0.3 s for the car's host to
+acknowledge it; the driver's stop guard took that wait for a stalled view and stopped
+the car after every other letter. A live driver is never stopped now, every letter
+arrives, and a link really lost still stops the car within half a second. Judged on the
+board's recording."""
+
+from __future__ import annotations
+
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from appmode.testing.process import BoardProcess
+from tests.support.netns import why_not
+from tests.support.processes import timed_sent, wait_for
+from tests.support.wan import wan
+
+pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
+WHY = why_not()
+pytestmark = pytest.mark.skipif(WHY is not None, reason=f"no network namespaces: {WHY}")
+LETTERS = "ABCDEFGH"
+
+
+@pytest.mark.slow
+@pytest.mark.timing
+def test_a_slow_link_stops_no_live_driver_and_a_lost_one_stops_the_car(
+    tmp_path: Path,
+) -> None:
+    record = tmp_path / "board.transcript"
+    board = BoardProcess("--pty", "--quiet", "--record", str(record))
+    with wan(delay=0.15, loss=0.0) as (machines, link):
+        car, laptop = machines["car"], machines["laptop"]
+        share = car.popen(
+            "share", board.url, "--name", "car", "--listen", "tcp/0.0.0.0:7450", "--key", "k"
+        )
+        try:
+            assert share.stdout is not None
+            url = share.stdout.readline().strip()
+            assert url.startswith("zenoh://"), share.communicate()[1]
+            script = "".join(f"drive {letter}\nwait 1.5\n" for letter in LETTERS) + "wait 60\n"
+            driver = laptop.popen("drive", url, stdin=subprocess.PIPE)
+            assert driver.stdin is not None
+            driver.stdin.write(script)
+            driver.stdin.flush()
+            wait_for(lambda: "H" in units(record), 30)
+            time.sleep(1.0)
+            timed = timed_sent(record)
+            driven = [unit for _, unit in timed[[u for _, u in timed].index("A") :]]
+            assert [u for u in driven if u in LETTERS] == list(LETTERS), driven
+            assert "Z" not in driven, f"a live driver was stopped: {driven}"
+            cut = time.monotonic()
+            link.cut()
+            wait_for(lambda: units(record)[-1] == "Z", 5)
+            stopped = board.clock_after + timed_sent(record)[-1][0]
+            assert stopped - cut < 0.5, f"stopped {stopped - cut:.2f} s after the link was lost"
+            driver.kill()
+            driver.communicate(timeout=10)
+        finally:
+            share.terminate()
+            share.communicate(timeout=10)
+            board.stop()
+
+
+def units(record: Path) -> list[str]:
+    return [unit for _, unit in timed_sent(record)] if record.exists() else []
