@@ -28,10 +28,12 @@ from appmode.errors import AppmodeError
 
 def register_urls() -> None:
     """Have pyserial open appmode's URLs (`serial.serial_for_url("sim://")`): sim://,
-    ble://, bt:// and zenoh://, whose modules these packages hold."""
+    ble://, bt:// and zenoh://, from the packages the scheme table names."""
     import serial
 
-    for package in ("appmode.ports", "appmode.bluetooth.links", "appmode.net"):
+    from appmode.ports.schemes import handler_packages
+
+    for package in handler_packages():
         if package not in serial.protocol_handler_packages:
             serial.protocol_handler_packages.append(package)
 

@@ -20,11 +20,9 @@ from appmode.line.wire import APP, PORTS, UART2
 from appmode.ports.radio import BadAddress, BleTarget, BtTarget, parse_ble, parse_bt
 from appmode.ports.remote import USAGE as REMOTE_USAGE
 from appmode.ports.remote import BadRemote, RemoteTarget, parse_remote
+from appmode.ports.schemes import SCHEMES
 from appmode.protocol import params
 
-SCHEMES = ("sim", "socket", "rfc2217", "loop", "ble", "bt", "zenoh")
-NETWORK_SCHEMES = ("socket", "rfc2217")
-RADIO_SCHEMES = ("ble", "bt")
 NUMBERED_PTY = re.compile(r"/dev/(pts/\d+|ttys\d+)")
 """A pseudo-terminal named by its number (Linux, macOS)."""
 URL_HELP = (
@@ -87,7 +85,8 @@ class Target:
     @property
     def network(self) -> bool:
         """A TCP link (socket://, rfc2217://)."""
-        return self.scheme in NETWORK_SCHEMES
+        scheme = SCHEMES.get(self.scheme)
+        return scheme is not None and scheme.network
 
     @property
     def numbered_pty(self) -> bool:
@@ -202,9 +201,10 @@ def parse_target(url: str) -> Target:
         path, baud = parse_device(url)
         return Target("", path=path, baud=baud)
     scheme = url.split("://", 1)[0].lower()
-    if scheme not in SCHEMES:
+    kind = SCHEMES.get(scheme)
+    if kind is None:
         raise AppmodeError(f"unknown URL scheme {scheme + '://'!r} in {url!r}: {URL_HELP}")
-    if scheme in NETWORK_SCHEMES:
+    if kind.network:
         _check_address(url, scheme)
     try:
         parts = urlsplit(url)
@@ -219,7 +219,7 @@ def parse_target(url: str) -> Target:
             raise AppmodeError(f"{twice[0]}= twice in {url!r}: give each option once")
     if scheme == "sim":
         _check_sim(url, parts.netloc, parts.path, options)
-    address = unquote(parts.netloc) + (parts.path if scheme in NETWORK_SCHEMES else "")
+    address = unquote(parts.netloc) + (parts.path if kind.network else "")
     radio: BleTarget | BtTarget | None = None
     remote: RemoteTarget | None = None
     if scheme == "zenoh":
@@ -230,7 +230,7 @@ def parse_target(url: str) -> Target:
         except BadRemote as exc:
             raise AppmodeError(str(exc)) from None
         _check_port(url, options)
-    if scheme in RADIO_SCHEMES:
+    if kind.radio:
         if parts.path not in ("", "/"):
             address = ""  # a path is no part of a module's address: the usage says so
         try:

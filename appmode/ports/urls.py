@@ -23,6 +23,7 @@ import serial
 from appmode import register_urls
 from appmode.errors import AppmodeError
 from appmode.ports.holders import holders
+from appmode.ports.schemes import SCHEMES
 from appmode.ports.target import AnyTarget, Target, as_target, parse_target
 
 if TYPE_CHECKING:
@@ -32,13 +33,7 @@ NO_PTY = "this system has no pseudo-terminals (Windows)"
 
 
 BAUD = 9600
-OWN_PORTS = {
-    "sim": "appmode.ports.protocol_sim",
-    "ble": "appmode.bluetooth.links.protocol_ble",
-    "bt": "appmode.bluetooth.links.protocol_bt",
-    "zenoh": "appmode.net.protocol_zenoh",
-    "socket": "appmode.ports.protocol_tcp",
-}
+OWN_PORTS = {name: scheme.port for name, scheme in SCHEMES.items() if scheme.port is not None}
 """appmode's own port classes (pyserial's handlers for these schemes): they take the
 Target itself, and say themselves what went wrong and what to do."""
 register_urls()  # in the `appmode` program, here: it imports pyserial only to open a port
