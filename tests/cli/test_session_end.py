@@ -8,6 +8,7 @@ frame would otherwise swallow. Each test checks the board's own state afterwards
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import subprocess
 import time
@@ -39,13 +40,15 @@ LONG_REPLAY = "# appmode transcript v1\n0.000 > J\n0.050 > A\n30.000 > Z\n"
 OPEN_FRAME_REPLAY = "# appmode transcript v1\n0.000 > J\n0.050 > A\n0.100 > {0:8\n"
 
 
-def _start(args: list[str], stdin: bytes = b"") -> subprocess.Popen[bytes]:
+def _start(args: list[str], stdin: bytes = b"", traceback: bool = False) -> subprocess.Popen[bytes]:
+    """`appmode ARGS` started (`traceback`: a bug prints its traceback, for the report)."""
     proc = subprocess.Popen(
         appmode_cmd(*args),
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         cwd=ROOT,
+        env={**os.environ, "APPMODE_TRACEBACK": "1"} if traceback else None,
     )
     assert proc.stdin is not None
     proc.stdin.write(stdin)
@@ -203,14 +206,15 @@ def _signal_trials(tmp_path: Path, trials: range) -> list[str]:
     wrong = []
     with board_process("--pty", "--record", str(record), "--quiet") as board:
         for count, trial in enumerate(trials):
-            proc = _start(["send", board.url, "J", "A", "wait:5"])
+            proc = _start(["send", board.url, "J", "A", "wait:5"], traceback=True)
+            err = b""
             try:
                 wait_for(lambda n=count: sent_lines(record).count("A") > n)
                 proc.send_signal(signal.SIGTERM)
                 if trial % 2:
                     time.sleep(0.001 * trial)  # the second lands at different points
                 proc.send_signal(signal.SIGHUP)
-                proc.communicate(timeout=10)
+                err = proc.communicate(timeout=10)[1]
             finally:
                 proc.kill()
             # the board, busy beside other work, may read the host's last bytes after it exits
@@ -219,7 +223,8 @@ def _signal_trials(tmp_path: Path, trials: range) -> list[str]:
             if sent_lines(record)[-1] != "Z":
                 wrong.append(f"trial {trial}: the car was left moving")
             if proc.returncode != 130:
-                wrong.append(f"trial {trial}: exit {proc.returncode}")
+                said = err.decode(errors="replace")[-1500:]
+                wrong.append(f"trial {trial}: exit {proc.returncode}: {said}")
         if board_state(board.url) != (STOPPED, DEFAULTS):
             wrong.append(f"trials {trials}: the board is not still at its defaults")
     if sent_lines(record).count("Z") < len(trials):
