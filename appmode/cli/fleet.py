@@ -9,7 +9,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, endpoint
 from appmode.text import escaped
 
 if TYPE_CHECKING:
@@ -34,6 +34,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     fleet.add_argument(
         "--connect",
         action="append",
+        type=endpoint,
         default=[],
         metavar="ENDPOINT",
         help="a share or a router to ask through: tcp/HOST:PORT (default: scout this LAN)",
@@ -45,15 +46,10 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from appmode.cli.share import a_clients_key
-    from appmode.errors import AppmodeError
     from appmode.net.config import close_session, open_session, zenoh_module
-    from appmode.ports.remote import BadRemote, check_endpoint
 
     zenoh_module()
-    try:
-        connect = tuple(check_endpoint(e) for e in args.connect)
-    except BadRemote as exc:
-        raise AppmodeError(f"--connect: {exc}") from None
+    connect = tuple(args.connect)
     key = a_clients_key(args.key, "fleet")
     session = open_session("client", key, connect=connect, scout=not connect)
     try:

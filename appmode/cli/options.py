@@ -9,6 +9,7 @@ from argparse import HelpFormatter
 from collections.abc import Callable
 from functools import partial
 
+from appmode.errors import AppmodeError
 from appmode.text import wrapped
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
@@ -163,6 +164,26 @@ def profile_name(text: str) -> str:
     except ProfileError as exc:
         raise argparse.ArgumentTypeError(str(exc).replace("\n", "; ")) from None
     return text
+
+
+def endpoint(text: str) -> str:
+    """A Zenoh endpoint to connect to, `tcp/HOST:PORT` or `tls/HOST:PORT`, checked once."""
+    return _endpoint(text, listening=False)
+
+
+def listening_endpoint(text: str) -> str:
+    """A Zenoh endpoint to listen on (port 0: a free one), checked once."""
+    return _endpoint(text, listening=True)
+
+
+def _endpoint(text: str, listening: bool) -> str:
+    """`text` checked; AppmodeError (one line, as a bad URL's) if it is no endpoint."""
+    from appmode.ports.remote import BadRemote, check_endpoint
+
+    try:
+        return check_endpoint(text, listening=listening)
+    except BadRemote as exc:
+        raise AppmodeError(str(exc)) from None
 
 
 def board_choice(

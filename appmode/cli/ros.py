@@ -19,6 +19,7 @@ from appmode.cli.options import (
     add_profile,
     add_uart2,
     board_choice,
+    endpoint,
     target,
 )
 from appmode.errors import AppmodeError, install_line
@@ -57,6 +58,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     ros.add_argument(
         "--connect",
         action="append",
+        type=endpoint,
         metavar="ENDPOINT",
         help=f"the Zenoh router (default {ROUTER}, as rmw_zenoh; may be given more than once)",
     )
@@ -133,16 +135,12 @@ def run(args: argparse.Namespace) -> int:
 def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
     from appmode.host import signals
     from appmode.net.config import close_session, open_session
-    from appmode.ports.remote import BadRemote, check_endpoint
     from appmode.ros.graph import Node
     from appmode.ros.node import TOPIC_SETS, Options, RosNode
     from appmode.session.hold import HoldToDrive
     from appmode.session.opener import open_session as open_car
 
-    try:
-        connect = tuple(check_endpoint(e) for e in args.connect or [ROUTER])
-    except BadRemote as exc:
-        raise AppmodeError(f"--connect: {exc}") from None
+    connect = tuple(args.connect or [ROUTER])
     config_file = os.environ.get("ZENOH_SESSION_CONFIG_URI") or None
     router = open_session("router", None, listen=connect) if args.router else None
     zenoh = None

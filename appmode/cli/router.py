@@ -8,7 +8,7 @@ import sys
 import time
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers
+from appmode.cli.options import Subparsers, listening_endpoint
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
 
@@ -23,6 +23,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     )
     router.add_argument(
         "--listen",
+        type=listening_endpoint,
         metavar="tcp/ADDR:PORT",
         default=DEFAULT_LISTEN,
         help=f"where it listens (default {DEFAULT_LISTEN}; tcp/0.0.0.0:7447 for every network)",
@@ -33,16 +34,11 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from appmode.cli.share import kept_key
-    from appmode.errors import AppmodeError
     from appmode.host import signals
     from appmode.net.config import close_session, free_port, open_session, zenoh_module
-    from appmode.ports.remote import BadRemote, check_endpoint
 
     zenoh_module()
-    try:
-        listen = free_port(check_endpoint(args.listen, listening=True))
-    except BadRemote as exc:
-        raise AppmodeError(f"--listen: {exc}") from None
+    listen = free_port(args.listen)
     session = open_session("router", args.key or kept_key(), listen=(listen,))
     ended = [False]
     try:

@@ -13,7 +13,16 @@ from typing import TYPE_CHECKING
 from urllib.parse import quote
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import HOLDS, Subparsers, add_chassis, add_profile, board_choice, target
+from appmode.cli.options import (
+    HOLDS,
+    Subparsers,
+    add_chassis,
+    add_profile,
+    board_choice,
+    endpoint,
+    listening_endpoint,
+    target,
+)
 from appmode.errors import AppmodeError, install_line
 
 if TYPE_CHECKING:
@@ -48,6 +57,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     share.add_argument("--name", required=True, type=car_name, help="what the car is called")
     share.add_argument(
         "--listen",
+        type=listening_endpoint,
         metavar="tcp/ADDR:PORT",
         default=DEFAULT_LISTEN,
         help=f"where other machines connect (default {DEFAULT_LISTEN}: this machine only; "
@@ -57,6 +67,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     share.add_argument(
         "--connect",
         action="append",
+        type=endpoint,
         default=[],
         metavar="ENDPOINT",
         help="connect to a Zenoh router, or to another share (shares route for each other): "
@@ -91,18 +102,9 @@ def car_name(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from appmode.net.config import free_port, zenoh_module
     from appmode.net.zenoh_log import zenoh_refusals
-    from appmode.ports.remote import BadRemote, check_endpoint
 
     zenoh_module()
-    try:
-        for endpoint in args.connect:
-            check_endpoint(endpoint)
-        listen = check_endpoint(
-            args.listen.replace("tcp/", "tls/") if args.tls else args.listen, listening=True
-        )
-    except BadRemote as exc:
-        raise AppmodeError(f"--listen/--connect: {exc}") from None
-    listen = free_port(listen)
+    listen = free_port(args.listen.replace("tcp/", "tls/", 1) if args.tls else args.listen)
     choice = board_choice(args, both=True)
     key = args.key if args.key is not None else kept_key()
     if not key or not key.isprintable():

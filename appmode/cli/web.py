@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
 from appmode.cli.live_view import attach, live_view
-from appmode.cli.options import Subparsers, board_choice, target
+from appmode.cli.options import Subparsers, board_choice, endpoint, target
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
@@ -48,6 +48,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     web.add_argument(
         "--connect",
         action="append",
+        type=endpoint,
         default=[],
         metavar="ENDPOINT",
         help="with --fleet: a share or a router to reach the cars through, tcp/HOST:PORT "
@@ -112,7 +113,6 @@ def _serve_fleet(
     """The fleet page: the cars the key opens; a car chosen there driven as URL is."""
     from appmode.cli.share import kept_key
     from appmode.net.config import close_session, open_session, zenoh_module
-    from appmode.ports.remote import BadRemote, check_endpoint
     from appmode.ports.target import shared_car
     from appmode.session.base import BaseSession
     from appmode.session.opener import open_session as open_car_session
@@ -125,10 +125,7 @@ def _serve_fleet(
             "--fleet shows the shared cars: give no URL, --uart2 or --record with it"
         )
     zenoh_module()
-    try:
-        connect = tuple(check_endpoint(e) for e in args.connect)
-    except BadRemote as exc:
-        raise AppmodeError(f"--connect: {exc}") from None
+    connect = tuple(args.connect)
     key = args.fleet_key or kept_key()
     zenoh = open_session("client", key, connect=connect, scout=not connect)
 
