@@ -25,7 +25,8 @@ TF = "tf2_msgs/msg/TFMessage"
 STRING = "std_msgs/msg/String"
 FLOAT32 = "std_msgs/msg/Float32"
 LOG = "rcl_interfaces/msg/Log"
-TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING, FLOAT32, LOG)
+PARAMETER_EVENT = "rcl_interfaces/msg/ParameterEvent"
+TYPES = (TWIST, TWIST_STAMPED, ODOMETRY, BATTERY, IMU, TF, STRING, FLOAT32, LOG, PARAMETER_EVENT)
 STORES = {"jazzy": Stores.ROS2_JAZZY, "humble": Stores.ROS2_HUMBLE}
 UNKNOWN = -1.0
 """A covariance's first element when the quantity is not measured (REP 145)."""

@@ -22,6 +22,7 @@ from appmode.protocol.odometry import Odometry, Pose2D
 from appmode.protocol.render import to_json
 from appmode.protocol.sensed import YAW_WINDOW, Inertial, yaw_rate
 from appmode.protocol.twist import BadTwist, Twist
+from appmode.ros import rosout
 from appmode.ros.graph import Durability, Node, Qos
 from appmode.ros.messages import (
     BATTERY,
@@ -29,6 +30,7 @@ from appmode.ros.messages import (
     IMU,
     LOG,
     ODOMETRY,
+    PARAMETER_EVENT,
     STRING,
     TF,
     TWIST,
@@ -57,10 +59,6 @@ HEARTBEAT = 0.5
 SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD, sporadic)."""
 STILL = Pose2D(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 """No offset: base_footprint lies under base_link (a flat car's ground projection)."""
-ROSOUT = Qos(depth=1000, durability=Durability.TRANSIENT_LOCAL, lifespan=(10, 0))
-"""/rosout's QoS, as rcl's (rcl_qos_profile_rosout_default)."""
-LEVELS = {"error:": 40, "WARNING": 30}
-"""rcl_interfaces/Log levels of the lines that start so (else INFO, 20)."""
 BATTERY_EVERY = 10
 """IMU readings a battery_state is sent for (a chassis's 20 Hz status: 2 Hz)."""
 Log = Callable[[str], None]
@@ -171,7 +169,6 @@ class RosNode:
         self._readings = 0
         self._angles: deque[tuple[float, tuple[float, float, float]]] = deque()
         """The last YAW_WINDOW s of B records' roll, pitch and yaw (degrees, REP 103)."""
-        """The time of the last A record whose twist was published."""
         self._queue: deque[bytes] = deque(maxlen=QUEUE)
         self._woken = threading.Event()
         """Set by a cmd_vel: the loop takes it at once, not at its next turn."""
@@ -187,9 +184,9 @@ class RosNode:
         self.publishers: dict[str, Publisher] = {}
         self._said: set[str] = set()
         self.services = Services(zenoh_session, graph, self.messages, self._woken)
-        self.parameters = Parameters(session, self.messages.types)
-        ns = graph.namespace.strip("/").replace("/", ".")
-        self.logger = f"{ns}.{graph.name}" if ns else graph.name
+        full = f"{graph.namespace.rstrip('/')}/{graph.name}"
+        self.parameters = Parameters(session, self.messages.types, full, self._parameter_event)
+        self.logger = full.strip("/").replace("/", ".")
         """The node's logger, as rcl names it (`robot1.appmode`)."""
 
     # ------------------------------------------------------------ the graph
@@ -207,7 +204,8 @@ class RosNode:
             ("imu", names.imu, IMU, Qos(depth=10)),
             ("raw", names.raw, STRING, Qos(depth=10)),
             ("tf_static", names.tf_static, TF, STATIC),
-            ("rosout", "/rosout", LOG, ROSOUT),
+            ("rosout", "/rosout", LOG, rosout.QOS),
+            ("parameter_events", "/parameter_events", PARAMETER_EVENT, Qos(depth=1000)),
         ]
         topics = [(name, topic, kind, qos) for name, topic, kind, qos in each if topic]
         for entity_id, (name, topic, ros_type, qos) in enumerate(topics, start=1):
@@ -330,6 +328,9 @@ class RosNode:
             )
         self.parameters.serve()
 
+    def _parameter_event(self, event: Any) -> None:
+        self._put("parameter_events", self.messages.cdr(event, PARAMETER_EVENT))
+
     def _replier(self, request: Request) -> Callable[[Any], None]:
         return lambda response: self.services.reply(request, response)
 
@@ -337,8 +338,8 @@ class RosNode:
         """A line of the node's (or its session's): on stderr and /rosout."""
         self.parameters.said(text)
         self.log(text)
-        level = next((n for start, n in LEVELS.items() if text.startswith(start)), 20)
-        self._put("rosout", self.messages.log(level, self.logger, text, time.time_ns()))
+        line = self.messages.log(rosout.level(text), self.logger, text, time.time_ns())
+        self._put("rosout", line)
 
     # ------------------------------------------------------------ the records
 
@@ -435,8 +436,7 @@ class RosNode:
         self._put("raw", self.messages.text(str(raw)))
 
     def _put(self, name: str, payload: bytes) -> None:
-        """Publish `payload` as the reading `name` (odom, tf, imu, battery, raw), where
-        the topic set publishes it."""
+        """Publish `payload` as `name` (odom, rosout, …), where the topic set has it."""
         publisher = self.publishers.get(name)
         if publisher is None:
             return

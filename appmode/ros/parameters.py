@@ -6,6 +6,7 @@ another). Nothing here is saved: `save` (std_srvs/Trigger) sends the board's sav
 
 from __future__ import annotations
 
+import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -55,9 +56,15 @@ class Parameters:
     """The parameter services' answers for `session`, made with `types` (the distro's
     rcl_interfaces messages); taken on the node's loop, never on Zenoh's threads."""
 
-    def __init__(self, session: BaseSession, types: Any) -> None:
+    def __init__(
+        self, session: BaseSession, types: Any, node: str, on_event: Reply | None = None
+    ) -> None:
         self.session = session
         self.types = types
+        self.node = node
+        """The node's full name (`/appmode`), as its parameter events name it."""
+        self.on_event = on_event
+        """Takes each rcl_interfaces/ParameterEvent (a value set, read back)."""
         self._sets: deque[Setting] = deque()
 
     def answer(self, ros_type: str, request: Any, reply: Reply) -> None:
@@ -200,6 +207,8 @@ class Parameters:
             setting = self._sets[0]
             if setting.asked is not None:
                 setting.results.append(self._outcome(setting))
+                if setting.results[-1][0]:
+                    self._changed(setting.asked)
                 setting.asked = None
             if len(setting.results) == len(setting.wanted):
                 self._sets.popleft()
@@ -234,6 +243,23 @@ class Parameters:
             return True, ""
         why = "; ".join(setting.errors) or f"the board reads back {name} = {now}"
         return False, f"not set: {why}"
+
+    def _changed(self, name: str) -> None:
+        """Say on /parameter_events that `name` changed, as rclcpp's nodes do."""
+        if self.on_event is None:
+            return
+        value = self._value(self._specs().get(name), self.session.parameters().get(name))
+        now = time.time_ns()
+        stamp = self.types["builtin_interfaces/msg/Time"](sec=now // 10**9, nanosec=now % 10**9)
+        event = self._make(
+            "msg/ParameterEvent",
+            stamp=stamp,
+            node=self.node,
+            new_parameters=[],
+            changed_parameters=[self._make("msg/Parameter", name=name, value=value)],
+            deleted_parameters=[],
+        )
+        self.on_event(event)
 
     def _answer(self, setting: Setting, why: str) -> None:
         setting.results = [(False, why)] * max(1, len(setting.wanted))

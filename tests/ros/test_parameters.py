@@ -22,8 +22,8 @@ MAX_SPEED = 800
 
 
 def services(car: Car) -> dict[str, peer.Entity]:
-    """The node's services by name, once its tokens (seven topics, seven services) show."""
-    return {e.topic: e for e in car.entities(15) if e.kind == "SS"}
+    """The node's services by name, once its tokens (eight topics, seven services) show."""
+    return {e.topic: e for e in car.entities(16) if e.kind == "SS"}
 
 
 def client(car: Car, name: str, service: str) -> peer.ServiceClient:
@@ -76,8 +76,20 @@ def set_request(car: Car, *parameters: object) -> list[object]:
 
 
 def test_a_set_reaches_the_board_and_is_answered_once_read_back(car: Car) -> None:
+    events = next(e for e in car.entities(16) if e.topic == "/parameter_events")
+    assert events.type_name == "rcl_interfaces::msg::dds_::ParameterEvent_"
+    assert events.qos == "::,1000:,:,:,,"  # rclcpp's parameter events: depth 1000
+    said = peer.Received()
+    subscriber = car.ros.declare_subscriber(events.data_key, said.on_sample)
+    time.sleep(0.3)
     (result,) = set_request(car, peer.parameter("max_speed", MAX_SPEED))
     assert result.successful, result.reason
+    time.sleep(0.3)
+    subscriber.undeclare()
+    (event,) = said.messages("rcl_interfaces/msg/ParameterEvent")
+    (changed,) = event.changed_parameters
+    assert event.node == "/appmode" and changed.name == "max_speed"
+    assert changed.value.integer_value == MAX_SPEED
     got, _ = client(car, "get_parameters", "rcl_interfaces/srv/GetParameters").call(
         names=["max_speed"]
     )
@@ -113,7 +125,7 @@ def test_refusals_say_why_and_nothing_reaches_the_board(car: Car) -> None:
 
 
 def test_save_sends_the_board_s_save_and_lines_go_to_rosout(car: Car) -> None:
-    rosout = next(e for e in car.entities(15) if e.topic == "/rosout")
+    rosout = next(e for e in car.entities(16) if e.topic == "/rosout")
     assert rosout.type_name == "rcl_interfaces::msg::dds_::Log_"
     assert rosout.qos == ":1:,1000:,:10,0:,,"  # rcl's: transient local, 10 s lifespan
     lines = peer.Received()

@@ -32,6 +32,9 @@ HASHES = {
     messages.FLOAT32: "RIHS01_7170d3d8f841f7be3172ce5f4f59f3a4d7f63b0447e8b33327601ad64d83d6e2",
     # /rosout (as a `ros2` CLI node's token on rmw_zenoh shows it)
     messages.LOG: "RIHS01_e28ce254ca8abc06abf92773b74602cdbf116ed34fbaf294fb9f81da9f318eac",
+    messages.PARAMETER_EVENT: (
+        "RIHS01_043e627780fcad87a22d225bc2a037361dba713fca6a6b9f4b869a5aa0393204"
+    ),
 }
 SERVICE_HASHES = {
     # rmw_zenoh's docs/design.md, "Services": its example service
