@@ -35,6 +35,10 @@ timeout 20 ros2 param get "${ns}/appmode" max_speed
 step "ros2 param set max_speed to what it is (expect: Set parameter successful)"
 value=$(timeout 20 ros2 param get --hide-type "${ns}/appmode" max_speed 2>/dev/null)
 [ -n "$value" ] && timeout 20 ros2 param set "${ns}/appmode" max_speed "$value"
+step "the set's /parameter_events (set it again, then read one)"
+(sleep 2; [ -n "$value" ] && timeout 20 ros2 param set "${ns}/appmode" max_speed "$value") &
+timeout 15 ros2 topic echo --once /parameter_events rcl_interfaces/msg/ParameterEvent
+wait
 step "one /rosout line"
 timeout 10 ros2 topic echo --once /rosout rcl_interfaces/msg/Log
 step "done: please send this output, and whether the car moved and stopped"
