@@ -8,7 +8,6 @@ import argparse
 import os
 import sys
 from contextlib import ExitStack
-from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.live_view import add_foxglove, attach, live_view
@@ -23,9 +22,6 @@ from appmode.cli.options import (
     target,
 )
 from appmode.errors import AppmodeError, install_line
-
-if TYPE_CHECKING:
-    pass
 
 ROUTER = "tcp/localhost:7447"
 """Where rmw_zenoh's sessions find their router (docs/design.md: the default config)."""

@@ -1,4 +1,4 @@
-"""appmode's URL schemes, one table (docs/design.md, "Extension points"): for each, the
+"""appmode's URL schemes, one table (docs/design.md, "Where a new part goes"): for each, the
 module that holds its pyserial port (`protocol_<scheme>`, as pyserial finds handlers:
 `serial.serial_for_url("sim://")` opens it in any program that imported appmode; None:
 pyserial's own), and what its address is. A scheme is added here and in its module."""

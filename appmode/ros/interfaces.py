@@ -68,7 +68,7 @@ def _renamed(value: Any) -> Any:
 
 
 def definitions(service: str) -> Fields:
-    """A service's request and response (and, for hashing, its event and itself)."""
+    """A service's request and response, as rosbags defines messages."""
     request, response = SERVICES[service]
     return {
         f"{service}_Request": _message(request),

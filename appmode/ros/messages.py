@@ -57,25 +57,22 @@ class Messages:
 
     def log(self, level: int, name: str, text: str, time_ns: int) -> bytes:
         """A line the node logs, as rcl_interfaces/Log (/rosout)."""
-        stamp = self._make(
-            "builtin_interfaces/msg/Time", sec=time_ns // 10**9, nanosec=time_ns % 10**9
-        )
+        stamp = self._stamp(time_ns)
         message = self._make(
             LOG, stamp=stamp, level=level, name=name, msg=text, file="", function="", line=0
         )
-        return self._cdr(message, LOG)
+        return self.cdr(message, LOG)
 
     def _make(self, ros_type: str, **fields: Any) -> Any:
         return self.types[ros_type](**fields)
 
-    def _header(self, time_ns: int, frame: str) -> Any:
-        stamp = self._make(
+    def _stamp(self, time_ns: int) -> Any:
+        return self._make(
             "builtin_interfaces/msg/Time", sec=time_ns // 10**9, nanosec=time_ns % 10**9
         )
-        return self._make("std_msgs/msg/Header", stamp=stamp, frame_id=frame)
 
-    def _cdr(self, message: Any, ros_type: str) -> bytes:
-        return bytes(self.store.serialize_cdr(message, ros_type))
+    def _header(self, time_ns: int, frame: str) -> Any:
+        return self._make("std_msgs/msg/Header", stamp=self._stamp(time_ns), frame_id=frame)
 
     def _vector(self, x: float, y: float, z: float) -> Any:
         return self._make("geometry_msgs/msg/Vector3", x=x, y=y, z=z)
@@ -122,7 +119,7 @@ class Messages:
                 covariance=twist_covariance,
             ),
         )
-        return self._cdr(message, ODOMETRY)
+        return self.cdr(message, ODOMETRY)
 
     def transform(self, pose: Pose2D, time_ns: int, frame: str, child: str) -> bytes:
         """`frame` → `child` as a TFMessage of one transform."""
@@ -136,7 +133,7 @@ class Messages:
                 rotation=self._quaternion(0.0, 0.0, pose.yaw),
             ),
         )
-        return self._cdr(self._make(TF, transforms=[stamped]), TF)
+        return self.cdr(self._make(TF, transforms=[stamped]), TF)
 
     def battery(self, percent: float, time_ns: int, frame: str) -> bytes:
         """The battery as the board reports it: a percentage (REP: 0–1), and the voltage
@@ -174,7 +171,7 @@ class Messages:
             location="",
             serial_number="",
         )
-        return self._cdr(message, BATTERY)
+        return self.cdr(message, BATTERY)
 
     def imu_raw(
         self,
@@ -197,7 +194,7 @@ class Messages:
             linear_acceleration=self._vector(*acceleration),
             linear_acceleration_covariance=_diagonal(3, (ACCEL_VARIANCE,) * 3),
         )
-        return self._cdr(message, IMU)
+        return self.cdr(message, IMU)
 
     def imu(
         self,
@@ -228,14 +225,14 @@ class Messages:
             linear_acceleration=self._vector(0.0, 0.0, 0.0),
             linear_acceleration_covariance=unknown.copy(),
         )
-        return self._cdr(message, IMU)
+        return self.cdr(message, IMU)
 
     def text(self, data: str) -> bytes:
-        return self._cdr(self._make(STRING, data=data), STRING)
+        return self.cdr(self._make(STRING, data=data), STRING)
 
     def float32(self, value: float) -> bytes:
         """A std_msgs/Float32 (the vendor driver's PowerVoltage, in volts)."""
-        return self._cdr(self._make(FLOAT32, data=value), FLOAT32)
+        return self.cdr(self._make(FLOAT32, data=value), FLOAT32)
 
     def twist(self, payload: bytes, stamped: bool) -> tuple[float, float, float, float]:
         """A Twist's (or TwistStamped's) linear x and y and angular z, and its angular x

@@ -20,7 +20,7 @@ import serial
 
 import appmode.ports.urls  # noqa: F401 - registers ble:// and bt:// with pyserial
 from appmode.testing.served import ServedBoard
-from tests.support.processes import ROOT, appmode_cmd, run, wait_for
+from tests.support.processes import ROOT, appmode_cmd, run, scripted, wait_for
 
 BLEAK_ONLY = textwrap.dedent(
     """
@@ -104,17 +104,7 @@ def driving(board: ServedBoard) -> subprocess.Popen[str]:
     """`appmode drive` over the board's BLE module, driving forward (script mode) until
     it is stopped; the board moving."""
     assert board.ble is not None
-    proc = subprocess.Popen(
-        appmode_cmd("drive", board.ble),
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    assert proc.stdin is not None
-    proc.stdin.write("drive A\nwait 60\n")
-    proc.stdin.flush()
+    proc = scripted(board.ble, "drive A\nwait 60\n")
     try:
         board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
     except BaseException:
@@ -335,17 +325,7 @@ def test_a_link_lost_for_good_is_never_shown_as_a_stop(appmode_ble_board: Served
     not delivered."""
     board = appmode_ble_board
     assert board.bus is not None and board.ble is not None
-    proc = subprocess.Popen(
-        appmode_cmd("drive", board.ble),
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    assert proc.stdin is not None
-    proc.stdin.write("drive A\nwait 4\nstatus\nquit\n")
-    proc.stdin.flush()
+    proc = scripted(board.ble, "drive A\nwait 4\nstatus\nquit\n")
     try:
         board.wait_until(lambda s: s.moving, timeout=15, what="a moving car")
         kill_bus(board.bus)

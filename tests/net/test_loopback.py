@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from appmode.web.certificate import own_certificate
-from tests.support.processes import ROOT, appmode_cmd, run, stop_process
+from tests.support.processes import ROOT, appmode_cmd, run, scripted, stop_process
 from tests.support.shares import KEY, shared_board
 from tests.testing.test_plugin import pytest_in
 
@@ -185,21 +185,6 @@ def test_a_shared_car_whose_serial_link_is_down_is_said_so_remotely(tmp_path: Pa
     assert "baud rate" not in done.stderr
 
 
-def _driving(url: str, script: str) -> subprocess.Popen[str]:
-    proc = subprocess.Popen(
-        appmode_cmd("drive", url),
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    assert proc.stdin is not None
-    proc.stdin.write(script)
-    proc.stdin.flush()
-    return proc
-
-
 def _ended(proc: subprocess.Popen[str]) -> tuple[str, str]:
     assert proc.stdin is not None and proc.stdout is not None and proc.stderr is not None
     proc.stdin.close()
@@ -215,7 +200,7 @@ def test_a_driver_is_told_truly_how_its_share_ended(ending: str, tmp_path: Path)
     import time
 
     with shared_board(tmp_path, "car") as car:
-        driver = _driving(car.url, "drive A\nwait 4\n")
+        driver = scripted(car.url, "drive A\nwait 4\n")
         time.sleep(2.5)
         if ending == "SIGKILL":
             car.share.kill()
@@ -238,9 +223,9 @@ def test_a_take_over_is_said_as_the_hosts_stop_not_as_the_control_port(tmp_path:
     import time
 
     with shared_board(tmp_path, "car") as car:
-        first = _driving(car.url, "drive A\nwait 5\n")
+        first = scripted(car.url, "drive A\nwait 5\n")
         time.sleep(2)
-        second = _driving(f"{car.url}&take=1", "wait 3\n")
+        second = scripted(f"{car.url}&take=1", "wait 3\n")
         out, _ = _ended(first)
         taken, _ = _ended(second)
         sent = car.sent()

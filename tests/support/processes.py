@@ -65,6 +65,23 @@ def serving(
     return proc, proc.stdout.readline() if selector.select(45) else ""
 
 
+def scripted(url: str, script: str) -> subprocess.Popen[str]:
+    """`appmode drive URL` in script mode, `script` given on its standard input (which
+    stays open: the session runs on after the script's last line)."""
+    proc = subprocess.Popen(
+        appmode_cmd("drive", url),
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    assert proc.stdin is not None
+    proc.stdin.write(script)
+    proc.stdin.flush()
+    return proc
+
+
 def stop_process(proc: subprocess.Popen[str], sig: int = signal.SIGTERM) -> str:
     """Send `sig` to a process still running, wait for its end (kill it after 10 s);
     return its stderr."""
