@@ -204,13 +204,6 @@ class ServiceClient:
 def parameter(name: str, value: int | float) -> Any:
     """An rcl_interfaces/Parameter as `ros2 param set` sends it (integer or double)."""
     types = JAZZY.types
-    empty = {
-        "byte_array_value": np.zeros(0, dtype=np.uint8),
-        "bool_array_value": np.zeros(0, dtype=bool),
-        "integer_array_value": np.zeros(0, dtype=np.int64),
-        "double_array_value": np.zeros(0, dtype=np.float64),
-        "string_array_value": [],
-    }
     kind = 2 if isinstance(value, int) else 3
     parameter_value = types["rcl_interfaces/msg/ParameterValue"](
         type=kind,
@@ -218,6 +211,10 @@ def parameter(name: str, value: int | float) -> Any:
         integer_value=value if kind == 2 else 0,
         double_value=float(value) if kind == 3 else 0.0,
         string_value="",
-        **empty,
+        byte_array_value=np.zeros(0, dtype=np.uint8),
+        bool_array_value=np.zeros(0, dtype=bool),
+        integer_array_value=np.zeros(0, dtype=np.int64),
+        double_array_value=np.zeros(0, dtype=np.float64),
+        string_array_value=[],
     )
     return types["rcl_interfaces/msg/Parameter"](name=name, value=parameter_value)
