@@ -197,6 +197,7 @@ class Boards:
                 stderr=errors,
                 text=True,
                 cwd=self.cwd,
+                env=dict(os.environ, XDG_DATA_HOME=str(self.cwd / "data")),  # its host key
             )
         self.procs.append(proc)
         shown = [_line(proc.stdout)]
@@ -245,7 +246,7 @@ def _line(stream: object) -> str:
 
 
 def run_shell(command: str, cwd: Path) -> str:
-    env = dict(os.environ, PYTHONUNBUFFERED="1", COLUMNS="80")
+    env = dict(os.environ, PYTHONUNBUFFERED="1", COLUMNS="80", XDG_DATA_HOME=str(cwd / "data"))
     prelude = f'appmode() {{ {shlex.quote(sys.executable)} -m appmode "$@"; }}\n'
     prelude += f'python() {{ {shlex.quote(sys.executable)} "$@"; }}\n'
     done = subprocess.run(

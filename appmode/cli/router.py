@@ -9,6 +9,7 @@ import time
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, listening_endpoint
+from appmode.cli.share import add_host_key
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
 
@@ -19,7 +20,8 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help=COMMANDS["router"],
         description="Run a Zenoh router (no zenohd needed): appmode share --connect and every "
         "zenoh:// URL's connect= may name it, across networks a LAN's scouting does not "
-        "reach. It admits only clients with the key. Needs the net extra.",
+        "reach. It admits only clients with the key, and holds them to a client's role: only "
+        "the cars' hosts, with the room's host key, speak for a car. Needs the net extra.",
     )
     router.add_argument(
         "--listen",
@@ -29,17 +31,19 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help=f"where it listens (default {DEFAULT_LISTEN}; tcp/0.0.0.0:7447 for every network)",
     )
     router.add_argument("--key", help="the key (default: this machine's share key)")
+    add_host_key(router)
     return router
 
 
 def run(args: argparse.Namespace) -> int:
-    from appmode.cli.share import kept_key
+    from appmode.cli.share import host_key, kept_key
     from appmode.host import signals
     from appmode.net.config import close_session, free_port, open_session, zenoh_module
 
     zenoh_module()
     listen = free_port(args.listen)
-    session = open_session("router", args.key or kept_key(), listen=(listen,))
+    key = args.key or kept_key()
+    session = open_session("router", key, listen=(listen,), host_key=host_key(args))
     ended = [False]
     try:
         print(f"router: {listen}", flush=True)

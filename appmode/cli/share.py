@@ -33,6 +33,9 @@ DEFAULT_LISTEN = "tcp/127.0.0.1:7450"
 KEY_FILE = "share.key"
 """The share's key, kept in appmode's data folder (made on first use, the user's
 alone): the URL another machine pasted stays good from one share to the next."""
+HOST_KEY_FILE = "share.host-key"
+"""The room's host key, kept beside it: shares and routers that hold it speak for cars
+(`net.roles`); a client's key does not. Copy it to each car's host and router of a room."""
 KEY_BYTES = 18
 """A new key's random bytes (24 characters of URL-safe text)."""
 
@@ -78,6 +81,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="the key a client needs (any printable text; default: appmode's own, made on "
         "first use and kept in its data folder)",
     )
+    add_host_key(share)
     share.add_argument(
         "--tls",
         action="store_true",
@@ -87,6 +91,25 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_profile(share, f"the car's profile, {HOLDS}", default=None)
     add_chassis(share, "share a WHEELTEC car's chassis port (clients open it with port=chassis)")
     return share
+
+
+def add_host_key(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--host-key",
+        metavar="KEY",
+        help="the room's host key, which only its cars' hosts and routers hold (clients "
+        "cannot speak for a car without it); default: appmode's own, made on first use "
+        f"and kept in its data folder ({HOST_KEY_FILE}): copy it to every share and router "
+        "that connect to each other",
+    )
+
+
+def host_key(args: argparse.Namespace) -> str:
+    """The host key given, else this machine's own."""
+    key: str = args.host_key if args.host_key is not None else kept_key(HOST_KEY_FILE)
+    if not key or not key.isprintable():
+        raise AppmodeError("--host-key: give printable text, the same on every host of a room")
+    return key
 
 
 def car_name(text: str) -> str:
@@ -130,7 +153,13 @@ def _serve(
 
     host = listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]")
     session = open_session(
-        "peer", key, listen=(listen,), connect=tuple(args.connect), scout=everywhere, tls=tls
+        "peer",
+        key,
+        listen=(listen,),
+        connect=tuple(args.connect),
+        scout=everywhere,
+        tls=tls,
+        host_key=host_key(args),
     )
     shared: Share | None = None
     try:
@@ -180,24 +209,25 @@ def _lan_address() -> str:
     return found[0] if found else socket.gethostname()
 
 
-def kept_key() -> str:
-    """appmode's own share key: made on first use, the user's alone, then the same."""
-    key = own_key()
+def kept_key(file: str = KEY_FILE) -> str:
+    """appmode's own share key (or host key): made on first use, the user's alone, then
+    the same."""
+    key = own_key(file)
     if key is None:
         key = secrets.token_urlsafe(KEY_BYTES)
-        _write_private(key_path(), key)
+        _write_private(key_path(file), key)
     return key
 
 
-def key_path() -> Path:
+def key_path(file: str = KEY_FILE) -> Path:
     from appmode.files import data_folder
 
-    return data_folder() / KEY_FILE
+    return data_folder() / file
 
 
-def own_key() -> str | None:
-    """This machine's share key, None if it has none (nothing is made)."""
-    path = key_path()
+def own_key(file: str = KEY_FILE) -> str | None:
+    """This machine's share key (or host key), None if it has none (nothing is made)."""
+    path = key_path(file)
     try:
         return path.read_text(encoding="utf-8").strip()
     except FileNotFoundError:

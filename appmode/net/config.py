@@ -17,7 +17,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 from appmode.errors import AppmodeError, install_line
-from appmode.net.names import USER
+from appmode.net.names import HOST_USER, USER
+from appmode.net.roles import access_control
 
 if TYPE_CHECKING:
     import zenoh
@@ -69,11 +70,14 @@ def open_session(
     scout: bool = False,
     tls: Tls | None = None,
     config_file: str | None = None,
+    host_key: str | None = None,
 ) -> zenoh.Session:
     """A Zenoh session (`key` None: no authentication, as ROS's own sessions; a
-    `config_file` is Zenoh's own configuration, used as it is); AppmodeError (one line,
-    no source paths) when it cannot open: nothing listens where it connects, or the key
-    was refused."""
+    `config_file` is Zenoh's own configuration, used as it is); with `host_key`, a car's
+    host's or a router's: it connects as a host, admits the key's holders and the room's
+    hosts, and holds its key holders to their role (`roles`). AppmodeError (one line, no
+    source paths) when it cannot open: nothing listens where it connects, or the key was
+    refused."""
     import zenoh
 
     if config_file is not None:
@@ -100,8 +104,11 @@ def open_session(
         _tls(config, tls)
     with tempfile.TemporaryDirectory(prefix="appmode-zenoh-") as folder:
         if key is not None:  # None: as ROS's sessions, anyone who reaches it
-            auth = _auth(key, Path(folder), admits=bool(listen) or mode == "router")
+            admits = bool(listen) or mode == "router"
+            auth = _auth(key, host_key, Path(folder), admits)
             config.insert_json5("transport/auth/usrpwd", json.dumps(auth))
+            if host_key is not None and admits:
+                config.insert_json5("access_control", json.dumps(access_control()))
         try:
             return zenoh.open(config)
         except zenoh.ZError as exc:
@@ -138,15 +145,20 @@ def certificate_refused(connect: tuple[str, ...], ca: str) -> str | None:
     return None
 
 
-def _auth(key: str, folder: Path, admits: bool) -> dict[str, str]:
-    """User-password authentication with `key`; a session that `admits` others (it
-    listens, or routes) takes only the key's holders (a file in `folder`, yours alone)."""
+def _auth(key: str, host_key: str | None, folder: Path, admits: bool) -> dict[str, str]:
+    """User-password authentication with `key` (as a host with `host_key`); a session
+    that `admits` others (it listens, or routes) takes only the key's holders and, for a
+    host, the room's hosts (a file in `folder`, yours alone)."""
     auth = {"user": USER, "password": key}
+    if host_key is not None:
+        auth = {"user": HOST_USER, "password": host_key}
     if admits:
         users = folder / "users"
         fd = os.open(users, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, "w", encoding="utf-8") as file:
             file.write(f"{USER}:{key}\n")
+            if host_key is not None:
+                file.write(f"{HOST_USER}:{host_key}\n")
         auth["dictionary_file"] = str(users)
     return auth
 

@@ -10,7 +10,7 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from appmode.net.names import ANY_INFO, ANY_STOP, name_of
+from appmode.net.names import ANY_INFO, ANY_STOP, Keys, name_of
 from appmode.ports.remote import NAME
 
 if TYPE_CHECKING:
@@ -47,8 +47,10 @@ def cars(session: zenoh.Session, wait: float = ASK) -> list[Car]:
         if reply.ok is None:
             continue
         info = _object(reply.ok)
-        name = name_of(str(reply.ok.key_expr))
-        if info is not None and NAME.fullmatch(name):  # a forged 20,000-character name: none
+        key = str(reply.ok.key_expr)
+        name = name_of(key)
+        if info is not None and NAME.fullmatch(name) and key == Keys(name).info:  # a forged
+            # 20,000-character name, or a wildcard's (`**`) reply: none
             found[name] = Car(name, info, (time.monotonic() - sent) * 1000)
     return [found[name] for name in sorted(found)]
 
@@ -66,7 +68,13 @@ def stop_all(session: zenoh.Session, wait: float = STOPPING) -> list[dict[str, A
         attachment=who,
         timeout=wait,
     )
-    answers = [answer for r in replies if r.ok is not None and (answer := _object(r.ok))]
+    answers = [
+        answer
+        for r in replies
+        if r.ok is not None
+        and (answer := _object(r.ok))
+        and str(r.ok.key_expr) == Keys(str(answer.get("name"))).stop  # its own car's
+    ]
     return sorted(answers, key=lambda answer: str(answer.get("name")))
 
 

@@ -7,7 +7,10 @@ from dataclasses import dataclass
 
 ROOT = "appmode"
 USER = "appmode"
-"""The user name of Zenoh's user-password authentication: the key is the password."""
+"""A key holder's user name in Zenoh's user-password authentication (the key is its
+password): it asks, watches and drives (`roles`)."""
+HOST_USER = "appmode-host"
+"""A car's host's user name (the room's host key is its password): it speaks for cars."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,5 +79,13 @@ ANY_STOP = f"{ROOT}/*/stop"
 
 
 def name_of(key: str) -> str:
-    """The car's name in one of its keys."""
-    return key.split("/")[1]
+    """The car's name in one of its keys ("" when it is none of a car's)."""
+    parts = key.split("/")
+    return parts[1] if len(parts) > 2 and parts[0] == ROOT else ""
+
+
+def concrete(key: object) -> bool:
+    """Whether a sample's, reply's or token's key names one thing: one published on a
+    wildcard (`**`, `appmode/*/events`, which Zenoh delivers to every subscriber it
+    intersects) is nobody's word."""
+    return "*" not in str(key)

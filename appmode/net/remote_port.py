@@ -27,8 +27,9 @@ from serial import SerialException
 from appmode.errors import AppmodeError
 from appmode.host import far
 from appmode.net.config import Tls, close_session, open_session, zenoh_module
-from appmode.net.names import Keys
-from appmode.net.share import unstamp
+from appmode.net.names import Keys, concrete
+from appmode.net.proof import Prover
+from appmode.net.stamps import unstamp
 from appmode.ports.modemless import Modemless
 from appmode.ports.remote import RemoteTarget, WriteRefused
 from appmode.ports.urls import port_target
@@ -84,6 +85,8 @@ class RemoteSerial(Modemless):
         self._remote, self._side = remote, target.sim_port
         self._keys = Keys(remote.name)
         self._client = new_client()
+        self._prover = Prover()
+        """What proves this client's heartbeats and writes its own, once it drives."""
         self._ready = threading.Condition()
         self._rx = bytearray()
         self._rx_times: deque[list[float]] = deque()
@@ -131,7 +134,10 @@ class RemoteSerial(Modemless):
         name = self._remote.name
         sent = time.monotonic()
         replies = list(self._session.get(self._keys.info, timeout=FIND))
-        found = next((r.ok for r in replies if r.ok is not None), None)
+        found = next(
+            (r.ok for r in replies if r.ok is not None and str(r.ok.key_expr) == self._keys.info),
+            None,
+        )
         if found is None:
             raise SerialException(
                 f"no car named {name} answers at {self._where()}: is 'appmode share --name "
@@ -167,9 +173,10 @@ class RemoteSerial(Modemless):
     # ------------------------------------------------------------ what comes
 
     def _on_bytes(self, sample: zenoh.Sample) -> None:
-        if sample.attachment is None:
+        stamped = None if sample.attachment is None else unstamp(sample.attachment.to_bytes())
+        if stamped is None or not concrete(sample.key_expr):
             return
-        at, direction = unstamp(sample.attachment.to_bytes())
+        at, direction = stamped
         if direction not in RECEIVED_DIRECTIONS:
             return
         data = sample.payload.to_bytes()
@@ -186,8 +193,13 @@ class RemoteSerial(Modemless):
             self._ready.notify_all()
 
     def _on_event(self, sample: zenoh.Sample) -> None:
+        try:
+            event = json.loads(sample.payload.to_string())
+        except ValueError:
+            return
+        if not concrete(sample.key_expr) or not isinstance(event, dict):
+            return  # nobody's word (a wildcard's), or not the car's host's
         self._host_heard = time.monotonic()
-        event = json.loads(sample.payload.to_string())
         if event.get("t") == "dropped" and event.get("client") == self._client:
             self._lose(str(event.get("why")))
         elif event.get("t") in ("stopped", "unstopped"):
@@ -207,7 +219,7 @@ class RemoteSerial(Modemless):
     def _on_presence(self, sample: zenoh.Sample) -> None:
         import zenoh
 
-        if sample.kind != zenoh.SampleKind.DELETE:
+        if sample.kind != zenoh.SampleKind.DELETE or not concrete(sample.key_expr):
             return
         name = self._remote.name
         said = self._closing.wait(CLOSING)  # the share says why it goes, before it goes
@@ -242,8 +254,9 @@ class RemoteSerial(Modemless):
                     "is cut?): it stops the car when this client falls silent to it"
                 )
                 return
+            proof = self._prover.words("alive", self._client)
             try:
-                self._session.put(alive, self._client)
+                self._session.put(alive, self._client + proof)
             except Exception:  # a session closing under it: the port is closing too
                 return
 
@@ -304,10 +317,12 @@ class RemoteSerial(Modemless):
         if self._remote.take and self._remote.name not in _TOOK:
             self._take()
         sent = time.monotonic()
-        until = sent - self._origin + WRITE_TIMEOUT  # the car's clock: after it, not written
+        until = f"{sent - self._origin + WRITE_TIMEOUT:.3f}"  # the car's clock: after it,
+        # not written
+        proof = self._prover.words("write", self._client, until, payload)
         with far.acknowledging():  # the car's host is the stop authority while it waits
             replies = list(
-                self._writer.get(payload=payload, attachment=f"{self._client} {until:.3f}")
+                self._writer.get(payload=payload, attachment=f"{self._client} {until}{proof}")
             )
         self.latency = (time.monotonic() - sent) * 1000
         if not replies:
@@ -316,8 +331,16 @@ class RemoteSerial(Modemless):
         reply = replies[0]
         if reply.ok is None:
             raise _write_error(reply.err)
-        self.written_at = float(json.loads(reply.ok.payload.to_string())["at"])
+        said = json.loads(reply.ok.payload.to_string())
+        self._granted(said)
+        self.written_at = float(said["at"])
         return len(payload)
+
+    def _granted(self, said: dict[str, Any]) -> None:
+        """Keep the secret the car's host granted the lease with (`proof`)."""
+        secret = said.get("secret")
+        if isinstance(secret, str):
+            self._prover.secret = secret
 
     def _take(self) -> None:
         """Take the driving over (`take=1`), once: the car's host stops the car first."""
@@ -331,6 +354,9 @@ class RemoteSerial(Modemless):
         if not replies or error is not None:
             why = "no answer" if error is None else error.payload.to_string()
             raise SerialException(f"cannot take the driving of {self._remote.name}: {why}")
+        granted = replies[0].ok
+        with contextlib.suppress(ValueError):
+            self._granted(json.loads(granted.payload.to_string()) if granted else {})
         _TOOK.add(self._remote.name)
 
     def _check(self) -> None:
@@ -364,9 +390,10 @@ class RemoteSerial(Modemless):
         self._beating.set()
         with contextlib.suppress(Exception):  # a session already gone has nothing to close
             body = json.dumps({"let_go": True})
+            proof = self._prover.words("lease", self._client, body)
             list(
                 self._session.get(
-                    self._keys.lease, payload=body, attachment=self._client, timeout=0.5
+                    self._keys.lease, payload=body, attachment=self._client + proof, timeout=0.5
                 )
             )
             for declared in self._declared:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import socket
-import struct
 import threading
 import time
 from collections.abc import Callable
@@ -22,10 +21,11 @@ from appmode.host.app.stop_check import SETTLE
 from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
 from appmode.host.link import Cut, LinkLost
-from appmode.net.asked import NOT_ASKED, asked_by, json_of, text_of, write_refusal
+from appmode.net.asked import NOT_ASKED, asked_by, json_of, proof_of, text_of, write_refusal
 from appmode.net.hosts import claim
-from appmode.net.lease import Driver, Granted, Lease, Refused, Revoked
-from appmode.net.names import ANY_STOP, Keys
+from appmode.net.lease import Driver, Granted, Lease, Refused, Revoked, Unproven
+from appmode.net.names import ANY_STOP, Keys, concrete
+from appmode.net.stamps import stamp
 from appmode.protocol import app
 from appmode.protocol.reader import SENT_DIRECTIONS
 from appmode.protocol.render import to_json
@@ -42,19 +42,7 @@ INFO_EVERY = 1.0
 """Seconds between two `info` samples published while nothing changes."""
 FRESH = 1.0
 """Seconds an A record tells whether the car moves."""
-STAMP = struct.Struct("<d")
-"""A byte sample's attachment: the car's time of it (seconds, its host's clock), then
-its direction (`>`, `<`, `2>`, `2<`)."""
 Log = Callable[[str], None]
-
-
-def stamp(time: float, direction: str) -> bytes:
-    return STAMP.pack(time) + direction.encode()
-
-
-def unstamp(attachment: bytes) -> tuple[float, str]:
-    """A byte sample's (time at the car, direction)."""
-    return STAMP.unpack_from(attachment)[0], attachment[STAMP.size :].decode()
 
 
 @dataclass
@@ -146,13 +134,17 @@ class Share:
     def _writer(self, port: str) -> Callable[[zenoh.Query], None]:
         def on_write(query: zenoh.Query) -> None:
             data = b"" if query.payload is None else query.payload.to_bytes()
-            asker = asked_by(query, self.keys.write(port))
-            client, refused = write_refusal(asker, data, self.now())
+            words = asked_by(query, self.keys.write(port))
+            refused = write_refusal(words, data, self.now())
             with self._lock:
-                refused = refused or self._may_drive(client, take=False)
+                if refused is None and words is not None:
+                    proof = proof_of(words, 2)
+                    proven = self.lease.proves(words[0], "write", proof, words[1], data)
+                    refused = self._may_drive(words[0], take=False, proven=proven)
                 if refused is not None:
                     query.reply_err(json.dumps({"refused": refused}))
                     return
+                secret = self._secret()
                 host = self.ports[port].host
                 self._used.add(port)
                 host.stop_on_close = True
@@ -170,26 +162,19 @@ class Share:
             except AppmodeError:
                 pass  # written: only the share's own recording failed
             written = self._written.get(port)
-            reply = {"at": self.now() if written is None else written, "driving": True}
-            query.reply(query.key_expr, json.dumps(reply))
+            at = self.now() if written is None else written
+            query.reply(query.key_expr, json.dumps({"at": at, "driving": True, **secret}))
 
         return on_write
 
-    def _may_drive(self, client: str, take: bool) -> str | None:
+    def _may_drive(self, client: str, take: bool, proven: bool) -> str | None:
         """None when `client` may drive (the lease granted it), else why not."""
         machine = client.rsplit("-", 2)[0]
-        answer = self.lease.ask(client, machine, self.now(), take)
-        if isinstance(answer, Revoked):
-            return (
-                f"this client's lease on {self.keys.name} was revoked (it went silent, or was "
-                "stopped or taken over): it drives no more; reconnect to drive again"
-            )
+        answer = self.lease.ask(client, machine, self.now(), take, proven)
+        if isinstance(answer, Unproven | Revoked):
+            return answer.why(self.keys.name)
         if isinstance(answer, Refused):
-            held = self.now() - answer.driver.since
-            return (
-                f"{self.keys.name} is driven from {answer.driver.machine} (for {held:.0f} s): "
-                "watch it, or take the driving over with take=1 in the URL"
-            )
+            return answer.why(self.keys.name, self.now())
         assert isinstance(answer, Granted)
         if answer.took_from is not None:
             self._stop_car(f"{machine} took the driving over from {answer.took_from.machine}")
@@ -200,36 +185,44 @@ class Share:
         return None
 
     def _on_lease(self, query: zenoh.Query) -> None:
-        client = asked_by(query, self.keys.lease)
+        words = asked_by(query, self.keys.lease)
         asked = json_of(query)
-        if client is None or asked is None:
+        if words is None or asked is None:
             query.reply_err(NOT_ASKED)
             return
+        client, body = words[0], text_of(query.payload) or ""
         with self._lock:
+            proven = self.lease.proves(client, "lease", proof_of(words, 1), body)
             if asked.get("let_go"):
-                driver = self.lease.let_go(client)
+                driver = self.lease.let_go(client) if proven else None
                 if driver is not None:
                     self._stop_car(f"the driver on {driver.machine} let go of the driving")
                 query.reply(query.key_expr, json.dumps({"granted": False}))
                 return
-            refused = self._may_drive(client, take=bool(asked.get("take")))
+            refused = self._may_drive(client, take=bool(asked.get("take")), proven=proven)
+            secret = self._secret()
         if refused is not None:
             query.reply_err(refused)
         else:
-            query.reply(query.key_expr, json.dumps({"granted": True}))
+            query.reply(query.key_expr, json.dumps({"granted": True, **secret}))
+
+    def _secret(self) -> dict[str, str]:
+        """The driver's secret, for the reply to its own granted query (only it gets it)."""
+        driver = self.lease.driver
+        return {} if driver is None else {"secret": driver.secret}
 
     def _on_alive(self, sample: zenoh.Sample) -> None:
-        client = text_of(sample.payload)
-        if client:
+        words = (text_of(sample.payload) or "").split(" ")
+        if str(sample.key_expr) == self.keys.alive and words[0]:
             with self._lock:
-                self.lease.beat(client, self.now())
+                self.lease.beat(words[0], self.now(), proof_of(words, 1))
 
     def _on_driver(self, sample: zenoh.Sample) -> None:
         """A client's Zenoh session ended (its liveliness token went): if it drove, the
         car stops now, without waiting for the lease to lapse."""
         import zenoh
 
-        if sample.kind != zenoh.SampleKind.DELETE:
+        if sample.kind != zenoh.SampleKind.DELETE or not concrete(sample.key_expr):
             return
         client = str(sample.key_expr).rsplit("/", 1)[1]
         with self._lock:

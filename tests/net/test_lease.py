@@ -1,9 +1,11 @@
 """Who drives a shared car (`net.lease`, no I/O): a client whose lease was taken from it
-drives no more (issue 80.8: a frozen driver woke up and drove again)."""
+drives no more (issue 80.8: a frozen driver woke up and drove again); a key holder
+under the driver's id renews nothing and drives nothing (issue 80.4)."""
 
 from __future__ import annotations
 
-from appmode.net.lease import LAPSE, Granted, Lease, Refused, Revoked
+from appmode.net.lease import LAPSE, Granted, Lease, Refused, Revoked, Unproven
+from appmode.net.proof import Proof, Prover
 
 
 def test_a_lapsed_driver_is_revoked_and_another_link_drives() -> None:
@@ -26,3 +28,30 @@ def test_one_taken_over_or_stopped_is_revoked_one_that_let_go_is_not() -> None:
     lease.ask("c-1-z", "c", 0.4)
     assert lease.let_go("c-1-z") is not None  # it closed
     assert lease.ask("c-1-z", "c", 0.5) == Granted()
+
+
+def _proof(words: str) -> Proof | None:
+    return Proof.parse(words.split(" "))
+
+
+def test_only_the_driver_s_proof_renews_its_lease_or_drives_under_its_id() -> None:
+    lease = Lease()
+    assert lease.ask("a-1-x", "a", 0.0) == Granted()
+    assert lease.driver is not None
+    driver, forger = Prover(), Prover()
+    driver.secret, forger.secret = lease.driver.secret, "0" * 32
+    beat = _proof(driver.words("alive", "a-1-x"))
+    lease.beat("a-1-x", 0.2, beat)
+    assert not lease.lapsed_at(0.2 + LAPSE)  # renewed at 0.2
+    lease.beat("a-1-x", 0.4, beat)  # the same beat again, replayed
+    lease.beat("a-1-x", 0.4, _proof(forger.words("alive", "a-1-x")))  # another secret
+    lease.beat("a-1-x", 0.4, None)  # the bare id
+    assert lease.lapsed_at(0.21 + LAPSE)
+    write = _proof(driver.words("write", "a-1-x", "9.5", b"A"))
+    assert not lease.proves("a-1-x", "write", write, "9.5", b"B")  # other bytes
+    assert not lease.proves("a-1-x", "alive", write, "9.5", b"A")  # another kind
+    assert not lease.proves("b-1-y", "write", write, "9.5", b"A")  # another id
+    assert lease.proves("a-1-x", "write", write, "9.5", b"A")
+    assert not lease.proves("a-1-x", "write", write, "9.5", b"A")  # once only
+    assert lease.ask("a-1-x", "a", 0.3) == Unproven()
+    assert lease.ask("a-1-x", "a", 0.3, proven=True) == Granted()

@@ -13,7 +13,7 @@ import pytest
 
 from appmode.web.certificate import own_certificate
 from tests.support.processes import ROOT, appmode_cmd, run, scripted, stop_process
-from tests.support.shares import KEY, shared_board
+from tests.support.shares import HOST_KEY, KEY, shared_board
 from tests.testing.test_plugin import pytest_in
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
@@ -41,7 +41,7 @@ def test_tls_checks_the_key_and_needs_the_share_s_certificate(tmp_path: Path) ->
 
 def test_a_car_through_a_router_is_driven_and_listed(tmp_path: Path) -> None:
     router = subprocess.Popen(
-        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY),
+        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY, "--host-key", HOST_KEY),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

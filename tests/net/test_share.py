@@ -19,6 +19,7 @@ import pytest
 from appmode.testing.process import BoardProcess
 from tests.support.netns import Machine, lan, why_not
 from tests.support.processes import ROOT, sent_lines, timed_sent, wait_for
+from tests.support.shares import HOST_KEY
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
 WHY = why_not()
@@ -58,7 +59,18 @@ class SharedCar:
 
 def start_share(car: Machine, board: BoardProcess, *args: str) -> tuple[subprocess.Popen[str], str]:
     share = car.popen(
-        "share", board.url, board.uart2, "--name", "car", "--listen", LISTEN, "--key", KEY, *args
+        "share",
+        board.url,
+        board.uart2,
+        "--name",
+        "car",
+        "--listen",
+        LISTEN,
+        "--key",
+        KEY,
+        "--host-key",
+        HOST_KEY,
+        *args,
     )
     assert share.stdout is not None
     url = share.stdout.readline().strip()
@@ -351,8 +363,9 @@ def test_a_second_car_of_one_name_on_one_key_is_not_shared(shared: SharedCar) ->
     record2 = shared.record.with_name("board2.transcript")
     board2 = BoardProcess("--pty", "--quiet", "--record", str(record2))
     second = shared.machines["stranger"].popen(
-        "share", board2.url, "--name", "car", "--listen", LISTEN, "--key", KEY
-    )
+        "share", board2.url, "--name", "car", "--listen", LISTEN, "--key", KEY,
+        "--host-key", HOST_KEY,
+    )  # fmt: skip
     try:
         out, err = second.communicate(timeout=30)
         assert second.returncode == 2 and not out.strip(), out + err
@@ -387,7 +400,7 @@ def test_a_tls_share_is_not_reached_through_a_plain_share_of_its_key(shared: Sha
     board2 = BoardProcess("--pty", "--quiet", "--record", str(record2))
     secure = shared.machines["stranger"].popen(
         "share", board2.url, "--name", "secure", "--listen", "tcp/0.0.0.0:7451", "--key", KEY,
-        "--tls",
+        "--host-key", HOST_KEY, "--tls",
     )  # fmt: skip
     try:
         assert secure.stdout is not None

@@ -17,6 +17,7 @@ import pytest
 from appmode.testing.process import BoardProcess
 from tests.support.netns import why_not
 from tests.support.processes import timed_sent, wait_for
+from tests.support.shares import HOST_KEY
 from tests.support.wan import wan
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
@@ -35,8 +36,9 @@ def test_a_slow_link_stops_no_live_driver_and_a_lost_one_stops_the_car(
     with wan(delay=0.15, loss=0.0) as (machines, link):
         car, laptop = machines["car"], machines["laptop"]
         share = car.popen(
-            "share", board.url, "--name", "car", "--listen", "tcp/0.0.0.0:7450", "--key", "k"
-        )
+            "share", board.url, "--name", "car", "--listen", "tcp/0.0.0.0:7450", "--key", "k",
+            "--host-key", HOST_KEY,
+        )  # fmt: skip
         try:
             assert share.stdout is not None
             url = share.stdout.readline().strip()

@@ -13,6 +13,9 @@ from appmode.testing.process import BoardProcess
 from tests.support.processes import board_process, sent_lines, serving, stop_process
 
 KEY = "fleet key"
+HOST_KEY = "room host key"
+"""The hosts' key of every share and router here (a test's own: none is kept in the
+user's data folder)."""
 
 
 @dataclass
@@ -54,6 +57,8 @@ def shared_board(folder: Path, name: str, *args: str, uart2: bool = False) -> It
             "tcp/127.0.0.1:0",
             "--key",
             KEY,
+            "--host-key",
+            HOST_KEY,
             *args,
             data=folder / "data",
         )

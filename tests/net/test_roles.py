@@ -1,0 +1,187 @@
+"""Issue 80.4 and 80.5: a key holder can drive a car it is given, and nothing more. It
+cannot keep a dead driver's car moving (heartbeats and a token under the driver's id),
+drive under the driver's id, answer as the car (info, stop, a `**` queryable), nor
+publish the car's events; judged on the board's own recording."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from appmode.net.names import Keys
+from tests.support.processes import ROOT, appmode_cmd, run, scripted, timed_sent, wait_for
+from tests.support.shares import HOST_KEY, KEY, SharedBoard, shared_board
+
+pytest.importorskip("zenoh")
+
+FORGED_INFO = {"name": "car", "driver": None, "moving": False, "in_force": None}
+
+
+class Forger:
+    """A key holder speaking for the driver — it echoes each heartbeat it hears, beats
+    under the driver's id, holds the driver's token and writes under its id, every 50 ms
+    — and for the car (`begin`)."""
+
+    def __init__(self, endpoint: str) -> None:
+        from appmode.net.config import open_session
+
+        self.keys = Keys("car")
+        self.session = open_session("client", KEY, connect=(endpoint,))
+        self.heard: list[str] = []
+        self.refusals: list[str] = []
+        self._token: Any = None
+        self._done = threading.Event()
+        self._begun = threading.Event()
+        self._as_car = False
+        keys = self.keys
+
+        self._declared = [self.session.declare_subscriber(keys.alive, self._on_alive)]
+        self._thread = threading.Thread(target=self._forge, daemon=True)
+        self._thread.start()
+
+    def _on_alive(self, sample: Any) -> None:
+        self.heard.append(sample.payload.to_string())
+
+    @property
+    def driver(self) -> str | None:
+        """The id its last heartbeat gave, once the forging began (`begin`)."""
+        return self.heard[-1].split(" ")[0] if self.heard and self._begun.is_set() else None
+
+    def begin(self, as_car: bool = False) -> None:
+        """Forge from now on (the car driven: the driver holds the lease); `as_car`, as
+        the car too: its events, and answers to its info and stop (and to `**`)."""
+        import zenoh
+
+        def answer(query: zenoh.Query) -> None:
+            body = {**FORGED_INFO, "sent": True, "confirmed": True}
+            query.reply(str(query.key_expr), json.dumps(body))
+
+        keys = self.keys
+        self._as_car = as_car
+        for key in (keys.info, keys.stop, "**") if as_car else ():
+            self._declared.append(self.session.declare_queryable(key, answer))
+        self._begun.set()
+
+    def _forge(self) -> None:
+        keys, session = self.keys, self.session
+        while not self._done.wait(0.05):
+            driver = self.driver
+            if driver is None:
+                continue
+            if self._token is None:
+                self._token = session.liveliness().declare_token(keys.driver(driver))
+            session.put(keys.alive, self.heard[-1])  # the driver's own, replayed
+            session.put(keys.alive, f"{driver} 99999 {'0' * 32}")
+            session.put(keys.alive, driver)
+            session.put(
+                keys.events, json.dumps({"t": "dropped", "client": driver, "why": "FORGED"})
+            )
+            session.put(keys.info, json.dumps(FORGED_INFO))
+            for reply in session.get(
+                keys.write("app"), payload=b"A", attachment=f"{driver} 1e9 99999 {'0' * 32}"
+            ):
+                if reply.err is not None:
+                    self.refusals.append(reply.err.payload.to_string())
+
+    def close(self) -> None:
+        from appmode.net.config import close_session
+
+        self._done.set()
+        self._thread.join(5)
+        close_session(self.session)
+
+
+def _z_after_a(car: SharedBoard) -> float:
+    """When (this machine's clock, at the latest) the board took Z after its last A."""
+    timed = timed_sent(car.record)
+    last = max(i for i, (_, unit) in enumerate(timed) if unit == "A")
+    return car.board.clock_after + next(t for t, unit in timed[last + 1 :] if unit == "Z")
+
+
+@contextmanager
+def routed(folder: Path) -> Iterator[tuple[str, SharedBoard]]:
+    """A router (with the room's host key) and a car shared through it: the router's
+    endpoint, where clients connect, and the car (a forger's token and the driver's are
+    one to the car's host there: the router holds both)."""
+    router = subprocess.Popen(
+        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY, "--host-key", HOST_KEY),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert router.stdout is not None
+        endpoint = router.stdout.readline().split()[-1]
+        with shared_board(folder, "car", "--connect", endpoint) as car:
+            yield endpoint, car
+    finally:
+        router.terminate()
+        router.communicate(timeout=10)
+
+
+def _url(endpoint: str) -> str:
+    return f"zenoh://car?connect={endpoint}&key={KEY.replace(' ', '%20')}"
+
+
+def test_a_key_holder_keeps_no_dead_driver_s_car_moving(tmp_path: Path) -> None:
+    """Issue 80.4: heartbeats under the driver's id and a token on its key kept the car
+    moving 5.9–7.0 s after the driver's SIGKILL. The driver's heartbeats carry a proof
+    under a secret only its grant's reply held: the forger's renew nothing, its writes
+    under the driver's id are refused, and the car stops as if it were not there."""
+    with routed(tmp_path) as (endpoint, car):
+        forger = Forger(endpoint)
+        try:
+            driver = scripted(_url(endpoint), "drive A\nwait 30\n")
+            wait_for(lambda: "A" in car.sent(), 30)
+            forger.begin()
+            time.sleep(1.5)  # the forger at work, the car driven on
+            refused = list(forger.refusals)  # while the driver lived
+            killed = time.monotonic()
+            driver.kill()
+            driver.wait(10)
+            wait_for(lambda: car.sent()[-1] == "Z", 10)
+            stopped_after = _z_after_a(car) - killed
+        finally:
+            forger.close()
+    assert stopped_after < 1.0, f"Z {stopped_after:.2f} s after the driver's SIGKILL"
+    assert refused and all("not the driver's" in r for r in refused), refused
+
+
+@pytest.mark.parametrize("through", ["router", "share"])
+def test_a_key_holder_does_not_speak_for_the_car(through: str, tmp_path: Path) -> None:
+    """Issue 80.5: a key holder's info reply replaced the car's, its stop reply said
+    "stopped (confirmed)" for a car whose host was killed, and its "dropped" event
+    kicked the driver. The car's host and the router let no key holder's answer or
+    event through (Zenoh's access control, the host key): the car is shown as it is,
+    the driver drives on, and a stop nobody could make is said to be unconfirmed. Key
+    holders connect to the router, or to the car's host itself."""
+    with routed(tmp_path) as (router, car):
+        endpoint = router if through == "router" else car.endpoint
+        forger = Forger(endpoint)
+        try:
+            driver = scripted(_url(endpoint), "drive A\nwait 3\n")
+            wait_for(lambda: "A" in car.sent(), 30)
+            forger.begin(as_car=True)
+            fleet = run("fleet", "--connect", endpoint, "--key", KEY, "--json")
+            listed = json.loads(fleet.stdout)
+            driver.stdin.close()  # type: ignore[union-attr]
+            out = driver.stdout.read()  # type: ignore[union-attr]
+            driver.wait(30)
+            assert driver.returncode == 0 and "FORGED" not in out, out
+            assert [c["driver"]["client"] for c in listed] == [forger.driver], listed
+            car.share.send_signal(signal.SIGKILL)
+            car.share.wait(10)
+            stop = run("fleet", "stop", "--connect", endpoint, "--key", KEY)
+        finally:
+            forger.close()
+    assert stop.returncode != 0 and "confirmed" not in stop.stdout, stop.stdout + stop.stderr
