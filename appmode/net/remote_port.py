@@ -201,7 +201,7 @@ class RemoteSerial(Modemless):
             return  # nobody's word (a wildcard's), or not the car's host's
         self._host_heard = time.monotonic()
         if event.get("t") == "dropped" and event.get("client") == self._client:
-            self._lose(str(event.get("why")))
+            self._lose(escaped(str(event.get("why"))[:200]))
         elif event.get("t") in ("stopped", "unstopped"):
             stopped = event["t"] == "stopped"
             with self._ready:
