@@ -26,7 +26,9 @@ from appmode.cli.options import (
 from appmode.errors import AppmodeError, install_line
 
 if TYPE_CHECKING:
+    from appmode.net.beats import BeatListener
     from appmode.net.config import Tls
+    from appmode.net.share import Share
     from appmode.ports.choice import BoardChoice
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7450"
@@ -162,18 +164,37 @@ def _serve(
         host_key=host_key(args),
     )
     shared: Share | None = None
+    beats: BeatListener | None = None
     try:
         shared = Share(session, args.name, choice, _log)
+        beats = _beats(listen, shared)
         print(remote_url(args.name, listen, key, everywhere), flush=True)
         _announce(host, listen, everywhere)
         ended = _Ended()
         with signals.diverted(ended.set):
             shared.run(ended.is_set)
     finally:
+        if beats is not None:
+            beats.close()
         if shared is not None:
             shared.close()
         close_session(session)
     return 0
+
+
+def _beats(listen: str, shared: Share) -> BeatListener | None:
+    """The driver's heartbeats on UDP, at the port number of `listen` (`net.beats`);
+    None, said, when that port is taken (they come on Zenoh alone)."""
+    from appmode.net.beats import BeatListener, address_of
+
+    address = address_of(listen)
+    if address is None:
+        return None
+    try:
+        return BeatListener(*address, shared.keys.name, shared.beat)
+    except OSError as exc:
+        _log(f"heartbeats on UDP port {address[1]}: {exc.strerror}: they come on Zenoh alone")
+        return None
 
 
 class _Ended:

@@ -20,7 +20,12 @@ REVOKED = 256
 """Revoked clients remembered at most (the oldest forgotten)."""
 LAPSE = 0.3
 """Seconds without a heartbeat after which a driver's lease has lapsed (a driver beats
-every 0.1 s): the car is stopped within 0.5 s of its last sign of life."""
+every 0.05 s): the car is stopped within 0.5 s of its last sign of life."""
+FIRST_PROOF = 2.5
+"""Seconds after its grant in which a driver's heartbeats renew its lease unproven: its
+secret is on its way to it, in the reply to its write (which it waits for 2 s at most,
+`remote_port.WRITE_TIMEOUT`: TCP resending a lost packet over a slow link). Its first
+proven message, or the end of this, ends that."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,7 +89,7 @@ class Lease:
         self._heard = 0.0
         self._revoked: deque[str] = deque(maxlen=REVOKED)
         self._counts: dict[str, int] = {}
-        """The driver's last proven count of each kind of message."""
+        """The driver's last proven count of each kind of message (none yet: {})."""
 
     def proves(self, client: str, kind: str, proof: Proof | None, *parts: str | bytes) -> bool:
         """Whether `client` drives and `proof` is its, over `kind` and `parts`, with a
@@ -121,8 +126,15 @@ class Lease:
         return Granted(took)
 
     def beat(self, client: str, now: float, proof: Proof | None) -> None:
-        """A heartbeat: the driver's, proven, renews its lease (others are watching)."""
-        if self.proves(client, "alive", proof):
+        """A heartbeat: the driver's, proven (or before its secret can have reached it,
+        `FIRST_PROOF`), renews its lease; others are watching."""
+        driver = self.driver
+        if self.proves(client, "alive", proof) or (
+            driver is not None
+            and driver.client == client
+            and not self._counts
+            and now - driver.since <= FIRST_PROOF
+        ):
             self._heard = now
 
     def lapsed_at(self, now: float) -> bool:

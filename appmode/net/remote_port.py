@@ -26,6 +26,7 @@ from serial import SerialException
 
 from appmode.errors import AppmodeError
 from appmode.host import far
+from appmode.net.beats import BeatSender
 from appmode.net.config import Tls, close_session, open_session, zenoh_module
 from appmode.net.names import Keys, concrete
 from appmode.net.proof import Prover
@@ -39,15 +40,19 @@ from appmode.text import escaped
 if TYPE_CHECKING:
     import zenoh
 
-BEAT = 0.1
-"""Seconds between two heartbeats (the car's host stops the car after 0.3 s without)."""
+BEAT = 0.05
+"""Seconds between two heartbeats, each on Zenoh and on UDP (`beats`): the car's host
+stops the car after 0.3 s without one, and a link losing 5 % of its packets loses six
+in a row once in 60 million."""
 FIND = 3.0
 """Seconds to wait for the car's host to answer when the port opens."""
 SILENT = 3.0
 """Seconds without a word from the car's host (it publishes its info every second) after
 which the port is lost: the network between is cut (its host stops the car)."""
-WRITE_TIMEOUT = 1.0
-"""Seconds a write waits for the car's host to say the bytes left."""
+WRITE_TIMEOUT = 2.0
+"""Seconds a write waits for the car's host to say the bytes left (a round trip, and
+TCP's resending of a packet lost on the way: 0.3 + 0.6 s over a link of 150 ms each
+way); bytes that reach it later are not written."""
 CLOSING = 0.3
 """Seconds the share's token may go before its last word, that it ends, is heard."""
 LINK_DOWN = (
@@ -247,6 +252,13 @@ class RemoteSerial(Modemless):
 
     def _beat(self) -> None:
         alive = self._keys.alive
+        datagrams = BeatSender(self._remote.connect)
+        try:
+            self._beat_until_lost(alive, datagrams)
+        finally:
+            datagrams.close()
+
+    def _beat_until_lost(self, alive: str, datagrams: BeatSender) -> None:
         while not self._beating.wait(BEAT):
             if time.monotonic() - self._host_heard > SILENT:
                 self._lose(
@@ -255,6 +267,8 @@ class RemoteSerial(Modemless):
                 )
                 return
             proof = self._prover.words("alive", self._client)
+            if proof:  # a driver's: on UDP too (only a driver's renews a lease)
+                datagrams.send(f"{self._remote.name} {self._client}{proof}")
             try:
                 self._session.put(alive, self._client + proof)
             except Exception:  # a session closing under it: the port is closing too

@@ -212,8 +212,12 @@ class Share:
         return {} if driver is None else {"secret": driver.secret}
 
     def _on_alive(self, sample: zenoh.Sample) -> None:
-        words = (text_of(sample.payload) or "").split(" ")
-        if str(sample.key_expr) == self.keys.alive and words[0]:
+        if str(sample.key_expr) == self.keys.alive:
+            self.beat((text_of(sample.payload) or "").split(" "))
+
+    def beat(self, words: list[str]) -> None:
+        """A heartbeat's words, `CLIENT COUNT MAC` (on Zenoh, or a datagram: `beats`)."""
+        if words and words[0]:
             with self._lock:
                 self.lease.beat(words[0], self.now(), proof_of(words, 1))
 

@@ -4,7 +4,7 @@ under the driver's id renews nothing and drives nothing (issue 80.4)."""
 
 from __future__ import annotations
 
-from appmode.net.lease import LAPSE, Granted, Lease, Refused, Revoked, Unproven
+from appmode.net.lease import FIRST_PROOF, LAPSE, Granted, Lease, Refused, Revoked, Unproven
 from appmode.net.proof import Proof, Prover
 
 
@@ -55,3 +55,22 @@ def test_only_the_driver_s_proof_renews_its_lease_or_drives_under_its_id() -> No
     assert not lease.proves("a-1-x", "write", write, "9.5", b"A")  # once only
     assert lease.ask("a-1-x", "a", 0.3) == Unproven()
     assert lease.ask("a-1-x", "a", 0.3, proven=True) == Granted()
+
+
+def test_a_driver_s_bare_beats_renew_its_lease_only_until_its_secret_can_have_come() -> None:
+    """Over a slow link the secret takes a round trip to reach the driver: its bare
+    heartbeats renew the lease until its first proven one, or FIRST_PROOF s."""
+    lease = Lease()
+    lease.ask("a-1-x", "a", 0.0)
+    lease.beat("a-1-x", 0.25, None)
+    assert not lease.lapsed_at(0.5)  # renewed at 0.25
+    lease.beat("a-1-x", FIRST_PROOF + 0.1, None)
+    assert lease.lapsed_at(0.25 + LAPSE + 0.01)  # that one renewed nothing
+    fresh = Lease()
+    fresh.ask("b-1-y", "b", 0.0)
+    assert fresh.driver is not None
+    prover = Prover()
+    prover.secret = fresh.driver.secret
+    fresh.beat("b-1-y", 0.1, _proof(prover.words("alive", "b-1-y")))
+    fresh.beat("b-1-y", 0.3, None)  # proven once: bare ones renew nothing from now on
+    assert fresh.lapsed_at(0.1 + LAPSE + 0.01)

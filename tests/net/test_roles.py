@@ -28,15 +28,18 @@ FORGED_INFO = {"name": "car", "driver": None, "moving": False, "in_force": None}
 
 class Forger:
     """A key holder speaking for the driver — it echoes each heartbeat it hears, beats
-    under the driver's id, holds the driver's token and writes under its id, every 50 ms
-    — and for the car (`begin`)."""
+    under the driver's id (on Zenoh, and on UDP to `beats`), holds the driver's token
+    and writes under its id, every 50 ms — and for the car (`begin`)."""
 
-    def __init__(self, endpoint: str) -> None:
+    def __init__(self, endpoint: str, beats: str | None = None) -> None:
+        from appmode.net.beats import BeatSender
         from appmode.net.config import open_session
 
         self.keys = Keys("car")
         self.session = open_session("client", KEY, connect=(endpoint,))
         self.heard: list[str] = []
+        self._datagrams = BeatSender(() if beats is None else (beats,))
+        """To the car's host's heartbeat port (`net.beats`), when given."""
         self.refusals: list[str] = []
         self._token: Any = None
         self._done = threading.Event()
@@ -82,6 +85,8 @@ class Forger:
             session.put(keys.alive, self.heard[-1])  # the driver's own, replayed
             session.put(keys.alive, f"{driver} 99999 {'0' * 32}")
             session.put(keys.alive, driver)
+            self._datagrams.send(f"car {self.heard[-1]}")
+            self._datagrams.send(f"car {driver}")
             session.put(
                 keys.events, json.dumps({"t": "dropped", "client": driver, "why": "FORGED"})
             )
@@ -97,6 +102,7 @@ class Forger:
 
         self._done.set()
         self._thread.join(5)
+        self._datagrams.close()
         close_session(self.session)
 
 
@@ -139,7 +145,7 @@ def test_a_key_holder_keeps_no_dead_driver_s_car_moving(tmp_path: Path) -> None:
     under a secret only its grant's reply held: the forger's renew nothing, its writes
     under the driver's id are refused, and the car stops as if it were not there."""
     with routed(tmp_path) as (endpoint, car):
-        forger = Forger(endpoint)
+        forger = Forger(endpoint, beats=car.endpoint)
         try:
             driver = scripted(_url(endpoint), "drive A\nwait 30\n")
             wait_for(lambda: "A" in car.sent(), 30)
