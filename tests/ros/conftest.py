@@ -44,12 +44,15 @@ class Car:
         return [unit for _, unit in self.board_timed()]
 
     def entities(self, want: int) -> list[peer.Entity]:
-        end = time.monotonic() + 15
+        """The node's entities once the graph holds `want` of them and has stopped
+        growing (its tokens do not come in one order: the eighth may be `/odom`)."""
+        end, seen = time.monotonic() + 15, -1
         while time.monotonic() < end:
             found = peer.graph(self.ros)
-            if len(found) >= want:
+            if len(found) >= want and len(found) == seen:
                 return found
-            time.sleep(0.2)
+            seen = len(found)
+            time.sleep(0.3)
         raise AssertionError(f"the graph holds {peer.graph(self.ros)}")
 
 
