@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 from appmode.web.certificate import own_certificate
-from tests.support.processes import ROOT, appmode_cmd, run, scripted, stop_process
-from tests.support.shares import HOST_KEY, KEY, shared_board
+from tests.support.processes import run, scripted
+from tests.support.shares import KEY, routed, shared_board
 from tests.testing.test_plugin import pytest_in
 
 pytest.importorskip("zenoh", reason="the net extra (eclipse-zenoh) is not installed")
@@ -40,27 +40,13 @@ def test_tls_checks_the_key_and_needs_the_share_s_certificate(tmp_path: Path) ->
 
 
 def test_a_car_through_a_router_is_driven_and_listed(tmp_path: Path) -> None:
-    router = subprocess.Popen(
-        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY, "--host-key", HOST_KEY),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    try:
-        assert router.stdout is not None
-        endpoint = router.stdout.readline().split()[-1]
-        assert endpoint.startswith("tcp/127.0.0.1:") and not endpoint.endswith(":0")
-        with shared_board(tmp_path, "car", "--connect", endpoint) as car:
-            listed = run("fleet", "--connect", endpoint, "--key", KEY, "--json")
-            assert '"name": "car"' in listed.stdout, listed.stderr
-            url = f"zenoh://car?connect={endpoint}&key={KEY.replace(' ', '%20')}"
-            done = run("send", url, "J", "A", "wait:0.5")
-            assert done.returncode == 0, done.stderr
-            assert "A" in car.sent() and car.sent()[-1] == "Z", car.sent()
-    finally:
-        err = stop_process(router)
-    assert router.returncode == 0 and "Traceback" not in err, err
+    with routed(tmp_path) as (endpoint, car):
+        listed = run("fleet", "--connect", endpoint, "--key", KEY, "--json")
+        assert '"name": "car"' in listed.stdout, listed.stderr
+        url = f"zenoh://car?connect={endpoint}&key={KEY.replace(' ', '%20')}"
+        done = run("send", url, "J", "A", "wait:0.5")
+        assert done.returncode == 0, done.stderr
+        assert "A" in car.sent() and car.sent()[-1] == "Z", car.sent()
 
 
 def test_a_share_stops_only_the_ports_used_so_letters_still_drive_after(tmp_path: Path) -> None:

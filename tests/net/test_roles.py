@@ -7,19 +7,16 @@ from __future__ import annotations
 
 import json
 import signal
-import subprocess
 import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from appmode.net.names import Keys
-from tests.support.processes import ROOT, appmode_cmd, run, scripted, timed_sent, wait_for
-from tests.support.shares import HOST_KEY, KEY, SharedBoard, shared_board
+from tests.support.processes import run, scripted, timed_sent, wait_for
+from tests.support.shares import KEY, SharedBoard, routed
 
 pytest.importorskip("zenoh")
 
@@ -111,28 +108,6 @@ def _z_after_a(car: SharedBoard) -> float:
     timed = timed_sent(car.record)
     last = max(i for i, (_, unit) in enumerate(timed) if unit == "A")
     return car.board.clock_after + next(t for t, unit in timed[last + 1 :] if unit == "Z")
-
-
-@contextmanager
-def routed(folder: Path) -> Iterator[tuple[str, SharedBoard]]:
-    """A router (with the room's host key) and a car shared through it: the router's
-    endpoint, where clients connect, and the car (a forger's token and the driver's are
-    one to the car's host there: the router holds both)."""
-    router = subprocess.Popen(
-        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY, "--host-key", HOST_KEY),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        cwd=ROOT,
-    )
-    try:
-        assert router.stdout is not None
-        endpoint = router.stdout.readline().split()[-1]
-        with shared_board(folder, "car", "--connect", endpoint) as car:
-            yield endpoint, car
-    finally:
-        router.terminate()
-        router.communicate(timeout=10)
 
 
 def _url(endpoint: str) -> str:

@@ -10,7 +10,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from appmode.testing.process import BoardProcess
-from tests.support.processes import board_process, sent_lines, serving, stop_process
+from tests.support.processes import (
+    ROOT,
+    appmode_cmd,
+    board_process,
+    sent_lines,
+    serving,
+    stop_process,
+)
 
 KEY = "fleet key"
 HOST_KEY = "room host key"
@@ -68,3 +75,26 @@ def shared_board(folder: Path, name: str, *args: str, uart2: bool = False) -> It
             yield SharedBoard(board, share, line, record)
         finally:
             stop_process(share)
+
+
+@contextmanager
+def routed(folder: Path) -> Iterator[tuple[str, SharedBoard]]:
+    """An `appmode router` on loopback (with KEY and HOST_KEY) and the car `car` shared
+    through it: the router's endpoint, where clients connect, and the car. The router
+    ends cleanly after (SIGTERM: exit 0, no traceback)."""
+    router = subprocess.Popen(
+        appmode_cmd("router", "--listen", "tcp/127.0.0.1:0", "--key", KEY, "--host-key", HOST_KEY),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
+    try:
+        assert router.stdout is not None
+        endpoint = router.stdout.readline().split()[-1]
+        assert endpoint.startswith("tcp/127.0.0.1:") and not endpoint.endswith(":0"), endpoint
+        with shared_board(folder, "car", "--connect", endpoint) as car:
+            yield endpoint, car
+    finally:
+        err = stop_process(router)
+    assert router.returncode == 0 and "Traceback" not in err, err
