@@ -13,11 +13,11 @@ from __future__ import annotations
 import errno
 import os
 import sys
+from typing import TYPE_CHECKING
 
 from appmode.host import signals
 from appmode.writer import CLOSE_WAIT, BoundedWriter
 
-TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:
     from typing import TextIO
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from contextlib import ExitStack
+from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
@@ -22,7 +23,6 @@ from appmode.cli.options import (
 from appmode.errors import AppmodeError
 from appmode.host.token_help import APP_TOKENS, CHASSIS_TOKENS, CONTROL_TOKENS
 
-TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:  # the rest is imported when the command runs: start-up stays short
     from typing import TextIO
 
