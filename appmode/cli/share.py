@@ -26,6 +26,8 @@ from appmode.cli.options import (
 from appmode.errors import AppmodeError, install_line
 
 if TYPE_CHECKING:
+    import zenoh
+
     from appmode.net.beats import BeatListener
     from appmode.net.config import Tls
     from appmode.net.share import Share
@@ -168,6 +170,7 @@ def _serve(
     try:
         shared = Share(session, args.name, choice, _log)
         beats = _beats(listen, shared)
+        _joined(session, tuple(args.connect))
         print(remote_url(args.name, listen, key, everywhere), flush=True)
         _announce(host, listen, everywhere)
         ended = _Ended()
@@ -180,6 +183,18 @@ def _serve(
             shared.close()
         close_session(session)
     return 0
+
+
+def _joined(session: zenoh.Session, connect: tuple[str, ...]) -> None:
+    """Say when the routers or shares `--connect` named have not let this one in (the
+    share started meanwhile: by now a refusal has come): Zenoh tries them again."""
+    info = session.info
+    if connect and not [*info.routers_zid(), *info.peers_zid()]:
+        _log(
+            f"not joined {', '.join(connect)}: nothing listens there, or it refused this "
+            "share's host key (every share and router that connect to each other need one "
+            "--host-key); trying again"
+        )
 
 
 def _beats(listen: str, shared: Share) -> BeatListener | None:

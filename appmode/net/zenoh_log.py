@@ -27,7 +27,10 @@ LEVEL = re.compile(r"\b(ERROR|WARN)\b\s+\S*\s*(\S+?):\s*(.*)")
 def said(line: str) -> str | None:
     """What a line Zenoh logged means for a person, or None (nothing worth a line)."""
     if REFUSED.search(line):
-        return "refused a client: wrong key (Zenoh's user-password authentication)"
+        return (
+            "refused a client: wrong key (Zenoh's user-password authentication; from "
+            "another share or router: a host key not this one's)"
+        )
     found = LEVEL.search(line)
     if found is None:
         return None

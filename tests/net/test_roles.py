@@ -16,7 +16,7 @@ import pytest
 
 from appmode.net.names import Keys
 from tests.support.processes import run, scripted, timed_sent, wait_for
-from tests.support.shares import KEY, SharedBoard, routed
+from tests.support.shares import KEY, SharedBoard, routed, shared_board
 
 pytest.importorskip("zenoh")
 
@@ -166,3 +166,22 @@ def test_a_key_holder_does_not_speak_for_the_car(through: str, tmp_path: Path) -
         finally:
             forger.close()
     assert stop.returncode != 0 and "confirmed" not in stop.stdout, stop.stdout + stop.stderr
+
+
+def test_a_share_of_another_host_key_is_refused_and_says_so(tmp_path: Path) -> None:
+    """Shares that connect to each other need one host key: one with another is refused
+    (the first logs it) and says it has not joined, in a line each; one with the same
+    joins quietly and is listed beside the first."""
+    with shared_board(tmp_path, "car-a") as first:
+        with shared_board(
+            tmp_path, "car-b", "--connect", first.endpoint, "--host-key", "another"
+        ) as stranger:
+            err = stranger.stop()
+        with shared_board(tmp_path, "car-c", "--connect", first.endpoint) as joined:
+            listed = run("fleet", "--connect", first.endpoint, "--key", KEY, "--json")
+            quiet = joined.stop()
+        said = first.stop()
+    assert "not joined" in err and "--host-key" in err, err
+    assert "a host key not this one's" in said, said
+    assert "not joined" not in quiet, quiet
+    assert [car["name"] for car in json.loads(listed.stdout)] == ["car-a", "car-c"], listed
