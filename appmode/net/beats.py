@@ -10,11 +10,15 @@ from __future__ import annotations
 import contextlib
 import socket
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
 DATAGRAM = 512
 """Bytes of a heartbeat at most (a car's name, a client's, a count and an HMAC)."""
+PER_SECOND = 200
+"""Datagrams read a second at most (a driver sends 20): a flood waits in the kernel's
+buffer, which drops what overflows, and takes no more of the share's time than this."""
 
 
 def address_of(endpoint: str) -> tuple[str, int] | None:
@@ -40,7 +44,12 @@ class BeatListener:
         self._thread.start()
 
     def _listen(self) -> None:
+        second, read = time.monotonic(), 0
         while True:
+            read += 1
+            if read > PER_SECOND:
+                time.sleep(max(0.0, second + 1 - time.monotonic()))
+                second, read = time.monotonic(), 1
             try:
                 data = self._socket.recv(DATAGRAM)
             except OSError:  # closed
