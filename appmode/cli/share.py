@@ -8,6 +8,7 @@ import os
 import secrets
 import socket
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import quote
@@ -126,53 +127,68 @@ def car_name(text: str) -> str:
     return text
 
 
+@dataclass(frozen=True, slots=True)
+class Sharing:
+    """What a share is told, each part checked once: the car's name, where it listens
+    and connects, its keys, whether it listens on every network, its TLS."""
+
+    name: str
+    listen: str
+    connect: tuple[str, ...]
+    key: str
+    host_key: str
+    everywhere: bool
+    tls: Tls | None
+
+
 def run(args: argparse.Namespace) -> int:
     from appmode.net.config import free_port, zenoh_module
     from appmode.net.zenoh_log import zenoh_refusals
 
     zenoh_module()
-    listen = free_port(args.listen.replace("tcp/", "tls/", 1) if args.tls else args.listen)
     choice = board_choice(args, both=True)
     key = args.key if args.key is not None else kept_key()
     if not key or not key.isprintable():
         raise AppmodeError("--key: give printable text (a key is what a client pastes)")
+    listen = free_port(args.listen.replace("tcp/", "tls/", 1) if args.tls else args.listen)
     host = listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]")
     everywhere = host in ("0.0.0.0", "::")
-    tls = _tls(host) if args.tls else None
+    sharing = Sharing(
+        args.name,
+        listen,
+        tuple(args.connect),
+        key,
+        host_key(args),
+        everywhere,
+        _tls(host) if args.tls else None,
+    )
     with zenoh_refusals(_log):
-        return _serve(args, choice, listen, key, everywhere, tls)
+        return _serve(sharing, choice)
 
 
-def _serve(
-    args: argparse.Namespace,
-    choice: BoardChoice,
-    listen: str,
-    key: str,
-    everywhere: bool,
-    tls: Tls | None,
-) -> int:
+def _serve(sharing: Sharing, choice: BoardChoice) -> int:
     from appmode.host import signals
     from appmode.net.config import close_session, open_session
     from appmode.net.share import Share
 
-    host = listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]")
+    listen, everywhere = sharing.listen, sharing.everywhere
     session = open_session(
         "peer",
-        key,
+        sharing.key,
         listen=(listen,),
-        connect=tuple(args.connect),
+        connect=sharing.connect,
         scout=everywhere,
-        tls=tls,
-        host_key=host_key(args),
+        tls=sharing.tls,
+        host_key=sharing.host_key,
     )
     shared: Share | None = None
     beats: BeatListener | None = None
     try:
-        shared = Share(session, args.name, choice, _log)
+        shared = Share(session, sharing.name, choice, _log)
         beats = _beats(listen, shared)
-        _joined(session, tuple(args.connect))
-        print(remote_url(args.name, listen, key, everywhere), flush=True)
-        _announce(host, listen, everywhere)
+        _joined(session, sharing.connect)
+        print(remote_url(sharing.name, listen, sharing.key, everywhere), flush=True)
+        _announce(listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]"), listen, everywhere)
         ended = _Ended()
         with signals.diverted(ended.set):
             shared.run(ended.is_set)
