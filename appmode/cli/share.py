@@ -130,15 +130,20 @@ def car_name(text: str) -> str:
 @dataclass(frozen=True, slots=True)
 class Sharing:
     """What a share is told, each part checked once: the car's name, where it listens
-    and connects, its keys, whether it listens on every network, its TLS."""
+    (and the address in that) and connects, its keys, its TLS."""
 
     name: str
     listen: str
+    host: str
     connect: tuple[str, ...]
     key: str
     host_key: str
-    everywhere: bool
     tls: Tls | None
+
+    @property
+    def everywhere(self) -> bool:
+        """It listens on every network of the machine."""
+        return self.host in ("0.0.0.0", "::")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -152,14 +157,13 @@ def run(args: argparse.Namespace) -> int:
         raise AppmodeError("--key: give printable text (a key is what a client pastes)")
     listen = free_port(args.listen.replace("tcp/", "tls/", 1) if args.tls else args.listen)
     host = listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]")
-    everywhere = host in ("0.0.0.0", "::")
     sharing = Sharing(
         args.name,
         listen,
+        host,
         tuple(args.connect),
         key,
         host_key(args),
-        everywhere,
         _tls(host) if args.tls else None,
     )
     with zenoh_refusals(_log):
@@ -188,7 +192,7 @@ def _serve(sharing: Sharing, choice: BoardChoice) -> int:
         beats = _beats(listen, shared)
         _joined(session, sharing.connect)
         print(remote_url(sharing.name, listen, sharing.key, everywhere), flush=True)
-        _announce(listen.split("/", 1)[1].rsplit(":", 1)[0].strip("[]"), listen, everywhere)
+        _announce(sharing.host, listen, everywhere)
         ended = _Ended()
         with signals.diverted(ended.set):
             shared.run(ended.is_set)

@@ -2,8 +2,9 @@
 holds every later heartbeat back until a lost one is sent again (0.4–0.9 s at 5 % loss,
 past the lease's 0.3 s), while a datagram lost is only that one. The car's host listens
 on the port number its share listens on; a driver sends each heartbeat — `NAME CLIENT
-COUNT MAC`, proven as on Zenoh (`proof`) — to the addresses its URL connects to. Nothing
-else travels this way, and a datagram renews only the lease its proof is for."""
+COUNT MAC`, proven as on Zenoh (`proof`; bare until its lease's secret has come) — to the
+addresses its URL connects to. Nothing else travels this way, and a datagram renews
+only what the same heartbeat on Zenoh would (`lease.Lease.beat`)."""
 
 from __future__ import annotations
 

@@ -5,9 +5,9 @@ act on: it stops the car. A client that writes while nobody drives becomes the d
 while another's lease is live it drives only after taking over (`take`), which the
 other hears of. A client whose lease was taken from it (it lapsed, another took over,
 a fleet stop) drives no more: its writes are refused, as a frozen process's that wakes
-up; a client's every link is a new id, so it drives again once it has reconnected. What the
-driver sends after its grant proves itself (`proof`): a key holder who uses the driver's
-id neither renews its lease nor drives under it."""
+up; a client's every link is a new id, so it drives again once it has reconnected.
+What the driver sends after its grant proves itself (`proof`): a key holder who uses
+the driver's id neither renews its lease nor drives under it."""
 
 from __future__ import annotations
 

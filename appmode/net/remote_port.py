@@ -172,6 +172,8 @@ class RemoteSerial(Modemless):
         ]
         self._writer = session.declare_querier(keys.write(self._side), timeout=WRITE_TIMEOUT)
         self._beating = threading.Event()
+        self._datagrams = BeatSender(self._remote.connect)  # here: a name it resolves
+        # holds up no heartbeat
         self._beats = threading.Thread(target=self._beat, name="zenoh beat", daemon=True)
         self._beats.start()
 
@@ -251,12 +253,10 @@ class RemoteSerial(Modemless):
             self._ready.notify_all()
 
     def _beat(self) -> None:
-        alive = self._keys.alive
-        datagrams = BeatSender(self._remote.connect)
         try:
-            self._beat_until_lost(alive, datagrams)
+            self._beat_until_lost(self._keys.alive, self._datagrams)
         finally:
-            datagrams.close()
+            self._datagrams.close()
 
     def _beat_until_lost(self, alive: str, datagrams: BeatSender) -> None:
         while not self._beating.wait(BEAT):
@@ -267,8 +267,8 @@ class RemoteSerial(Modemless):
                 )
                 return
             proof = self._prover.words("alive", self._client)
-            if proof:  # a driver's: on UDP too (only a driver's renews a lease)
-                datagrams.send(f"{self._remote.name} {self._client}{proof}")
+            datagrams.send(f"{self._remote.name} {self._client}{proof}")  # a bare one too:
+            # while the lease's secret is on its way, TCP under loss may hold Zenoh's back
             try:
                 self._session.put(alive, self._client + proof)
             except Exception:  # a session closing under it: the port is closing too
@@ -331,8 +331,7 @@ class RemoteSerial(Modemless):
         if self._remote.take and self._remote.name not in _TOOK:
             self._take()
         sent = time.monotonic()
-        until = f"{sent - self._origin + WRITE_TIMEOUT:.3f}"  # the car's clock: after it,
-        # not written
+        until = f"{sent - self._origin + WRITE_TIMEOUT:.3f}"  # the car's clock: not after
         proof = self._prover.words("write", self._client, until, payload)
         with far.acknowledging():  # the car's host is the stop authority while it waits
             replies = list(
@@ -350,9 +349,9 @@ class RemoteSerial(Modemless):
         self.written_at = float(said["at"])
         return len(payload)
 
-    def _granted(self, said: dict[str, Any]) -> None:
+    def _granted(self, said: object) -> None:
         """Keep the secret the car's host granted the lease with (`proof`)."""
-        secret = said.get("secret")
+        secret = said.get("secret") if isinstance(said, dict) else None
         if isinstance(secret, str):
             self._prover.secret = secret
 
@@ -370,7 +369,7 @@ class RemoteSerial(Modemless):
             raise SerialException(f"cannot take the driving of {self._remote.name}: {why}")
         granted = replies[0].ok
         with contextlib.suppress(ValueError):
-            self._granted(json.loads(granted.payload.to_string()) if granted else {})
+            self._granted(json.loads(granted.payload.to_string()) if granted else None)
         _TOOK.add(self._remote.name)
 
     def _check(self) -> None:
