@@ -9,11 +9,12 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.options import Subparsers, endpoint
+from appmode.cli.options import Subparsers, add_host_id, endpoint
 from appmode.text import escaped
 
 if TYPE_CHECKING:
     from appmode.net.fleet import Car
+    from appmode.net.signature import Trust
 
 REFRESH = 1.0
 """Seconds between two looks at the fleet, live."""
@@ -40,6 +41,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         help="a share or a router to ask through: tcp/HOST:PORT (default: scout this LAN)",
     )
     fleet.add_argument("--key", help="the cars' key (default: this machine's share key)")
+    add_host_id(fleet)
     fleet.add_argument("--json", action="store_true", help="print the fleet once, as JSON")
     return fleet
 
@@ -47,40 +49,44 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from appmode.cli.share import a_clients_key
     from appmode.net.config import close_session, open_session, zenoh_module
+    from appmode.net.signature import Trust
 
     zenoh_module()
     connect = tuple(args.connect)
     key = a_clients_key(args.key, "fleet")
+    trust = Trust(key, args.host_id)
     session = open_session("client", key, connect=connect, scout=not connect)
     try:
         if args.action == "stop":
-            return _stop(session, args.json)
+            return _stop(session, trust, args.json)
         if args.json or not sys.stdout.isatty():
-            return _once(session, args.json)
-        return _live(session)
+            return _once(session, trust, args.json)
+        return _live(session, trust)
     finally:
         close_session(session)
 
 
-def _once(session: Any, as_json: bool) -> int:
+def _once(session: Any, trust: Trust, as_json: bool) -> int:
     from appmode.net.fleet import cars
 
-    found = cars(session)
+    found = cars(session, trust)
     if as_json:
         rows = [{"name": c.name, **c.info, "latency_ms": round(c.latency_ms, 2)} for c in found]
         sys.stdout.write(json.dumps(rows) + "\n")
     else:
         sys.stdout.write(table(found) + "\n")
+    if not found and trust.strangers:
+        print(f"appmode: no car's host answered{trust.refusal()}", file=sys.stderr)
     return 0 if found else 1
 
 
-def _live(session: Any) -> int:
+def _live(session: Any, trust: Trust) -> int:
     from appmode.net.fleet import cars
 
     shown = 0
     try:
         while True:
-            text = table(cars(session, wait=REFRESH)) + "\n"
+            text = table(cars(session, trust, wait=REFRESH)) + "\n"
             sys.stdout.write(f"\x1b[{shown}A\x1b[J" if shown else "")
             sys.stdout.write(text)
             sys.stdout.flush()
@@ -136,10 +142,10 @@ def _motion(info: dict[str, Any]) -> str:
     return "stopped" if info.get("records_moving") is False else "stopped (not confirmed)"
 
 
-def _stop(session: Any, as_json: bool) -> int:
+def _stop(session: Any, trust: Trust, as_json: bool) -> int:
     from appmode.net.fleet import stop_all
 
-    answers = stop_all(session)
+    answers = stop_all(session, trust)
     if as_json:
         sys.stdout.write(json.dumps(answers) + "\n")
     for answer in [] if as_json else answers:
@@ -152,6 +158,6 @@ def _stop(session: Any, as_json: bool) -> int:
             said = "stopped (confirmed)" if answer["confirmed"] else "stop sent, NOT confirmed"
         print(f"{name}: {said}")
     if not answers:
-        print("appmode: no car answered: nothing was stopped", file=sys.stderr)
+        print(f"appmode: no car answered: nothing was stopped{trust.refusal()}", file=sys.stderr)
         return 1
     return 0 if all(a.get("sent") and a.get("confirmed") is not False for a in answers) else 1

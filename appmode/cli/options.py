@@ -186,6 +186,28 @@ def _endpoint(text: str, listening: bool) -> str:
         raise AppmodeError(str(exc)) from None
 
 
+def host_id(text: str) -> str:
+    """A car's host's id (`id=` in the URL appmode share printed), checked once."""
+    from appmode.ports.remote import HOST_ID
+
+    if not HOST_ID.fullmatch(text):
+        raise AppmodeError(
+            f"{text[:60]!r} is no host id: copy the id= part of the URL appmode share printed"
+        )
+    return text
+
+
+def add_host_id(parser: argparse.ArgumentParser, option: str = "--id") -> None:
+    parser.add_argument(
+        option,
+        dest="host_id",
+        type=host_id,
+        metavar="ID",
+        help="the cars' hosts' id, the id= part of the URL appmode share printed: only what "
+        "they sign is heard (default: the first host met with this key, then kept)",
+    )
+
+
 def board_choice(
     args: argparse.Namespace, *, url: Target | None = None, both: bool = False
 ) -> BoardChoice:

@@ -174,6 +174,7 @@ def _serve(sharing: Sharing, choice: BoardChoice) -> int:
     from appmode.host import signals
     from appmode.net.config import close_session, open_session
     from appmode.net.share import Share
+    from appmode.net.signature import Signer
 
     listen, everywhere = sharing.listen, sharing.everywhere
     session = open_session(
@@ -188,10 +189,11 @@ def _serve(sharing: Sharing, choice: BoardChoice) -> int:
     shared: Share | None = None
     beats: BeatListener | None = None
     try:
-        shared = Share(session, sharing.name, choice, _log)
+        signer = Signer(sharing.host_key)
+        shared = Share(session, sharing.name, choice, _log, signer)
         beats = _beats(listen, shared)
         _joined(session, sharing.connect)
-        print(remote_url(sharing.name, listen, sharing.key, everywhere), flush=True)
+        print(remote_url(sharing, signer.id), flush=True)
         _announce(sharing.host, listen, everywhere)
         ended = _Ended()
         with signals.diverted(ended.set):
@@ -245,13 +247,15 @@ class _Ended:
         return self._set
 
 
-def remote_url(name: str, listen: str, key: str, everywhere: bool) -> str:
-    """The URL another machine pastes (this machine's LAN address when it listens on all)."""
-    endpoint = listen
-    if everywhere:
-        scheme, rest = listen.split("/", 1)
+def remote_url(sharing: Sharing, host_id: str) -> str:
+    """The URL another machine pastes (this machine's LAN address when it listens on
+    all), with the id of the host that signs for the car."""
+    endpoint = sharing.listen
+    if sharing.everywhere:
+        scheme, rest = endpoint.split("/", 1)
         endpoint = f"{scheme}/{_lan_address()}:{rest.rsplit(':', 1)[1]}"
-    return f"zenoh://{name}?connect={endpoint}&key={quote(key, safe='')}"
+    key = quote(sharing.key, safe="")
+    return f"zenoh://{sharing.name}?connect={endpoint}&key={key}&id={host_id}"
 
 
 def _lan_address() -> str:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
 from appmode.cli.live_view import attach, live_view
-from appmode.cli.options import Subparsers, board_choice, endpoint, target
+from appmode.cli.options import Subparsers, add_host_id, board_choice, endpoint, target
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
@@ -57,6 +57,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     web.add_argument(
         "--fleet-key", metavar="KEY", help="with --fleet: the cars' key (default: this machine's)"
     )
+    add_host_id(web, "--fleet-id")
     web.add_argument("--cert", metavar="FILE", help="serve HTTPS with this PEM certificate")
     web.add_argument("--key", metavar="FILE", help="the private key of --cert (PEM)")
     return web
@@ -91,8 +92,8 @@ def run(args: argparse.Namespace) -> int:
         tls, fingerprint = certificate.server_context(cert, key), certificate.fingerprint(cert)
     if args.fleet:
         return _serve_fleet(args, host, port, tls, tuple(addresses), fingerprint)
-    if args.connect or args.fleet_key is not None:
-        raise AppmodeError("--connect and --fleet-key go with --fleet")
+    if args.connect or args.fleet_key is not None or args.host_id is not None:
+        raise AppmodeError("--connect, --fleet-key and --fleet-id go with --fleet")
     choice = board_choice(args)
     with live_view(
         args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
@@ -113,6 +114,7 @@ def _serve_fleet(
     """The fleet page: the cars the key opens; a car chosen there driven as URL is."""
     from appmode.cli.share import kept_key
     from appmode.net.config import close_session, open_session, zenoh_module
+    from appmode.net.signature import Trust
     from appmode.ports.target import shared_car
     from appmode.session.base import BaseSession
     from appmode.session.opener import open_session as open_car_session
@@ -127,17 +129,18 @@ def _serve_fleet(
     zenoh_module()
     connect = tuple(args.connect)
     key = args.fleet_key or kept_key()
+    trust = Trust(key, args.host_id)
     zenoh = open_session("client", key, connect=connect, scout=not connect)
 
     def open_car(name: str) -> BaseSession:
-        choice = board_choice(args, url=shared_car(name, connect, key))
+        choice = board_choice(args, url=shared_car(name, connect, key, trust.id))
         session = open_car_session(choice, driving())
         session.start()
         return session
 
     try:
         return serve_web(
-            None, host, port, tls, addresses, fingerprint, fleet=Fleet(zenoh, open_car)
+            None, host, port, tls, addresses, fingerprint, fleet=Fleet(zenoh, trust, open_car)
         )
     finally:
         close_session(zenoh)

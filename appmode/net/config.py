@@ -48,6 +48,7 @@ class Tls:
 def zenoh_module() -> object:
     """The zenoh package; AppmodeError with what to install when it is not there."""
     try:
+        import cryptography  # noqa: F401  # what a car's host says is signed (`signature`)
         import zenoh
     except ImportError:
         raise AppmodeError(NO_ZENOH) from None

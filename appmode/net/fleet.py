@@ -1,16 +1,19 @@
 """The cars a key opens: every share that answers (`appmode/*/info`), each with how long
 its answer took; and the stop of all of them, each car's host saying whether its stop
-took (on the car's A records, where it sends them)."""
+took (on the car's A records, where it sends them). Only answers the cars' hosts signed
+count (`signature.Trust`): a key holder's own peer is not heard."""
 
 from __future__ import annotations
 
 import json
+import secrets
 import socket
 import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from appmode.net.names import ANY_INFO, ANY_STOP, Keys, name_of
+from appmode.net.signature import Trust
 from appmode.ports.remote import NAME
 
 if TYPE_CHECKING:
@@ -31,23 +34,14 @@ class Car:
     latency_ms: float
 
 
-def cars(session: zenoh.Session, wait: float = ASK) -> list[Car]:
-    """Every car that answers within `wait` seconds, by name."""
-    import zenoh
-
+def cars(session: zenoh.Session, trust: Trust, wait: float = ASK) -> list[Car]:
+    """Every car whose host answers within `wait` seconds, by name."""
     sent = time.monotonic()
     found: dict[str, Car] = {}
-    replies = session.get(
-        ANY_INFO,
-        target=zenoh.QueryTarget.ALL,
-        consolidation=zenoh.ConsolidationMode.NONE,  # two hosts of one name: both heard
-        timeout=wait,
-    )
-    for reply in replies:
-        if reply.ok is None:
-            continue
-        info = _object(reply.ok)
-        key = str(reply.ok.key_expr)
+    asked = token()
+    for reply in trust.replies(ask(session, ANY_INFO, asked, wait), asked):
+        info = _object(reply)
+        key = str(reply.key_expr)
         name = name_of(key)
         if info is not None and NAME.fullmatch(name) and key == Keys(name).info:  # a forged
             # 20,000-character name, or a wildcard's (`**`) reply: none
@@ -55,34 +49,45 @@ def cars(session: zenoh.Session, wait: float = ASK) -> list[Car]:
     return [found[name] for name in sorted(found)]
 
 
-def stop_all(session: zenoh.Session, wait: float = STOPPING) -> list[dict[str, Any]]:
+def stop_all(session: zenoh.Session, trust: Trust, wait: float = STOPPING) -> list[dict[str, Any]]:
     """Stop every car; each car's answer: `name`, `sent` (its stop went out),
     `confirmed` (its A records showed it at rest; None: it sends none)."""
-    import zenoh
-
-    who = socket.gethostname()
-    replies = session.get(
-        ANY_STOP,
-        target=zenoh.QueryTarget.ALL,
-        consolidation=zenoh.ConsolidationMode.NONE,  # each host's answer, whatever its name
-        attachment=who,
-        timeout=wait,
-    )
+    asked = f"{socket.gethostname()} {token()}"
     answers = [
         answer
-        for r in replies
-        if r.ok is not None
-        and (answer := _object(r.ok))
-        and str(r.ok.key_expr) == Keys(str(answer.get("name"))).stop  # its own car's
+        for reply in trust.replies(ask(session, ANY_STOP, asked, wait), asked)
+        if (answer := _object(reply))
+        and str(reply.key_expr) == Keys(str(answer.get("name"))).stop  # its own car's
     ]
     return sorted(answers, key=lambda answer: str(answer.get("name")))
+
+
+def token() -> str:
+    """A query's own token: the answer signed over it answers this query alone."""
+    return secrets.token_hex(8)
+
+
+def ask(session: zenoh.Session, key: str, attachment: str, wait: float, payload: str = "") -> Any:
+    """Every answer to a query of `key`, as they come: each host's, whatever its name
+    (two hosts of one name: both heard), and whoever else answers (only what the car's
+    host signed counts: `Trust`), whichever is nearer."""
+    import zenoh
+
+    return session.get(
+        key,
+        payload=payload or None,
+        target=zenoh.QueryTarget.ALL,
+        consolidation=zenoh.ConsolidationMode.NONE,
+        attachment=attachment,
+        timeout=wait,
+    )
 
 
 def _object(sample: zenoh.Sample) -> dict[str, Any] | None:
     """A reply's JSON object; None for anything else (what a car's host says is read as
     data from outside: shown escaped, never trusted to be well formed)."""
     try:
-        found = json.loads(sample.payload.to_string())
-    except (ValueError, UnicodeDecodeError):
+        found = json.loads(sample.payload.to_bytes())
+    except ValueError:
         return None
     return found if isinstance(found, dict) else None

@@ -22,13 +22,16 @@ def new_secret() -> str:
     return secrets.token_hex(SECRET_BYTES)
 
 
+def framed(*parts: str | bytes) -> bytes:
+    """`parts` as one message, each length-prefixed: no two lists of parts share one."""
+    data = [part.encode() if isinstance(part, str) else part for part in parts]
+    return b"".join(len(part).to_bytes(4, "big") + part for part in data)
+
+
 def mac(secret: str, count: int, *parts: str | bytes) -> str:
-    """The HMAC of `count` and `parts` (each length-prefixed: no two messages share one)."""
-    signer = hmac.new(secret.encode(), digestmod=hashlib.sha256)
-    for part in (str(count), *parts):
-        data = part.encode() if isinstance(part, str) else part
-        signer.update(len(data).to_bytes(4, "big") + data)
-    return signer.hexdigest()[:MAC_CHARACTERS]
+    """The HMAC of `count` and `parts`."""
+    message = framed(str(count), *parts)
+    return hmac.new(secret.encode(), message, hashlib.sha256).hexdigest()[:MAC_CHARACTERS]
 
 
 @dataclass(frozen=True, slots=True)

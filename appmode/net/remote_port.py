@@ -28,8 +28,10 @@ from appmode.errors import AppmodeError
 from appmode.host import far
 from appmode.net.beats import BeatSender
 from appmode.net.config import Tls, close_session, open_session, zenoh_module
+from appmode.net.fleet import ask, token
 from appmode.net.names import Keys, concrete
 from appmode.net.proof import Prover
+from appmode.net.signature import Trust
 from appmode.net.stamps import unstamp
 from appmode.ports.modemless import Modemless
 from appmode.ports.remote import RemoteTarget, WriteRefused
@@ -53,6 +55,9 @@ WRITE_TIMEOUT = 2.0
 """Seconds a write waits for the car's host to say the bytes left (a round trip, and
 TCP's resending of a packet lost on the way: 0.3 + 0.6 s over a link of 150 ms each
 way); bytes that reach it later are not written."""
+REPLAY = 1.0
+"""Seconds an event may be older than the newest heard (the car's host says them from
+several threads); an older one is a replay."""
 CLOSING = 0.3
 """Seconds the share's token may go before its last word, that it ends, is heard."""
 LINK_DOWN = (
@@ -90,6 +95,10 @@ class RemoteSerial(Modemless):
         self._remote, self._side = remote, target.sim_port
         self._keys = Keys(remote.name)
         self._client = new_client()
+        self._trust = Trust(remote.key, remote.host_id)
+        """Who speaks for the car: only what its host signed is heard."""
+        self._said_at = 0.0
+        """The car's time of the newest event heard (an older one is a replay)."""
         self._prover = Prover()
         """What proves this client's heartbeats and writes its own, once it drives."""
         self._ready = threading.Condition()
@@ -137,18 +146,13 @@ class RemoteSerial(Modemless):
     def _found(self) -> None:
         """The car's host answers and shares this port; the car's clock, from its info."""
         name = self._remote.name
-        sent = time.monotonic()
-        replies = list(self._session.get(self._keys.info, timeout=FIND))
-        found = next(
-            (r.ok for r in replies if r.ok is not None and str(r.ok.key_expr) == self._keys.info),
-            None,
-        )
-        if found is None:
+        sent, asked = time.monotonic(), token()
+        info = self._trust.answer(ask(self._session, self._keys.info, asked, FIND), asked)
+        if info is None or info.get("name") != name:
             raise SerialException(
                 f"no car named {name} answers at {self._where()}: is 'appmode share --name "
-                f"{name}' running there, with this key?"
+                f"{name}' running there, with this key?{self._trust.refusal()}"
             )
-        info = json.loads(found.payload.to_string())
         self.simulated = info.get("simulated") is True
         """The car shared is a simulated board (the views say so)."""
         self.car_link_down = LINK_DOWN if info.get("links", {}).get(self._side) is False else None
@@ -159,10 +163,13 @@ class RemoteSerial(Modemless):
             raise SerialException(f"{name} shares no {self._side} port (it shares {shared})")
         now = time.monotonic()
         self._origin = now - (now - sent) / 2 - float(info["time"])
+        self._said_at = float(info["time"])
         """`time.monotonic()` at the car's clock zero, as seen here: the car's times of
         its bytes plus this are this machine's (a recording here is timed at the car)."""
 
     def _declare(self) -> None:
+        import zenoh
+
         session, keys = self._session, self._keys
         self._declared: list[Any] = [
             session.declare_subscriber(keys.bytes(self._side), self._on_bytes),
@@ -170,7 +177,12 @@ class RemoteSerial(Modemless):
             session.liveliness().declare_subscriber(keys.presence, self._on_presence, history=True),
             session.liveliness().declare_token(keys.driver(self._client)),
         ]
-        self._writer = session.declare_querier(keys.write(self._side), timeout=WRITE_TIMEOUT)
+        self._writer = session.declare_querier(
+            keys.write(self._side),
+            target=zenoh.QueryTarget.ALL,  # the car's host's queryable too, whatever is nearer
+            consolidation=zenoh.ConsolidationMode.NONE,
+            timeout=WRITE_TIMEOUT,
+        )
         self._beating = threading.Event()
         self._datagrams = BeatSender(self._remote.connect)  # here: a name it resolves
         # holds up no heartbeat
@@ -183,9 +195,11 @@ class RemoteSerial(Modemless):
         stamped = None if sample.attachment is None else unstamp(sample.attachment.to_bytes())
         if stamped is None or not concrete(sample.key_expr):
             return
-        at, direction = stamped
-        if direction not in RECEIVED_DIRECTIONS:
+        at, direction, stamp = stamped
+        if direction not in RECEIVED_DIRECTIONS or at < self._heard:  # a replay's are older
             return
+        if not self._trust.sample(sample, stamp):
+            return  # not the car's host's
         data = sample.payload.to_bytes()
         self._host_heard = time.monotonic()
         if not self._joined:  # the APP port's stream is joined at a record's start
@@ -201,11 +215,17 @@ class RemoteSerial(Modemless):
 
     def _on_event(self, sample: zenoh.Sample) -> None:
         try:
-            event = json.loads(sample.payload.to_string())
+            event = json.loads(sample.payload.to_bytes())
         except ValueError:
             return
         if not concrete(sample.key_expr) or not isinstance(event, dict):
-            return  # nobody's word (a wildcard's), or not the car's host's
+            return  # nobody's word (a wildcard's)
+        at = event.get("at")
+        if not isinstance(at, int | float) or at < self._said_at - REPLAY:
+            return  # a replay of what the car's host said before
+        if not self._trust.sample(sample):
+            return  # not the car's host's
+        self._said_at = max(self._said_at, at)
         self._host_heard = time.monotonic()
         if event.get("t") == "dropped" and event.get("client") == self._client:
             self._lose(escaped(str(event.get("why"))[:200]))
@@ -333,43 +353,39 @@ class RemoteSerial(Modemless):
         sent = time.monotonic()
         until = f"{sent - self._origin + WRITE_TIMEOUT:.3f}"  # the car's clock: not after
         proof = self._prover.words("write", self._client, until, payload)
+        asked = f"{self._client} {until}{proof}"
         with far.acknowledging():  # the car's host is the stop authority while it waits
-            replies = list(
-                self._writer.get(payload=payload, attachment=f"{self._client} {until}{proof}")
+            said = self._trust.answer(
+                self._writer.get(payload=payload, attachment=asked), asked, payload
             )
         self.latency = (time.monotonic() - sent) * 1000
-        if not replies:
-            self._lose(f"the car's host did not answer within {WRITE_TIMEOUT:g} s")
+        if said is None:
+            why = f"the car's host did not answer within {WRITE_TIMEOUT:g} s"
+            self._lose(why + self._trust.refusal())
             self._check()
-        reply = replies[0]
-        if reply.ok is None:
-            raise _write_error(reply.err)
-        said = json.loads(reply.ok.payload.to_string())
+        assert said is not None
+        if "at" not in said:
+            raise _write_error(said)
         self._granted(said)
         self.written_at = float(said["at"])
         return len(payload)
 
-    def _granted(self, said: object) -> None:
+    def _granted(self, said: dict[str, Any]) -> None:
         """Keep the secret the car's host granted the lease with (`proof`)."""
-        secret = said.get("secret") if isinstance(said, dict) else None
+        secret = said.get("secret")
         if isinstance(secret, str):
             self._prover.secret = secret
 
     def _take(self) -> None:
         """Take the driving over (`take=1`), once: the car's host stops the car first."""
         body = json.dumps({"take": True})
-        replies = list(
-            self._session.get(
-                self._keys.lease, payload=body, attachment=self._client, timeout=WRITE_TIMEOUT
-            )
-        )
-        error = replies[0].err if replies else None
-        if not replies or error is not None:
-            why = "no answer" if error is None else error.payload.to_string()
+        asked = self._client
+        replies = ask(self._session, self._keys.lease, asked, WRITE_TIMEOUT, body)
+        said = self._trust.answer(replies, asked, body)
+        if said is None or not said.get("granted"):
+            why = "no answer" if said is None else escaped(str(said.get("refused"))[:200])
             raise SerialException(f"cannot take the driving of {self._remote.name}: {why}")
-        granted = replies[0].ok
-        with contextlib.suppress(ValueError):
-            self._granted(json.loads(granted.payload.to_string()) if granted else None)
+        self._granted(said)
         _TOOK.add(self._remote.name)
 
     def _check(self) -> None:
@@ -414,15 +430,9 @@ class RemoteSerial(Modemless):
             close_session(self._session)
 
 
-def _write_error(error: zenoh.ReplyError | None) -> SerialException:
+def _write_error(said: dict[str, Any]) -> SerialException:
     """What the car's host's refusal of a write means: another client drives (the link
     stays up), or the car's link is down at its host."""
-    try:
-        said = json.loads(error.payload.to_string()) if error is not None else {}
-    except ValueError:
-        said = {}
-    if not isinstance(said, dict):
-        said = {}
     if "refused" in said:
         return WriteRefused(str(said["refused"]))
     return SerialException(str(said.get("down", "the car's host did not take the bytes")))

@@ -16,13 +16,14 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from appmode.errors import AppmodeError
-from appmode.host.app.state import STILL, HostState
+from appmode.host.app.state import HostState
 from appmode.host.app.stop_check import SETTLE
 from appmode.host.events import LinkStatus
 from appmode.host.kinds import AnyHost, open_hosts
 from appmode.host.link import Cut, LinkLost
 from appmode.net.asked import NOT_ASKED, asked_by, json_of, proof_of, text_of, write_refusal
 from appmode.net.hosts import claim
+from appmode.net.last_records import LastRecords
 from appmode.net.lease import Driver, Granted, Lease, Refused, Revoked, Unproven
 from appmode.net.names import ANY_STOP, Keys, concrete
 from appmode.net.stamps import stamp
@@ -34,14 +35,13 @@ from appmode.text import escaped, shortened
 if TYPE_CHECKING:
     import zenoh
 
+    from appmode.net.signature import Signer
     from appmode.ports.choice import BoardChoice
 
 TICK = 0.02
 """Seconds between the share's looks at the car and at the lease."""
 INFO_EVERY = 1.0
 """Seconds between two `info` samples published while nothing changes."""
-FRESH = 1.0
-"""Seconds an A record tells whether the car moves."""
 Log = Callable[[str], None]
 
 
@@ -55,10 +55,14 @@ class Port:
 
 
 class Share:
-    """The car of `choice`'s ports shared as `name` on `session` until `close`."""
+    """The car of `choice`'s ports shared as `name` on `session` until `close`, its
+    replies and samples signed by `signer`."""
 
-    def __init__(self, session: zenoh.Session, name: str, choice: BoardChoice, log: Log) -> None:
+    def __init__(
+        self, session: zenoh.Session, name: str, choice: BoardChoice, log: Log, signer: Signer
+    ) -> None:
         self.session = session
+        self.signer = signer
         self.keys = Keys(name)
         self.choice = choice
         self.log = log
@@ -71,14 +75,12 @@ class Share:
         self._used: set[str] = set()
         """The ports clients have written to: the ones a stop is for (a zero frame on an
         unused control port would take the motion over from the APP port, §8.3)."""
-        self._velocity: app.Velocity | None = None
-        self._velocity_at = 0.0
+        self._last = LastRecords()
         self._stops = 0
         """Stops sent so far: a write lets its rest go only while none came since it began."""
         self._host_token: Any = None
         self._events: Any = None
         """The events' publisher, once declared (after the stop at the start)."""
-        self._battery: int | None = None
 
         self._closed = threading.Event()
         for port, host in open_hosts(choice, self._tap).items():
@@ -127,22 +129,30 @@ class Share:
             when = at + link.origin - self._origin
             if direction in SENT_DIRECTIONS:
                 self._written[port] = when
-            publisher.put(data, attachment=stamp(when, direction))
+            self.signer.put(publisher, self.keys.bytes(port), data, stamp(when, direction))
 
         return tap
 
     def _writer(self, port: str) -> Callable[[zenoh.Query], None]:
+        key = self.keys.write(port)
+
+        def answer(query: zenoh.Query, **said: object) -> None:
+            self.signer.reply(query, key, json.dumps(said))
+
         def on_write(query: zenoh.Query) -> None:
             data = b"" if query.payload is None else query.payload.to_bytes()
-            words = asked_by(query, self.keys.write(port))
+            words = asked_by(query, key)
             refused = write_refusal(words, data, self.now())
+            if refused == NOT_ASKED:  # no client's: nobody's answer to sign
+                query.reply_err(NOT_ASKED)
+                return
             with self._lock:
                 if refused is None and words is not None:
                     proof = proof_of(words, 2)
                     proven = self.lease.proves(words[0], "write", proof, words[1], data)
                     refused = self._may_drive(words[0], take=False, proven=proven)
                 if refused is not None:
-                    query.reply_err(json.dumps({"refused": refused}))
+                    answer(query, refused=refused)
                     return
                 secret = self._secret()
                 host = self.ports[port].host
@@ -153,17 +163,16 @@ class Share:
             try:  # outside the lock: a stop pre-empts it, and none is sent after one
                 host.send(data, still=lambda: self._stops == stops)
             except Cut as exc:
-                query.reply_err(json.dumps({"refused": f"the car's host stopped the car: {exc}"}))
+                answer(query, refused=f"the car's host stopped the car: {exc}")
                 return
             except LinkLost as exc:
-                why = f"the car's {port} link is down at its host ({exc})"
-                query.reply_err(json.dumps({"down": why}))
+                answer(query, down=f"the car's {port} link is down at its host ({exc})")
                 return
             except AppmodeError:
                 pass  # written: only the share's own recording failed
             written = self._written.get(port)
             at = self.now() if written is None else written
-            query.reply(query.key_expr, json.dumps({"at": at, "driving": True, **secret}))
+            answer(query, at=at, driving=True, **secret)
 
         return on_write
 
@@ -197,14 +206,12 @@ class Share:
                 driver = self.lease.let_go(client) if proven else None
                 if driver is not None:
                     self._stop_car(f"the driver on {driver.machine} let go of the driving")
-                query.reply(query.key_expr, json.dumps({"granted": False}))
+                self.signer.reply(query, self.keys.lease, json.dumps({"granted": False}))
                 return
             refused = self._may_drive(client, take=bool(asked.get("take")), proven=proven)
             secret = self._secret()
-        if refused is not None:
-            query.reply_err(refused)
-        else:
-            query.reply(query.key_expr, json.dumps({"granted": True, **secret}))
+        said = {"granted": True, **secret} if refused is None else {"refused": refused}
+        self.signer.reply(query, self.keys.lease, json.dumps(said))
 
     def _secret(self) -> dict[str, str]:
         """The driver's secret, for the reply to its own granted query (only it gets it)."""
@@ -235,7 +242,7 @@ class Share:
                 self._stop_car(f"the driver on {driver.machine} left (its session ended)")
 
     def _on_info(self, query: zenoh.Query) -> None:
-        query.reply(self.keys.info, json.dumps(self.info()))
+        self.signer.reply(query, self.keys.info, json.dumps(self.info()))
 
     def _on_stop(self, query: zenoh.Query) -> None:
         """`fleet stop`: stop the car and say whether it took (on its A records, when
@@ -243,7 +250,8 @@ class Share:
         if str(query.key_expr) not in (self.keys.stop, ANY_STOP):
             query.reply_err(NOT_ASKED)  # `get appmode/**` is no fleet stop
             return
-        who = shortened(escaped(text_of(query.attachment) or "")) or "a client"
+        asker = (text_of(query.attachment) or "").split(" ")[0]  # then the client's token
+        who = shortened(escaped(asker)) or "a client"
 
         def stop() -> None:
             with self._lock:
@@ -255,7 +263,7 @@ class Share:
                     self._dropped(driver, f"{who} stopped every car (fleet stop)")
             confirmed = self._confirmed() if sent else None
             reply = {"name": self.keys.name, "sent": sent, "confirmed": confirmed}
-            query.reply(self.keys.stop, json.dumps(reply))
+            self.signer.reply(query, self.keys.stop, json.dumps(reply))
 
         threading.Thread(target=stop, name="fleet stop", daemon=True).start()
 
@@ -290,15 +298,13 @@ class Share:
         state = self._telemetry()
         if state is None:
             return None
-        layout = state.layout
         end = time.monotonic() + SETTLE
-        self._velocity = None
+        self._last.velocity = None
         while time.monotonic() < end:
             time.sleep(TICK)
-            velocity = self._velocity
-            if velocity is not None and layout.speed(app.record_fields(velocity)[1]) <= STILL:
+            if self._last.moving(state.layout) is False:
                 return True
-        return False if self._velocity is not None else None
+        return None if self._last.velocity is None else False
 
     def _dropped(self, driver: Driver, why: str) -> None:
         """Tell `driver` it drives no more, and why (its port is lost: it says so)."""
@@ -306,7 +312,8 @@ class Share:
 
     def _event(self, kind: str, **fields: object) -> None:
         if self._events is not None and not self._closed.is_set():
-            self._events.put(json.dumps({"t": kind, "at": round(self.now(), 3), **fields}))
+            said = json.dumps({"t": kind, "at": round(self.now(), 3), **fields})
+            self.signer.put(self._events, self.keys.events, said)
 
     def info(self) -> dict[str, object]:
         """The car as `fleet` shows it."""
@@ -321,7 +328,7 @@ class Share:
             "links": links,
             "machine": socket.gethostname(),
             "driver": None if driver is None else _driver(driver),
-            "battery": self._battery,
+            "battery": self._last.battery,
             "in_force": next(filter(None, motions), None),
             "moving": any(motions) or self._records_moving() is True,
             "records_moving": self._records_moving(),
@@ -395,34 +402,30 @@ class Share:
         while time.monotonic() < end:
             for port in self.ports.values():
                 for event in port.host.poll(TICK / len(self.ports)):
-                    if isinstance(event, app.Velocity):
-                        self._velocity, self._velocity_at = event, self.now()
-                        moving = state.layout.speed(app.record_fields(event)[1]) > STILL
-                        if not moving:
-                            return True
+                    seen = self._last.saw(event, self.now(), state.layout)
+                    if seen is False:
+                        return True
+                    moving = moving or seen
         return None if moving is None else False
 
     def _records_moving(self) -> bool | None:
         """Whether the car's last A record (of the last second) shows it moving; None:
         none came."""
-        state, velocity = self._telemetry(), self._velocity
-        if state is None or velocity is None or self.now() - self._velocity_at > FRESH:
-            return None
-        return state.layout.speed(app.record_fields(velocity)[1]) > STILL
+        state = self._telemetry()
+        return None if state is None else self._last.moving(state.layout, self.now())
 
     def _seen(self, port: Port, event: object) -> None:
         if isinstance(event, LinkStatus):
             self.log(f"{port.name}: {event.text}")
             self._event("link", port=port.name, up=event.up, text=event.text)
             return
-        if isinstance(event, app.Velocity):
-            self._velocity, self._velocity_at = event, self.now()
-        if isinstance(event, app.Attitude):
-            self._battery = event.battery
         state = port.host.telemetry
+        if state is not None:
+            self._last.saw(event, self.now(), state.layout)
         if isinstance(event, app.RECORDS) and state is not None:
             body = to_json(event, state.layout)
-            self._records.put(json.dumps({"t": round(self.now(), 3), **body}))
+            said = json.dumps({"t": round(self.now(), 3), **body})
+            self.signer.put(self._records, self.keys.records, said)
 
     def close(self) -> None:
         """Stop sharing: the car's stop last on every port (its hosts close), then the
@@ -435,7 +438,8 @@ class Share:
             port.host.stop_on_close = name in stopping
             delivered &= port.host.close() is not None or name not in stopping
         if self._events is not None:  # before the token goes: clients hear why it went
-            self._events.put(json.dumps({"t": "closed", "stopped": delivered}))
+            said = {"t": "closed", "at": round(self.now(), 3), "stopped": delivered}
+            self.signer.put(self._events, self.keys.events, json.dumps(said))
         for declared in [*getattr(self, "_declared", []), self._host_token]:
             if declared is not None:
                 declared.undeclare()

@@ -241,11 +241,13 @@ def parse_target(url: str) -> Target:
     return Target(scheme, address, options, radio=radio, remote=remote)
 
 
-def shared_car(name: str, connect: tuple[str, ...], key: str) -> Target:
+def shared_car(name: str, connect: tuple[str, ...], key: str, host_id: str | None) -> Target:
     """The car `name` shared on Zenoh, reached at `connect` (none: by scouting) with
-    `key`: the target its `zenoh://` URL names."""
+    `key`, signed for by the host of `host_id`: the target its `zenoh://` URL names."""
     options = {"connect": ",".join(connect)} if connect else {}
-    remote = RemoteTarget(name, connect, key)
+    if host_id is not None:
+        options["id"] = host_id
+    remote = RemoteTarget(name, connect, key, host_id=host_id)
     return Target("zenoh", name, _frozen({**options, "key": key}), remote=remote)
 
 

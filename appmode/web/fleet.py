@@ -27,6 +27,7 @@ from appmode.web.messages import FLEET_PAGE
 if TYPE_CHECKING:
     import zenoh
 
+    from appmode.net.signature import Trust
     from appmode.session.base import BaseSession
     from appmode.web.server import WebServer
 
@@ -42,11 +43,14 @@ VANISHED = "its host stopped answering: it may still be moving"
 
 
 class Fleet:
-    """The cars `session` reaches, looked at until `close`; `open_car(name)` opens a
-    driving session on one of them."""
+    """The cars `session` reaches (what their hosts signed: `trust`), looked at until
+    `close`; `open_car(name)` opens a driving session on one of them."""
 
-    def __init__(self, session: zenoh.Session, open_car: Callable[[str], BaseSession]) -> None:
+    def __init__(
+        self, session: zenoh.Session, trust: Trust, open_car: Callable[[str], BaseSession]
+    ) -> None:
         self.session = session
+        self.trust = trust
         self.open_car = open_car
         self.cars: list[dict[str, Any]] = []
         self._ended = threading.Event()
@@ -57,7 +61,7 @@ class Fleet:
 
     def _look(self) -> None:
         while not self._ended.is_set():
-            found = cars(self.session, wait=LOOK)
+            found = cars(self.session, self.trust, wait=LOOK)
             answered = [
                 {
                     **{k: car.info.get(k) for k in CARD_FIELDS[1:]},
@@ -83,7 +87,7 @@ class Fleet:
 
     def stop_all(self) -> list[dict[str, Any]]:
         """Stop every car; each one's answer (blocks up to a few seconds)."""
-        return stop_all(self.session)
+        return stop_all(self.session, self.trust)
 
     def close(self) -> None:
         self._ended.set()

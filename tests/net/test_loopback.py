@@ -87,12 +87,16 @@ def test_the_pytest_plugin_runs_against_a_shared_car(tmp_path: Path) -> None:
 
 
 def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fleet() -> None:
-    """A key holder's own 'share' answering with terminal escapes, a driver that is not
-    an object, and no JSON at all: `fleet` lists what it can, escaped, in one piece; a
-    name no share could take (escapes, 2,000 characters: issue 80.12) is no car."""
+    """A car's host (it holds the host key: it signs) answering with terminal escapes, a
+    driver that is not an object, and no JSON at all: `fleet` lists what it can, escaped,
+    in one piece; a name no share could take (escapes, 2,000 characters: issue 80.12) is
+    no car."""
     import zenoh
 
     from appmode.net.config import close_session, free_port, open_session
+    from appmode.net.signature import Signer
+
+    signer = Signer("a hostile room's host key")
 
     endpoint = free_port("tcp/127.0.0.1:0")
     evil = "evil\x1b]52;c;bm9wZQ==\x07\x1b[2J"
@@ -106,11 +110,11 @@ def test_what_a_hostile_car_s_host_says_is_shown_escaped_and_never_breaks_the_fl
 
     def answer(query: zenoh.Query) -> None:
         for key, body in answers.items():
-            query.reply(key, "{not json" if body is None else json.dumps(body))
+            signer.reply(query, key, "{not json" if body is None else json.dumps(body))
 
     queryable = session.declare_queryable("appmode/*/info", answer)
     try:
-        listed = run("fleet", "--connect", endpoint, "--key", KEY)
+        listed = run("fleet", "--connect", endpoint, "--key", KEY, "--id", signer.id)
     finally:
         queryable.undeclare()
         close_session(session)

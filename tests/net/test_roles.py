@@ -91,8 +91,9 @@ class Forger:
             for reply in session.get(
                 keys.write("app"), payload=b"A", attachment=f"{driver} 1e9 99999 {'0' * 32}"
             ):
-                if reply.err is not None:
-                    self.refusals.append(reply.err.payload.to_string())
+                said = reply.ok.payload.to_string() if reply.ok is not None else "{}"
+                if "refused" in json.loads(said):
+                    self.refusals.append(said)
 
     def close(self) -> None:
         from appmode.net.config import close_session

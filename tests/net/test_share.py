@@ -110,10 +110,11 @@ def driving(
 def test_the_url_names_the_car_s_lan_address_and_hides_nothing_but_the_key(
     shared: SharedCar,
 ) -> None:
+    from appmode.net.signature import Signer
+
     address = shared.machines["car"].address
-    assert (
-        shared.url == f"zenoh://car?connect=tcp/{address}:7450&key=k3y%20with%20spaces%20%26%20such"
-    )
+    key, host_id = "k3y%20with%20spaces%20%26%20such", Signer(HOST_KEY).id
+    assert shared.url == f"zenoh://car?connect=tcp/{address}:7450&key={key}&id={host_id}"
 
 
 def test_a_laptop_drives_reads_and_records_the_shared_car(
@@ -433,3 +434,42 @@ def test_a_frozen_driver_that_wakes_up_drives_no_more(shared: SharedCar) -> None
     assert sent.index("A") < len(sent) - 1 and "A" not in sent[sent.index("A") + 1 :], sent
     again = shared.laptop.run("send", shared.url, "J", "A", "wait:0.3", timeout=30)
     assert again.returncode == 0, again.stderr  # another link of the laptop's drives
+
+
+def test_a_key_holder_s_own_peer_that_clients_join_does_not_speak_for_the_car(
+    shared: SharedCar,
+) -> None:
+    """Issue 80.5: a key holder's own Zenoh peer, joined to the car's host with the key,
+    took the clients that joined it (as one that scouts may) for the car: a forged fleet
+    list, a driver told it was dropped, and "stopped (confirmed)" from a car whose host
+    was killed. Only what the car's host signed is heard: the id in the URL, or for
+    `fleet` the first host met with the key, kept."""
+    car = shared.machines["car"].address
+    first = shared.laptop.run("fleet", "--connect", f"tcp/{car}:7450", "--key", KEY, "--json")
+    assert first.returncode == 0, first.stderr  # its host's id, now kept on the laptop
+    peer = subprocess.Popen(
+        shared.machines["stranger"].command(
+            sys.executable, "-m", "tests.support.own_peer",
+            "tcp/0.0.0.0:7460", f"tcp/{car}:7450", KEY, "car",
+        ),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+    )  # fmt: skip
+    try:
+        assert peer.stdout is not None and peer.stdout.readline().strip() == "ready"
+        through = f"tcp/{shared.machines['stranger'].address}:7460"
+        url = shared.url.replace(f"tcp/{car}:7450", through)
+        driver = driving(shared, "drive A\nwait 3\n", url)
+        fleet = shared.laptop.run("fleet", "--connect", through, "--key", KEY, "--json")
+        out, err = driver.communicate(timeout=30)
+        assert driver.returncode == 0 and "FORGED" not in out + err, out + err
+        (listed,) = json.loads(fleet.stdout)
+        assert listed["driver"]["machine"] and listed["moving"] is True, listed
+        shared.share.send_signal(signal.SIGKILL)
+        shared.share.wait(10)
+        stop = shared.laptop.run("fleet", "stop", "--connect", through, "--key", KEY)
+    finally:
+        peer.terminate()
+        answered, _ = peer.communicate(timeout=10)
+    assert "answered appmode/car/info" in answered and "answered appmode/car/stop" in answered
+    assert stop.returncode == 1 and "confirmed" not in stop.stdout, stop.stdout + stop.stderr
+    assert "answers came from a host whose id is not the car's host's" in stop.stderr

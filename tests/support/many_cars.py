@@ -11,6 +11,7 @@ import threading
 
 from appmode.net.config import close_session, open_session
 from appmode.net.share import Share
+from appmode.net.signature import Signer
 from appmode.ports.choice import choose
 from appmode.ports.target import parse_target
 
@@ -24,10 +25,11 @@ def main(count: int, listen: str, key: str) -> None:
     ended = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: ended.set())
     shares: list[Share] = []
+    signer = Signer("many cars' host key")
     try:
         for n in range(1, count + 1):
             choice = choose(parse_target("sim://"), both=True)
-            shares.append(Share(session, f"car-{n:02}", choice, _log))
+            shares.append(Share(session, f"car-{n:02}", choice, _log, signer))
         runs = [threading.Thread(target=s.run, args=(ended.is_set,), daemon=True) for s in shares]
         for run in runs:
             run.start()

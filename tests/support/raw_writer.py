@@ -43,13 +43,14 @@ def main(
             asker = f"{CLIENT} {until}" + prover.words("write", CLIENT, until, data)
             replies = list(session.get(keys.write("app"), payload=data, attachment=asker))
             reply = replies[0] if replies else None
+            said = None if reply is None or reply.ok is None else reply.ok.payload.to_string()
             if reply is None:
                 print("no answer", flush=True)
-            elif reply.ok is not None:
-                prover.secret = json.loads(reply.ok.payload.to_string()).get("secret")
+            elif said is not None and "at" in json.loads(said):
+                prover.secret = json.loads(said).get("secret")
                 print("ok", flush=True)
-            else:
-                print(f"error {reply.err.payload.to_string()}", flush=True)
+            else:  # refused (signed by the car's host), or a malformed query's error
+                print(f"error {said or reply.err.payload.to_string()}", flush=True)
                 return  # as a client does once its write is refused
             if float(freeze) and awake.is_set():
                 awake.clear()  # frozen: no heartbeat, no write
