@@ -124,7 +124,9 @@ def test_holding_up_drives_and_letting_go_stops(
     assert all(before == "Z" for letter, before in pairs if letter == "A"), payloads
     z_after = [t for t, p in lines if p == "Z" and t > typed[24]]
     release = z_after[0] - typed[24]
-    assert 0.14 <= release <= 0.35, f"stopped {release:.3f} s after the last repeat"
+    # due 0.25 s after it (the repeat time-out, then the session's 0.1-s tick); a loaded
+    # machine's scheduler may add a tenth and more to a wait: 0.394 s beside five workers
+    assert 0.14 <= release <= 0.45, f"stopped {release:.3f} s after the last repeat"
     assert payloads[-1] == "Z"
 
 

@@ -44,7 +44,9 @@ def test_events_and_statistics_at_the_line_rate() -> None:
         events = list(host.events(2.2))
         kinds = {type(e) for e in events}
         assert kinds == {Velocity, Attitude}
-        assert 40 <= len(events) <= 46, "about 20 records a second"
+        # 44 in 2.2 s; a loaded machine reads late, and the window's ends catch a few
+        # records more or less (47 beside five other workers)
+        assert 40 <= len(events) <= 48, "about 20 records a second"
         stats = host.state.stats
         assert stats.records == len(events) and stats.errors == 0
         assert 15 <= stats.rate(host.now()) <= 21
