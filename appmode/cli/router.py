@@ -6,10 +6,14 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.options import Subparsers, listening_endpoint
 from appmode.cli.share import add_host_key
+
+if TYPE_CHECKING:
+    from appmode.net.beats import BeatRelay
 
 DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
 
@@ -42,8 +46,9 @@ def run(args: argparse.Namespace) -> int:
 
     zenoh_module()
     listen = free_port(args.listen)
-    key = args.key or kept_key()
-    session = open_session("router", key, listen=(listen,), host_key=host_key(args))
+    key, hosts_key = args.key or kept_key(), host_key(args)
+    session = open_session("router", key, listen=(listen,), host_key=hosts_key)
+    relay = _relay(listen, hosts_key)
     ended = [False]
     try:
         print(f"router: {listen}", flush=True)
@@ -52,5 +57,27 @@ def run(args: argparse.Namespace) -> int:
             while not ended[0]:
                 time.sleep(0.1)
     finally:
+        if relay is not None:
+            relay.close()
         close_session(session)
     return 0
+
+
+def _relay(listen: str, hosts_key: str) -> BeatRelay | None:
+    """The drivers' heartbeats on UDP, relayed to the cars' hosts (`net.beats`), at the
+    port number the router listens on; None, said, when that port is taken."""
+    from appmode.net.beats import BeatRelay, address_of
+
+    address = address_of(listen)
+    if address is None:
+        return None
+    try:
+        return BeatRelay(*address, hosts_key)
+    except OSError as exc:
+        print(
+            f"appmode: heartbeats on UDP port {address[1]}: {exc.strerror}: they reach the cars "
+            "on Zenoh alone",
+            file=sys.stderr,
+            flush=True,
+        )
+        return None

@@ -187,11 +187,11 @@ def _serve(sharing: Sharing, choice: BoardChoice) -> int:
         host_key=sharing.host_key,
     )
     shared: Share | None = None
-    beats: BeatListener | None = None
+    beats: list[BeatListener] = []
     try:
         signer = Signer(sharing.host_key)
         shared = Share(session, sharing.name, choice, _log, signer)
-        beats = _beats(listen, shared)
+        beats = _beats(sharing, shared)
         _joined(session, sharing.connect)
         print(remote_url(sharing, signer.id), flush=True)
         _announce(sharing.host, listen, everywhere)
@@ -199,8 +199,8 @@ def _serve(sharing: Sharing, choice: BoardChoice) -> int:
         with signals.diverted(ended.set):
             shared.run(ended.is_set)
     finally:
-        if beats is not None:
-            beats.close()
+        for listener in beats:
+            listener.close()
         if shared is not None:
             shared.close()
         close_session(session)
@@ -219,19 +219,26 @@ def _joined(session: zenoh.Session, connect: tuple[str, ...]) -> None:
         )
 
 
-def _beats(listen: str, shared: Share) -> BeatListener | None:
-    """The driver's heartbeats on UDP, at the port number of `listen` (`net.beats`);
-    None, said, when that port is taken (they come on Zenoh alone)."""
-    from appmode.net.beats import BeatListener, address_of
+def _beats(sharing: Sharing, shared: Share) -> list[BeatListener]:
+    """The driver's heartbeats on UDP (`net.beats`): at the port number the share
+    listens on, and relayed by each router it connects to; where that port is taken,
+    said, they come on Zenoh alone."""
+    from appmode.net.beats import BeatListener, RelayedBeats, address_of
 
-    address = address_of(listen)
-    if address is None:
-        return None
-    try:
-        return BeatListener(*address, shared.keys.name, shared.beat)
-    except OSError as exc:
-        _log(f"heartbeats on UDP port {address[1]}: {exc.strerror}: they come on Zenoh alone")
-        return None
+    name, beat = shared.keys.name, shared.beat
+    listeners: list[BeatListener] = []
+    address = address_of(sharing.listen)
+    if address is not None:
+        try:
+            listeners.append(BeatListener.on(*address, name, beat))
+        except OSError as exc:
+            _log(f"heartbeats on UDP port {address[1]}: {exc.strerror}: they come on Zenoh alone")
+    for router in filter(None, map(address_of, sharing.connect)):
+        try:
+            listeners.append(RelayedBeats(router, name, beat, sharing.host_key))
+        except OSError as exc:
+            _log(f"heartbeats through {router[0]}: {exc.strerror}: they come on Zenoh alone")
+    return listeners
 
 
 class _Ended:

@@ -4,8 +4,10 @@ TUN devices and a forwarder, the kernel's own TCP in each namespace). A write wa
 0.3 s for the car's host to acknowledge it; the driver's stop guard took that wait for a
 stalled view and stopped the car after every other letter. At 5 % loss TCP held the
 heartbeats back past the lease, and the car's host stopped the live driver: they go on
-UDP too now. A live driver is never stopped, every letter arrives, and a link really
-lost still stops the car within half a second. Judged on the board's recording."""
+UDP too now, and through a router (on the car's side of the link) the router relays
+them to the car's host that greeted it. A live driver is never stopped, every letter
+arrives, and a link really lost still stops the car within half a second. Judged on the
+board's recording."""
 
 from __future__ import annotations
 
@@ -29,22 +31,27 @@ LETTERS = "ABCDEFGH"
 
 @pytest.mark.slow
 @pytest.mark.timing
-@pytest.mark.parametrize("loss", [0.0, 0.05])
+@pytest.mark.parametrize(("loss", "through"), [(0.0, "share"), (0.05, "share"), (0.05, "router")])
 def test_a_slow_link_stops_no_live_driver_and_a_lost_one_stops_the_car(
-    loss: float, tmp_path: Path
+    loss: float, through: str, tmp_path: Path
 ) -> None:
     record = tmp_path / "board.transcript"
     board = BoardProcess("--pty", "--quiet", "--record", str(record))
     with wan(delay=0.15, loss=loss) as (machines, link):
         car, laptop = machines["car"], machines["laptop"]
+        keys = ("--key", "k", "--host-key", HOST_KEY)
+        router = car.popen("router", "--listen", "tcp/0.0.0.0:7447", *keys)
+        assert router.stdout is not None and router.stdout.readline().startswith("router: ")
         share = car.popen(
-            "share", board.url, "--name", "car", "--listen", "tcp/0.0.0.0:7450", "--key", "k",
-            "--host-key", HOST_KEY,
+            "share", board.url, "--name", "car", "--listen", "tcp/0.0.0.0:7450",
+            "--connect", "tcp/127.0.0.1:7447", *keys,
         )  # fmt: skip
         try:
             assert share.stdout is not None
             url = share.stdout.readline().strip()
             assert url.startswith("zenoh://"), share.communicate()[1]
+            if through == "router":
+                url = url.replace(":7450", ":7447")
             script = "".join(f"drive {letter}\nwait 1.5\n" for letter in LETTERS) + "wait 60\n"
             driver = laptop.popen("drive", url, stdin=subprocess.PIPE)
             assert driver.stdin is not None
@@ -66,6 +73,8 @@ def test_a_slow_link_stops_no_live_driver_and_a_lost_one_stops_the_car(
         finally:
             share.terminate()
             share.communicate(timeout=10)
+            router.terminate()
+            router.communicate(timeout=10)
             board.stop()
 
 
