@@ -32,9 +32,12 @@ def driving(
     return serving("drive", url, "--foxglove-drive", *extra, stdin=f"wait {seconds}\n")
 
 
-def finish(proc: subprocess.Popen[str]) -> tuple[str, str]:
-    """The session's end: what it printed on stdout and stderr."""
+def finish(proc: subprocess.Popen[str], early: bool = True) -> tuple[str, str]:
+    """The session's end (`early`: ended now, by SIGTERM, rather than at its script's
+    end): what it printed on stdout and stderr."""
     assert proc.stdout is not None and proc.stderr is not None
+    if early:
+        proc.terminate()
     out, err = proc.stdout.read(), proc.stderr.read()
     proc.wait(20)
     return out, err
@@ -160,7 +163,7 @@ def test_garbage_and_a_killed_viewer_say_a_line_each_never_the_servers_log(
 ) -> None:
     with board_process() as board, driving(board.url, seconds=4) as (proc, url):
         asyncio.run(malformed(url))
-        out, err = finish(proc)
+        out, err = finish(proc, early=False)
     assert proc.returncode == 0, err
     assert "Error receiving" not in err and "Invalid message" not in err, err
     assert "\x1b" not in out + err and "bogus0\\x1b[2J" in out  # shown escaped
