@@ -29,6 +29,27 @@ def _read_timed(fd: int, seconds: float) -> list[tuple[float, bytes]]:
 
 
 def test_a_c_record_arrives_over_its_wire_time_and_never_faster() -> None:
+    """Judged on a read the reader made in time: a reader the machine kept waiting past
+    the record's 32 ms (beside six workers on two cores) finds it whole, as on a car,
+    and that read tells nothing; each of three tries reads the C record afresh."""
+    spreads = []
+    for _ in range(3):
+        chunks, spread, wire = _c_record()
+        spreads.append(spread)
+        # never faster than the line: after the first read, bytes come at most one per
+        # byte time (one read's worth of slack for a reader that was late)
+        t0, before = chunks[0][0], 0
+        for t, chunk in chunks[1:]:
+            before += len(chunk)
+            assert before <= (t - t0) / BYTE + 8, f"{before} bytes in {1000 * (t - t0):.1f} ms"
+        if spread > wire / 2:
+            return
+    raise AssertionError(f"the C record came whole each time: {spreads} s, its wire time {wire}")
+
+
+def _c_record() -> tuple[list[tuple[float, bytes]], float, float]:
+    """A board's answer to `{Q:P}` as read: the timed chunks, the time between the C
+    record's first and last bytes' reads, and its wire time."""
     with board_process("--quiet") as board:
         fd = os.open(board.url, os.O_RDWR | os.O_NOCTTY)
         try:
@@ -49,11 +70,4 @@ def test_a_c_record_arrives_over_its_wire_time_and_never_faster() -> None:
         pos += len(chunk)
     first = next(t for a, b, t in offsets if a <= start < b)
     last = next(t for a, b, t in offsets if a <= end < b)
-    wire = (end - start + 1) * BYTE  # 31 bytes: 32 ms
-    assert last - first > wire / 2, f"the C record came in {1000 * (last - first):.1f} ms"
-    # never faster than the line: after the first read, bytes come at most one per byte
-    # time (one read's worth of slack for a reader that was late)
-    t0, before = chunks[0][0], 0
-    for t, chunk in chunks[1:]:
-        before += len(chunk)
-        assert before <= (t - t0) / BYTE + 8, f"{before} bytes in {1000 * (t - t0):.1f} ms"
+    return chunks, last - first, (end - start + 1) * BYTE  # 31 bytes: 32 ms
