@@ -39,8 +39,8 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
     Most tests wait on boards, ptys and processes in real time: three workers used 0.6
     of a core and took 7.5 minutes. Six (three a core) took 4 min 44 s to 5 min 8 s, but
-    each of six runs failed a test the load starved — a pty read 0.48 s late, a C record
-    read whole, a key let go stopped 0.5 s after — and CI must pass. So three, and, as
+    three runs of five failed a test the load starved — a pty read 0.48 s late, a C
+    record read whole, a key let go stopped 0.5 s after — and CI must pass. So three, and, as
     `make -l` does, a run started beside another run of this suite (RUNS), or on a
     machine whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
