@@ -75,8 +75,14 @@ def json_of(query: zenoh.Query) -> dict[str, Any] | None:
     text = text_of(query.payload)
     if not text:
         return None if text is None else {}
+    return json_object(text)
+
+
+def json_object(data: str | bytes) -> dict[str, Any] | None:
+    """`data`'s JSON object; None for anything else (what comes from outside is read as
+    data: never trusted to be well formed)."""
     try:
-        found = json.loads(text)
-    except ValueError:
+        found = json.loads(data)
+    except ValueError:  # not JSON, or not UTF-8
         return None
     return found if isinstance(found, dict) else None

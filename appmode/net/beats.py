@@ -8,8 +8,8 @@ only what the same heartbeat on Zenoh would (`lease.Lease.beat`).
 
 Through a router the driver's datagrams reach the router: it relays each to the car's
 host that greeted it last for the car's name (`+hello NAME COUNT MAC`, every second,
-from the port the host listens on, under the room's host key, each count higher than
-the last: a stranger can neither greet for a car nor replay a greeting)."""
+from a socket connected to the router, under the room's host key, each count higher
+than the last: a stranger can neither greet for a car nor replay a greeting)."""
 
 from __future__ import annotations
 

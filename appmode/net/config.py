@@ -25,8 +25,8 @@ if TYPE_CHECKING:
 
 Mode = Literal["peer", "client", "router"]
 NO_ZENOH = (
-    f"the network needs eclipse-zenoh: {install_line('net')}; it has wheels for Linux, "
-    "macOS and Windows on x86-64 and ARM, a Raspberry Pi too"
+    f"the network needs eclipse-zenoh and cryptography: {install_line('net')}; both have "
+    "wheels for Linux, macOS and Windows on x86-64 and ARM, a Raspberry Pi too"
 )
 CLOSING = 1.0
 """Seconds a session is given to close: Zenoh waits up to ten for a peer whose network

@@ -5,13 +5,13 @@ count (`signature.Trust`): a key holder's own peer is not heard."""
 
 from __future__ import annotations
 
-import json
 import secrets
 import socket
 import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from appmode.net.asked import json_object
 from appmode.net.names import ANY_INFO, ANY_STOP, Keys, name_of
 from appmode.net.signature import Trust
 from appmode.ports.remote import NAME
@@ -40,7 +40,7 @@ def cars(session: zenoh.Session, trust: Trust, wait: float = ASK) -> list[Car]:
     found: dict[str, Car] = {}
     asked = token()
     for reply in trust.replies(ask(session, ANY_INFO, asked, wait), asked):
-        info = _object(reply)
+        info = json_object(reply.payload.to_bytes())
         key = str(reply.key_expr)
         name = name_of(key)
         if info is not None and NAME.fullmatch(name) and key == Keys(name).info:  # a forged
@@ -56,7 +56,7 @@ def stop_all(session: zenoh.Session, trust: Trust, wait: float = STOPPING) -> li
     answers = [
         answer
         for reply in trust.replies(ask(session, ANY_STOP, asked, wait), asked)
-        if (answer := _object(reply))
+        if (answer := json_object(reply.payload.to_bytes()))
         and str(reply.key_expr) == Keys(str(answer.get("name"))).stop  # its own car's
     ]
     return sorted(answers, key=lambda answer: str(answer.get("name")))
@@ -81,13 +81,3 @@ def ask(session: zenoh.Session, key: str, attachment: str, wait: float, payload:
         attachment=attachment,
         timeout=wait,
     )
-
-
-def _object(sample: zenoh.Sample) -> dict[str, Any] | None:
-    """A reply's JSON object; None for anything else (what a car's host says is read as
-    data from outside: shown escaped, never trusted to be well formed)."""
-    try:
-        found = json.loads(sample.payload.to_bytes())
-    except ValueError:
-        return None
-    return found if isinstance(found, dict) else None

@@ -26,6 +26,7 @@ from serial import SerialException
 
 from appmode.errors import AppmodeError
 from appmode.host import far
+from appmode.net.asked import json_object
 from appmode.net.beats import BeatSender
 from appmode.net.config import Tls, close_session, open_session, zenoh_module
 from appmode.net.fleet import ask, token
@@ -163,9 +164,9 @@ class RemoteSerial(Modemless):
             raise SerialException(f"{name} shares no {self._side} port (it shares {shared})")
         now = time.monotonic()
         self._origin = now - (now - sent) / 2 - float(info["time"])
-        self._said_at = float(info["time"])
         """`time.monotonic()` at the car's clock zero, as seen here: the car's times of
         its bytes plus this are this machine's (a recording here is timed at the car)."""
+        self._said_at = float(info["time"])
 
     def _declare(self) -> None:
         import zenoh
@@ -214,12 +215,9 @@ class RemoteSerial(Modemless):
             self._ready.notify_all()
 
     def _on_event(self, sample: zenoh.Sample) -> None:
-        try:
-            event = json.loads(sample.payload.to_bytes())
-        except ValueError:
-            return
-        if not concrete(sample.key_expr) or not isinstance(event, dict):
-            return  # nobody's word (a wildcard's)
+        event = json_object(sample.payload.to_bytes())
+        if event is None or not concrete(sample.key_expr):
+            return  # not the car's host's JSON, or nobody's word (a wildcard's)
         at = event.get("at")
         if not isinstance(at, int | float) or at < self._said_at - REPLAY:
             return  # a replay of what the car's host said before

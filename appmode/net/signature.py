@@ -11,12 +11,12 @@ from __future__ import annotations
 import base64
 import hashlib
 import hmac
-import json
 import os
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from appmode.net.asked import json_object
 from appmode.net.proof import framed
 from appmode.ports.remote import HOST_ID
 
@@ -108,14 +108,9 @@ class Trust:
     ) -> dict[str, Any] | None:
         """The car's host's signed answer to a query of `attachment` and `payload`, a JSON
         object; None when none came."""
-        for ok in self.replies(replies, attachment, payload):
-            try:
-                found = json.loads(ok.payload.to_bytes())
-            except ValueError:
-                continue
-            if isinstance(found, dict):
-                return found
-        return None
+        signed = self.replies(replies, attachment, payload)
+        answers = (json_object(ok.payload.to_bytes()) for ok in signed)
+        return next(filter(None, answers), None)
 
     def sample(self, sample: zenoh.Sample, stamp: bytes = b"") -> bool:
         """Whether the car's host signed `sample` (whose attachment's `stamp` is given)."""
