@@ -34,15 +34,15 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers for two cores on an idle machine, one a core on a busy
-    one.
+    """`-n auto`: three workers a core on an idle machine, one a core on a busy one.
 
     Most tests wait on boards, ptys and processes in real time: three workers used 0.6
-    of a core and took 7.5 minutes. Six (three a core) took 4 min 44 s to 5 min 8 s, but
-    three runs of five failed a test the load starved — a pty read 0.48 s late, a C
-    record read whole, a key let go stopped 0.5 s after — and CI must pass. So three, and, as
-    `make -l` does, a run started beside another run of this suite (RUNS), or on a
-    machine whose cores are already busy, takes one worker a core."""
+    of a core and took 7.5 minutes; six took five. Beside five others, though, a test
+    whose timing is its feature was starved (a pty read 0.48 s late, a C record read
+    whole, a key let go stopped 0.5 s after), so such a test (`timing`) runs with two
+    of its run's tests at most (`_slots`), the load its bounds were set for. As `make
+    -l` does, a run started beside another run of this suite (RUNS), or on a machine
+    whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -52,7 +52,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
         others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
     except OSError:  # another user's folder: the load average alone tells
         others = []
-    return cores if others or busy_cores() >= 0.9 * cores else cores + cores // 2
+    return cores if others or busy_cores() >= 0.9 * cores else 3 * cores
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
@@ -83,17 +83,77 @@ ALONE_WAIT = 300.0
 def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
     """A test marked `alone` (the suite in real time, run last) has the machine to
     itself: it waits until the tests running in this run and in others beside it end,
-    and theirs wait until it has. One marked `timing` has it to itself across runs of
-    this suite side by side, its own run going on beside it (the load its bounds were
-    set for). In the real-time suite beside the run's last tests a board's encoder
-    report came 50 ms late (±25 ms); beside another run its boards applied commands
-    later than its ±0.3 s, and a console let go of stopped the car 0.45 s after, not
-    within 0.35."""
+    and theirs wait until it has. One marked `timing` runs with at most TIMING_BESIDE of
+    its run's tests beside it (`_slots`: the load its bounds were set for, whatever the
+    number of workers), and has the machine to itself across runs of this suite side by
+    side. In the real-time suite beside the run's last tests a board's encoder report
+    came 50 ms late (±25 ms); beside another run its boards applied commands later than
+    its ±0.3 s, and a console let go of stopped the car 0.45 s after, not within 0.35."""
     others = _other_runs()
     alone = item.get_closest_marker("alone") is not None
-    timing = item.get_closest_marker("timing") is not None and bool(others)
-    with _machine(alone, timing, others):
+    timing = item.get_closest_marker("timing") is not None
+    with _machine(alone, timing and bool(others), others), _slots(alone, timing):
         yield
+
+
+TIMING_BESIDE = 2
+"""How many of its run's tests a `timing` test runs beside: with three workers, all
+its bounds held, run after run."""
+
+
+@contextlib.contextmanager
+def _slots(alone: bool, timing: bool) -> Iterator[None]:
+    """A slot of the run's (one a worker, RUN.N in ALONE) held while a test runs: any
+    test takes one, a `timing` test all but TIMING_BESIDE (an `alone` one has the run's
+    lock, `_machine`). One test gathers at a time (RUN.gather); while it does
+    (RUN.drain-PID), no other test starts, so the tests running end and it has their slots."""
+    count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    need = max(1, count - TIMING_BESIDE) if timing and not alone else 1  # `_machine`: alone
+    try:
+        import fcntl
+    except ImportError:  # Windows: tests are not kept apart
+        yield
+        return
+    if count < 2:
+        yield
+        return
+    run = _run()
+    drain = ALONE / f"{run}.drain-{os.getpid()}"
+    with contextlib.ExitStack() as held:
+        try:
+            slots = [held.enter_context((ALONE / f"{run}.{n}").open("a")) for n in range(count)]
+            if need > 1:
+                gather = held.enter_context((ALONE / f"{run}.gather").open("a"))
+                _wait(lambda: _locked(gather.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB))
+                drain.touch()
+                held.callback(drain.unlink, missing_ok=True)
+            else:
+                _wait(lambda: not _draining(run))
+        except OSError:  # another user's folder
+            yield
+            return
+        taken: set[int] = set()
+
+        def more() -> bool:
+            for n, slot in enumerate(slots):
+                if n not in taken and _locked(slot.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB):
+                    taken.add(n)
+                    if len(taken) == need:
+                        return True
+            return False
+
+        _wait(more)
+        drain.unlink(missing_ok=True)
+        yield
+    # closing the files let the locks go
+
+
+def _draining(run: str) -> bool:
+    """Whether a test of `run` is gathering slots (its worker still running)."""
+    for path in ALONE.glob(f"{run}.drain-*"):
+        if _running(path.name.rpartition("-")[2], path):
+            return True
+    return False
 
 
 @contextlib.contextmanager
@@ -138,9 +198,10 @@ def _wanted(run: str) -> bool:
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    """The run's lock file goes with it (its controller's)."""
+    """The run's lock and slot files go with it (its controller's)."""
     if not hasattr(config, "workerinput"):
-        (ALONE / f"{os.getpid()}.lock").unlink(missing_ok=True)
+        for path in ALONE.glob(f"{os.getpid()}.*"):
+            path.unlink(missing_ok=True)
 
 
 def _locked(fd: int, how: int) -> bool:

@@ -117,6 +117,7 @@ def test_the_url_names_the_car_s_lan_address_and_hides_nothing_but_the_key(
     assert shared.url == f"zenoh://car?connect=tcp/{address}:7450&key={key}&id={host_id}"
 
 
+@pytest.mark.timing
 def test_a_laptop_drives_reads_and_records_the_shared_car(
     shared: SharedCar, tmp_path: Path
 ) -> None:

@@ -9,6 +9,8 @@ import selectors
 import time
 import tty
 
+import pytest
+
 from appmode.line.pacing import byte_time
 from appmode.protocol.app import ParamsRecord
 from appmode.protocol.app_decoders import BoardDecoder
@@ -28,6 +30,7 @@ def _read_timed(fd: int, seconds: float) -> list[tuple[float, bytes]]:
     return chunks
 
 
+@pytest.mark.timing
 def test_a_c_record_arrives_over_its_wire_time_and_never_faster() -> None:
     """Judged on a read the reader made in time: a reader the machine kept waiting past
     the record's 32 ms (beside six workers on two cores) finds it whole, as on a car,
