@@ -88,12 +88,14 @@ def choose(
     board's chassis port alone."""
     if chassis or url.sim_port == CHASSIS:
         return _chassis(url, url2, uart2=uart2, profile=profile, drive=drive)
+    ports = board_ports(url, url2, uart2=uart2, profile=profile, drive=drive)
+    paired = None
     if both and url2 is None and (url.simulated or (uart2 and url.remote is not None)):
-        named = profile_named(profile or url.profile or "sheet")
-        if named.file is None or named.file.control_port:
-            url2, uart2 = url.for_uart2(), False
-    driven, beside, control = board_ports(url, url2, uart2=uart2, profile=profile, drive=drive)
-    chosen = profile_named(profile or driven.profile or "sheet")
+        paired = board_ports(url, url.for_uart2(), uart2=False, profile=profile, drive=drive)
+    chosen = profile_named(profile or ports[0].profile or "sheet")
+    if paired is not None and (chosen.file is None or chosen.file.control_port):
+        ports = paired  # both ports where the profile's board has a control port
+    driven, beside, control = ports
     if not control:
         if drive and not driven.simulated:
             raise AppmodeError(
@@ -122,12 +124,6 @@ def _chassis(
             "(--profile wheeltec-mec, wheeltec-akm or wheeltec-diff)"
         )
     name = profile or url.profile or "wheeltec-mec"
-    chosen = profile_named(name)
-    if chosen.chassis is None:
-        raise AppmodeError(
-            f"the {chosen.name} profile has no chassis port: give --profile wheeltec-mec, "
-            "wheeltec-akm, wheeltec-diff, or a profile file with a [chassis] table"
-        )
     board = url.with_sim(profile=name)
     if board.simulated or board.remote is not None:
         if board.sim_port not in (APP, CHASSIS) or (
@@ -138,4 +134,10 @@ def _chassis(
                 "chassis port (port=chassis, or leave port= out)"
             )
         board = board.on_port(CHASSIS)
+    chosen = profile_named(name)
+    if chosen.chassis is None:
+        raise AppmodeError(
+            f"the {chosen.name} profile has no chassis port: give --profile wheeltec-mec, "
+            "wheeltec-akm, wheeltec-diff, or a profile file with a [chassis] table"
+        )
     return BoardChoice(board, chosen, chassis=True)
