@@ -39,8 +39,8 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     Most tests wait on boards, ptys and processes in real time: three workers used 0.6
     of a core and took 7.5 minutes; six took five. Beside five others, though, a test
     whose timing is its feature was starved (a pty read 0.48 s late, a C record read
-    whole, a key let go stopped 0.5 s after), so such a test (`timing`) runs with two
-    of its run's tests at most (`_slots`), the load its bounds were set for. As `make
+    whole, a key let go stopped 0.5 s after), so such a test (`timing`) runs with three
+    of its run's tests at most (`_slots`), about the load its bounds were set for. As `make
     -l` does, a run started beside another run of this suite (RUNS), or on a machine
     whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
@@ -96,9 +96,9 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
         yield
 
 
-TIMING_BESIDE = 2
-"""How many of its run's tests a `timing` test runs beside: with three workers, all
-its bounds held, run after run."""
+TIMING_BESIDE = 3
+"""How many of its run's tests a `timing` test runs beside at most: with three
+workers, all its bounds held, run after run; six failed three runs of five."""
 
 
 @contextlib.contextmanager
@@ -106,7 +106,8 @@ def _slots(alone: bool, timing: bool) -> Iterator[None]:
     """A slot of the run's (one a worker, RUN.N in ALONE) held while a test runs: any
     test takes one, a `timing` test all but TIMING_BESIDE (an `alone` one has the run's
     lock, `_machine`). One test gathers at a time (RUN.gather); while it does
-    (RUN.drain-PID), no other test starts, so the tests running end and it has their slots."""
+    (RUN.drain-PID), no other test starts, so the tests running end and it has their
+    slots. Two `timing` tests may run at once: each has fewer beside it."""
     count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
     need = max(1, count - TIMING_BESIDE) if timing and not alone else 1  # `_machine`: alone
     try:
@@ -122,8 +123,9 @@ def _slots(alone: bool, timing: bool) -> Iterator[None]:
     with contextlib.ExitStack() as held:
         try:
             slots = [held.enter_context((ALONE / f"{run}.{n}").open("a")) for n in range(count)]
+            gather = (ALONE / f"{run}.gather").open("a")
+            held.callback(gather.close)
             if need > 1:
-                gather = held.enter_context((ALONE / f"{run}.gather").open("a"))
                 _wait(lambda: _locked(gather.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB))
                 drain.touch()
                 held.callback(drain.unlink, missing_ok=True)
@@ -144,6 +146,7 @@ def _slots(alone: bool, timing: bool) -> Iterator[None]:
 
         _wait(more)
         drain.unlink(missing_ok=True)
+        gather.close()  # the next may gather from the slots left
         yield
     # closing the files let the locks go
 

@@ -52,12 +52,17 @@ def test_a_slow_link_stops_no_live_driver_and_a_lost_one_stops_the_car(
             assert url.startswith("zenoh://"), share.communicate()[1]
             if through == "router":
                 url = url.replace(":7450", ":7447")
-            script = "".join(f"drive {letter}\nwait 1.5\n" for letter in LETTERS) + "wait 60\n"
+            script = "".join(f"drive {letter}\nwait 1\n" for letter in LETTERS) + "wait 60\n"
             driver = laptop.popen("drive", url, stdin=subprocess.PIPE)
             assert driver.stdin is not None
             driver.stdin.write(script)
             driver.stdin.flush()
-            wait_for(lambda: "H" in units(record), 30)
+            try:
+                wait_for(lambda: "H" in units(record), 30)
+            except AssertionError:
+                driver.kill()
+                said = driver.communicate()
+                raise AssertionError(f"H never came: {units(record)}, {said}") from None
             time.sleep(1.0)
             timed = timed_sent(record)
             driven = [unit for _, unit in timed[[u for _, u in timed].index("A") :]]
