@@ -43,6 +43,15 @@ def add_url(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("url", metavar="URL", type=target, help=URL_FORMS)
 
 
+def add_car(parser: argparse.ArgumentParser) -> None:
+    """URL, the car (its APP port), and URL2, its control port: what `share` and `ros`
+    serve."""
+    parser.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
+    parser.add_argument(
+        "url2", nargs="?", type=target, metavar="URL2", help="the same car's control port"
+    )
+
+
 def add_uart2(parser: argparse.ArgumentParser, what: str) -> None:
     parser.add_argument(
         "--uart2",

@@ -14,12 +14,12 @@ from appmode.cli.live_view import add_foxglove, attach, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
+    add_car,
     add_chassis,
     add_profile,
     add_uart2,
     board_choice,
     endpoint,
-    target,
 )
 from appmode.errors import AppmodeError, install_line
 
@@ -45,10 +45,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "them to flash); its lines go to /rosout. Ctrl-C or "
         "SIGTERM stops the car and withdraws the node. Needs the ros extra.",
     )
-    ros.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
-    ros.add_argument(
-        "url2", nargs="?", type=target, metavar="URL2", help="the same car's control port"
-    )
+    add_car(ros)
     add_uart2(ros, "drive over the URL's own control port (a sim:// board's, a zenoh:// car's)")
     add_chassis(ros, "drive a WHEELTEC car as its vendor's driver does, over its chassis port")
     ros.add_argument(

@@ -17,12 +17,12 @@ from appmode.cli.commands import COMMANDS
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
+    add_car,
     add_chassis,
     add_profile,
     board_choice,
     endpoint,
     listening_endpoint,
-    target,
 )
 from appmode.errors import AppmodeError, install_line
 
@@ -58,10 +58,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
         "car. Only a client with the key gets in (Zenoh's user-password authentication; "
         "--tls also encrypts). Needs the net extra.",
     )
-    share.add_argument("url", type=target, metavar="URL", help="the car (its APP port)")
-    share.add_argument(
-        "url2", nargs="?", type=target, metavar="URL2", help="the same car's control port"
-    )
+    add_car(share)
     share.add_argument("--name", required=True, type=car_name, help="what the car is called")
     share.add_argument(
         "--listen",
