@@ -113,6 +113,7 @@ def test_monitor_counts_and_json() -> None:
     assert "monitor: 6 records, 0 errors" in done.stderr
 
 
+@pytest.mark.timing  # 8 to 14 records in 0.6 s: 7 beside five other tests
 def test_monitor_over_tcp_for_a_duration() -> None:
     with board_process("--listen", "0", "--quiet") as board:
         done = run("monitor", board.url, "--duration", "0.6")

@@ -273,6 +273,7 @@ def _raw_writes(car: SharedCar, size: int, count: int, *until: str) -> subproces
     )
 
 
+@pytest.mark.timing  # Z within 0.3 s: 0.30 s beside five other tests
 def test_no_write_holds_the_stop_up(shared: SharedCar) -> None:
     """Issue 80.3: a 3,000-byte write held the share's lock while it went out at 9600
     bps, and a fleet stop reached the board 2.6–3.0 s later. A write is at most a chunk,
