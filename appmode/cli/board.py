@@ -15,6 +15,7 @@ from appmode.cli.options import (
     add_profile,
     add_record,
     file_name,
+    listen,
     number_type,
 )
 from appmode.errors import AppmodeError, install_line
@@ -91,6 +92,7 @@ def _add_where(board: argparse.ArgumentParser) -> None:
     )
     where.add_argument(
         "--listen",
+        type=listen("--listen"),
         metavar="HOST:PORT",
         help="serve on TCP, one client at a time (host 127.0.0.1 by default, [::1] for "
         "IPv6; port 0 picks a free one)",
@@ -120,6 +122,7 @@ def _add_where(board: argparse.ArgumentParser) -> None:
     where2 = board.add_mutually_exclusive_group()
     where2.add_argument(
         "--listen2",
+        type=listen("--listen2"),
         metavar="HOST:PORT",
         help="serve UART2, the control port, on TCP (default: a second pseudo-terminal)",
     )
@@ -131,6 +134,7 @@ def _add_where(board: argparse.ArgumentParser) -> None:
     where3 = board.add_mutually_exclusive_group()
     where3.add_argument(
         "--listen-chassis",
+        type=listen("--listen-chassis"),
         metavar="HOST:PORT",
         help="serve a WHEELTEC profile's chassis port on TCP (default: a pseudo-terminal)",
     )
@@ -215,7 +219,7 @@ def _app_endpoint(args: argparse.Namespace) -> MakeEndpoint:
     from appmode.ports.urls import BAUD
 
     if args.listen is not None:
-        host, port = endpoints.parse_listen(args.listen)
+        host, port = args.listen
         return partial(endpoints.TcpEndpoint, host=host, port=port, baud=args.baud)
     if args.port is not None:
         return partial(endpoints.SerialEndpoint, device=args.port, baud=args.baud or BAUD)
@@ -262,7 +266,7 @@ def _uart2_endpoint(args: argparse.Namespace) -> MakeEndpoint:
     from appmode.ports import endpoints
 
     if args.listen2 is not None:
-        host, port = endpoints.parse_listen(args.listen2, "--listen2")
+        host, port = args.listen2
         return partial(endpoints.TcpEndpoint, host=host, port=port, baud=None)
     if args.port2 is not None:
         return partial(endpoints.SerialEndpoint, device=args.port2, baud=UART2_BAUD)
@@ -275,7 +279,7 @@ def _chassis_endpoint(args: argparse.Namespace) -> MakeEndpoint:
     from appmode.ports import endpoints
 
     if args.listen_chassis is not None:
-        host, port = endpoints.parse_listen(args.listen_chassis, "--listen-chassis")
+        host, port = args.listen_chassis
         return partial(endpoints.TcpEndpoint, host=host, port=port, baud=None)
     if args.port_chassis is not None:
         return partial(endpoints.SerialEndpoint, device=args.port_chassis, baud=CHASSIS_BAUD)

@@ -20,6 +20,7 @@ from appmode.protocol.twist import Twist
 from appmode.text import counted
 
 if TYPE_CHECKING:
+    from appmode.cli.options import Address
     from appmode.ports.choice import BoardChoice
     from appmode.protocol.channels import Viewer
 
@@ -142,7 +143,7 @@ def run_monitor(
     record: str | None,
     out: TextIO | None,
     stop_on_exit: bool = False,
-    foxglove: str | None = None,
+    foxglove: Address | None = None,
     name: str = "monitor",
 ) -> int:
     """Print status frames as they arrive (`out` None: none, `appmode record`); passive

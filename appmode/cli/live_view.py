@@ -7,8 +7,11 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from appmode.cli.options import listen
+
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:
+    from appmode.cli.options import Address
     from appmode.protocol.layouts import Layout
     from appmode.protocol.params import DriveType
     from appmode.session.base import BaseSession
@@ -33,7 +36,10 @@ def add_foxglove(
 ) -> None:
     """`--foxglove`, and with `drives` (a command that drives a car) `--foxglove-drive`."""
     parser.add_argument(
-        "--foxglove", metavar="[HOST:]PORT", help=HELP.replace("it live", f"{what} live", 1)
+        "--foxglove",
+        type=listen("--foxglove"),
+        metavar="[HOST:]PORT",
+        help=HELP.replace("it live", f"{what} live", 1),
     )
     if drives:
         parser.add_argument("--foxglove-drive", action="store_true", help=DRIVE_HELP)
@@ -41,7 +47,10 @@ def add_foxglove(
 
 @contextmanager
 def live_view(
-    spec: str | None, layout: Layout, drive: bool = False, drive_type: DriveType | None = None
+    where: Address | None,
+    layout: Layout,
+    drive: bool = False,
+    drive_type: DriveType | None = None,
 ) -> Iterator[LiveView | None]:
     """The live view `--foxglove` asks for (None if not asked), its address said on
     stderr; stopped on the way out, after what it was fed is logged. With `drive`, its
@@ -49,16 +58,15 @@ def live_view(
     signs the A records' magnitudes by the control port's frames (the pose)."""
     from appmode.errors import AppmodeError
 
-    if spec is None:
+    if where is None:
         if drive:
             raise AppmodeError("--foxglove-drive needs --foxglove PORT (the viewers' server)")
         yield None
         return
-    from appmode.ports.endpoints import parse_listen
     from appmode.viewers.live import LiveView
     from appmode.web.access import is_loopback
 
-    host, port = parse_listen(spec, "--foxglove")
+    host, port = where
     if drive and not is_loopback(host):
         raise AppmodeError(
             f"--foxglove-drive serves this machine only (a Foxglove viewer shows no owner's "

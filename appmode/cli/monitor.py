@@ -27,6 +27,7 @@ from appmode.protocol import app
 from appmode.text import counted
 
 if TYPE_CHECKING:
+    from appmode.cli.options import Address
     from appmode.host.app.client import Event
     from appmode.ports.choice import BoardChoice
 
@@ -140,7 +141,7 @@ def run_monitor(
     stop_on_exit: bool = False,
     kinds: frozenset[str] | None = None,
     name: str = "monitor",
-    foxglove: str | None = None,
+    foxglove: Address | None = None,
 ) -> int:
     """Print records as they arrive (of `kinds` only, if given: record letters or
     "errors"), until interrupted, `duration` or `count` of them; `out` None prints none

@@ -43,6 +43,22 @@ def add_url(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("url", metavar="URL", type=target, help=URL_FORMS)
 
 
+Address = tuple[str, int]
+"""Where a server listens: (host, port), parsed once from `[HOST:]PORT` (`listen`)."""
+
+
+def listen(option: str) -> Callable[[str], Address]:
+    """The type of an option that names where a server listens, `[HOST:]PORT`
+    (`ports.endpoints.parse_listen`: host 127.0.0.1 unless given)."""
+
+    def address(text: str) -> Address:
+        from appmode.ports.endpoints import parse_listen
+
+        return parse_listen(text, option)
+
+    return address
+
+
 def add_car(parser: argparse.ArgumentParser) -> None:
     """URL, the car (its APP port), and URL2, its control port: what `share` and `ros`
     serve."""

@@ -22,6 +22,7 @@ from appmode.protocol.render import line
 from appmode.text import counted, wrapped
 
 if TYPE_CHECKING:
+    from appmode.cli.options import Address
     from appmode.ports.choice import BoardChoice
     from appmode.protocol.channels import Viewer
 
@@ -196,7 +197,7 @@ def run_monitor(
     record: str | None,
     out: TextIO,
     stop_on_exit: bool = False,
-    foxglove: str | None = None,
+    foxglove: Address | None = None,
 ) -> int:
     """Print replies and encoder reports as they arrive; passive unless `stop_on_exit`;
     live to Foxglove on `foxglove` ([HOST:]PORT)."""

@@ -8,7 +8,14 @@ from typing import TYPE_CHECKING
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
 from appmode.cli.live_view import attach, live_view
-from appmode.cli.options import Subparsers, add_host_id, board_choice, endpoint, target
+from appmode.cli.options import (
+    Subparsers,
+    add_host_id,
+    board_choice,
+    endpoint,
+    listen,
+    target,
+)
 from appmode.errors import AppmodeError
 
 if TYPE_CHECKING:
@@ -31,6 +38,7 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
     add_board(web)
     web.add_argument(
         "--listen",
+        type=listen("--listen"),
         metavar="HOST:PORT",
         default=DEFAULT_LISTEN,
         help=f"where to serve the page (default {DEFAULT_LISTEN}; port 0 picks a free one). "
@@ -66,7 +74,6 @@ def register(sub: Subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from appmode.ports.endpoints import parse_listen
     from appmode.session.opener import open_session
     from appmode.web.access import is_loopback
     from appmode.web.bridge import driving
@@ -81,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
         ) from None
     if (args.cert is None) != (args.key is None):
         raise AppmodeError("--cert and --key go together: the certificate and its key")
-    host, port = parse_listen(args.listen)
+    host, port = args.listen
     names = [n for n in certificate.machine_names(host) if not is_loopback(n)]
     addresses = sorted(names, key=lambda name: (":" in name, not name[0].isdigit(), name))
     tls = fingerprint = None

@@ -58,7 +58,8 @@ def show(session: BaseSession, step: Step) -> None:
     """What a command returned for the view: the panel for `status`, the help for
     `help`, as messages."""
     if isinstance(step, ShowStatus):
-        session.say(status_text(session))
+        text = status_text(session)
+        session.say(text)
     elif isinstance(step, ShowHelp):
         for text in session.help_lines():
             session.say(text)

@@ -86,13 +86,25 @@ def choose(
     (a simulated board that has a control port; a shared car with `uart2`) opens both,
     its control port driven. With `chassis` (or a sim:// URL's `port=chassis`), the
     board's chassis port alone."""
-    if chassis or url.sim_port == CHASSIS:
-        return _chassis(url, url2, uart2=uart2, profile=profile, drive=drive)
-    ports = board_ports(url, url2, uart2=uart2, profile=profile, drive=drive)
+    chassis = chassis or url.sim_port == CHASSIS
     paired = None
-    if both and url2 is None and (url.simulated or (uart2 and url.remote is not None)):
-        paired = board_ports(url, url.for_uart2(), uart2=False, profile=profile, drive=drive)
-    chosen = profile_named(profile or ports[0].profile or "sheet")
+    ports: tuple[Target, Target | None, bool]
+    if chassis:
+        ports = (_chassis_port(url, url2, uart2=uart2, profile=profile, drive=drive), None, False)
+    else:
+        ports = board_ports(url, url2, uart2=uart2, profile=profile, drive=drive)
+        if both and url2 is None and (url.simulated or (uart2 and url.remote is not None)):
+            paired = board_ports(url, url.for_uart2(), uart2=False, profile=profile, drive=drive)
+    default = "wheeltec-mec" if chassis else "sheet"
+    chosen = profile_named(profile or ports[0].profile or default)
+    if chassis:
+        if chosen.chassis is None:
+            raise AppmodeError(
+                f"the {chosen.name} profile has no chassis port: give --profile "
+                "wheeltec-mec, wheeltec-akm, wheeltec-diff, or a profile file with a "
+                "[chassis] table"
+            )
+        return BoardChoice(ports[0], chosen, chassis=True)
     if paired is not None and (chosen.file is None or chosen.file.control_port):
         ports = paired  # both ports where the profile's board has a control port
     driven, beside, control = ports
@@ -108,9 +120,9 @@ def choose(
     return BoardChoice(driven, chosen, control=True, app=beside, drive=fixed)
 
 
-def _chassis(
+def _chassis_port(
     url: Target, url2: Target | None, *, uart2: bool, profile: str | None, drive: str | None
-) -> BoardChoice:
+) -> Target:
     """The chassis port of the board `url` names, with a WHEELTEC profile (by default
     wheeltec-mec: a host sends what it is asked, and the car does what its kind can)."""
     if uart2 or url2 is not None:
@@ -123,8 +135,7 @@ def _chassis(
             "--drive is the control port's drive type: a chassis's kind is its profile's "
             "(--profile wheeltec-mec, wheeltec-akm or wheeltec-diff)"
         )
-    name = profile or url.profile or "wheeltec-mec"
-    board = url.with_sim(profile=name)
+    board = url.with_sim(profile=profile or url.profile or "wheeltec-mec")
     if board.simulated or board.remote is not None:
         if board.sim_port not in (APP, CHASSIS) or (
             "port" in board.options and board.sim_port != CHASSIS
@@ -134,10 +145,4 @@ def _chassis(
                 "chassis port (port=chassis, or leave port= out)"
             )
         board = board.on_port(CHASSIS)
-    chosen = profile_named(name)
-    if chosen.chassis is None:
-        raise AppmodeError(
-            f"the {chosen.name} profile has no chassis port: give --profile wheeltec-mec, "
-            "wheeltec-akm, wheeltec-diff, or a profile file with a [chassis] table"
-        )
-    return BoardChoice(board, chosen, chassis=True)
+    return board

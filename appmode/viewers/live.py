@@ -85,11 +85,19 @@ class LiveView:
         """The wall-clock time of the session's time 0 (set by whoever feeds it)."""
         self.dropped = 0
         """Units and notes the queue had no room for."""
-        self._channels: dict[str, Any] = {}
-        for spec in channels(layout).values():
-            self._channel(spec.topic, spec.schema_name, spec.schema)
-        for topic in RAW.values():
-            self._channel(topic, "appmode.bytes", RAW_SCHEMA)
+        served = [(spec.topic, spec.schema_name, spec.schema) for spec in channels(layout).values()]
+        served += [(topic, "appmode.bytes", RAW_SCHEMA) for topic in RAW.values()]
+        self._channels: dict[str, Any] = {
+            topic: foxglove.Channel(
+                topic,
+                schema=foxglove.Schema(
+                    name=kind, encoding="jsonschema", data=json.dumps(schema).encode()
+                ),
+                message_encoding="json",
+                context=self._context,
+            )
+            for topic, kind, schema in served
+        }
         self._log = foxglove.channels.LogChannel(LOG, context=self._context)
         self._layout = layout
         self._drive_type = drive_type
@@ -101,15 +109,6 @@ class LiveView:
     def url(self) -> str:
         host = f"[{self.host}]" if ":" in self.host else self.host
         return f"ws://{host}:{self.port}"
-
-    def _channel(self, topic: str, schema_name: str, schema: dict[str, Any]) -> None:
-        fox = self._foxglove
-        described = fox.Schema(
-            name=schema_name, encoding="jsonschema", data=json.dumps(schema).encode()
-        )
-        self._channels[topic] = fox.Channel(
-            topic, schema=described, message_encoding="json", context=self._context
-        )
 
     # ------------------------------------------------------------ the caller's side
 
