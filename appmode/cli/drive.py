@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.live_view import add_foxglove, attach, live_view
+from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -124,8 +124,7 @@ def run(args: argparse.Namespace) -> int:
     with live_view(
         args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
     ) as view:
-        session = open_session(choice, driving, on_message, args.record)
-        attach(view, session)
+        session = open_session(choice, driving, on_message, args.record, view)
         script = command_lines(sys.stdin, MAX_COMMAND)
         return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
 

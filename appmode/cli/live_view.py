@@ -14,7 +14,6 @@ if TYPE_CHECKING:
     from appmode.cli.options import Address
     from appmode.protocol.layouts import Layout
     from appmode.protocol.params import DriveType
-    from appmode.session.base import BaseSession
     from appmode.viewers.live import LiveView
 
 HELP = (
@@ -54,8 +53,9 @@ def live_view(
 ) -> Iterator[LiveView | None]:
     """The live view `--foxglove` asks for (None if not asked), its address said on
     stderr; stopped on the way out, after what it was fed is logged. With `drive`, its
-    viewers may drive and tune the car (`attach` gives them the session); `drive_type`
-    signs the A records' magnitudes by the control port's frames (the pose)."""
+    viewers may drive and tune the car (`session.opener.open_session` gives them the
+    session); `drive_type` signs the A records' magnitudes by the control port's frames
+    (the pose)."""
     from appmode.errors import AppmodeError
 
     if where is None:
@@ -79,6 +79,13 @@ def live_view(
         file=sys.stderr,
         flush=True,
     )
+    if drive:
+        print(
+            "foxglove: viewers on this machine may drive (Teleop on /cmd_vel, 0.5 s a "
+            "twist) and tune (Parameters)",
+            file=sys.stderr,
+            flush=True,
+        )
     if not is_loopback(host):
         print(
             f"appmode: WARNING: the live view is served on {host}:{view.port}: every device "
@@ -95,18 +102,3 @@ def live_view(
                 f"appmode: the live view dropped {view.dropped} units it had no room for",
                 file=sys.stderr,
             )
-
-
-def attach(view: LiveView | None, session: BaseSession) -> None:
-    """Show `session` to `view`, and let its viewers drive and tune it where they may."""
-    if view is None:
-        return
-    session.add_viewer(view)
-    if view.desk is not None:
-        session.desks.append(view.desk)
-        print(
-            "foxglove: viewers on this machine may drive (Teleop on /cmd_vel, 0.5 s a "
-            "twist) and tune (Parameters)",
-            file=sys.stderr,
-            flush=True,
-        )

@@ -10,7 +10,7 @@ import sys
 from contextlib import ExitStack
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.live_view import add_foxglove, attach, live_view
+from appmode.cli.live_view import add_foxglove, live_view
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -152,9 +152,9 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
                 args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
             )
         )
-        session = open_car(choice, HoldToDrive(first_timeout=timeout, repeat_timeout=timeout))
+        held = HoldToDrive(first_timeout=timeout, repeat_timeout=timeout)
+        session = open_car(choice, held, view=view)
         session.lease, session.lease_source = timeout, "cmd_vel"
-        attach(view, session)
         graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
         topics = TOPIC_SETS[args.topics].placed(
             ns, args.frame_prefix or "", args.odom_frame, args.base_frame

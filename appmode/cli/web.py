@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
-from appmode.cli.live_view import attach, live_view
+from appmode.cli.live_view import live_view
 from appmode.cli.options import (
     Subparsers,
     add_host_id,
@@ -105,8 +105,7 @@ def run(args: argparse.Namespace) -> int:
     with live_view(
         args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
     ) as view:
-        session = open_session(choice, driving(), record=args.record)
-        attach(view, session)
+        session = open_session(choice, driving(), record=args.record, view=view)
         return serve_web(session, host, port, tls, tuple(addresses), fingerprint)
 
 

@@ -4,13 +4,16 @@ page, a test) gets its session."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Protocol
 
 from appmode.line.wire import APP, CHASSIS, UART2
 from appmode.ports.choice import BoardChoice
+from appmode.protocol.channels import Viewer
 from appmode.session.app.session import AppSession
 from appmode.session.base import BaseSession
 from appmode.session.chassis.session import ChassisSession
 from appmode.session.control.session import ControlSession
+from appmode.session.desk import Desk
 from appmode.session.hold import HoldToDrive
 
 SESSIONS: dict[str, type[AppSession] | type[ControlSession] | type[ChassisSession]] = {
@@ -21,13 +24,27 @@ SESSIONS: dict[str, type[AppSession] | type[ControlSession] | type[ChassisSessio
 """The session of each port a board choice drives (`BoardChoice.port`)."""
 
 
+class LiveViewer(Viewer, Protocol):
+    """A live view (`viewers.live.LiveView`) whose viewers may drive and tune the car
+    through its `desk`, if it has one."""
+
+    desk: Desk | None
+
+
 def open_session(
     choice: BoardChoice,
     driving: HoldToDrive | None = None,
     on_message: Callable[[str], None] | None = None,
     record: str | None = None,
+    view: LiveViewer | None = None,
 ) -> BaseSession:
     """The session `choice` asks for: the APP port's, the control port's (with the APP
     port of the same board beside it) or the chassis port's; `record` names its
-    recording."""
-    return SESSIONS[choice.port](choice, driving, record, on_message)
+    recording; `view` is shown the session, and its viewers drive and tune where it
+    lets them."""
+    session = SESSIONS[choice.port](choice, driving, record, on_message)
+    if view is not None:
+        session.add_viewer(view)
+        if view.desk is not None:
+            session.desks.append(view.desk)
+    return session
