@@ -10,10 +10,12 @@ from __future__ import annotations
 import compileall
 import contextlib
 import os
+import subprocess
 import tempfile
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -34,17 +36,16 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers for two cores on an idle machine, one a core on a busy
-    one.
+    """`-n auto`: three workers a core on an idle machine, one a core on a busy one.
 
-    Most tests wait on boards, ptys and processes in real time: three workers used 0.6
-    of a core and took 7.5 minutes. Six took 4 min 44 s to 5 min 25 s, but half their
-    runs failed a test the load starved — a pty read 0.48 s late, a C record read whole,
-    a key let go stopped 0.5 s after, 7 records in 0.6 s, a stop 0.30 s after it was
-    asked — though a `timing` test had at most two others beside it (`_slots`): many
-    tests keep time. So three, and, as `make -l` does, a run started beside another run
-    of this suite (RUNS), or on a machine whose cores are already busy, takes one worker
-    a core."""
+    Most tests wait on boards, ptys and processes in real time: three workers for two
+    cores used 0.6 of a core and took 7.5 minutes; six take under five. Beside five
+    others, though, a test that keeps time was starved of the CPU by their processes
+    (a pty read 0.48 s late, 7 records in 0.6 s where 8 were due, a stop 0.30 s after
+    it was asked) in half the runs, so the others' processes run at a lower priority
+    (`pytest_runtest_call`). As `make -l` does, a run started beside another run of
+    this suite (RUNS), or on a machine whose cores are already busy, takes one worker a
+    core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -54,7 +55,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
         others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
     except OSError:  # another user's folder: the load average alone tells
         others = []
-    return cores if others or busy_cores() >= 0.9 * cores else cores + cores // 2
+    return cores if others or busy_cores() >= 0.9 * cores else 3 * cores
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
@@ -85,81 +86,49 @@ ALONE_WAIT = 300.0
 def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
     """A test marked `alone` (the suite in real time, run last) has the machine to
     itself: it waits until the tests running in this run and in others beside it end,
-    and theirs wait until it has. One marked `timing` runs with at most TIMING_BESIDE of
-    its run's tests beside it (`_slots`: the load its bounds were set for, whatever the
-    number of workers), and has the machine to itself across runs of this suite side by
-    side. In the real-time suite beside the run's last tests a board's encoder report
-    came 50 ms late (±25 ms); beside another run its boards applied commands later than
-    its ±0.3 s, and a console let go of stopped the car 0.45 s after, not within 0.35."""
+    and theirs wait until it has. One marked `timing` runs in its place, its processes
+    ahead of the rest's (`pytest_runtest_call`), and has the machine to itself across
+    runs of this suite side by side. In the real-time suite beside the run's last tests
+    a board's encoder report came 50 ms late (±25 ms); beside another run its boards
+    applied commands later than its ±0.3 s, and a console let go of stopped the car 0.45
+    s after, not within 0.35."""
     others = _other_runs()
     alone = item.get_closest_marker("alone") is not None
-    timing = item.get_closest_marker("timing") is not None
-    with _machine(alone, timing and bool(others), others), _slots(alone, timing):
+    timing = item.get_closest_marker("timing") is not None and bool(others)
+    with _machine(alone, timing, others):
         yield
 
 
-TIMING_BESIDE = 2
-"""How many of its run's tests a `timing` test runs beside at most: with three
-workers, all its bounds held, run after run. With more (`-n 6`), it waits for the
-rest to make room."""
-
-
-@contextlib.contextmanager
-def _slots(alone: bool, timing: bool) -> Iterator[None]:
-    """A slot of the run's (one a worker, RUN.N in ALONE) held while a test runs: any
-    test takes one, a `timing` test all but TIMING_BESIDE (an `alone` one has the run's
-    lock, `_machine`). One test gathers at a time (RUN.gather); while it does
-    (RUN.drain-PID), no other test starts, so the tests running end and it has their
-    slots. Two `timing` tests may run at once: each has fewer beside it."""
-    count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
-    need = max(1, count - TIMING_BESIDE) if timing and not alone else 1  # `_machine`: alone
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_call(item: pytest.Item) -> Iterator[None]:
+    """The processes a test starts in its body run at nice 10 (LOWERED), unless it keeps
+    time (`timing`, `alone`): beside five other workers, a test that keeps time was
+    starved of the CPU by their processes (a pty read 0.48 s late, 7 records in 0.6 s
+    where 8 were due). A fixture's processes are not lowered: a test that keeps time may
+    use them (a shared car's host)."""
+    keeps_time = any(item.get_closest_marker(name) for name in ("timing", "alone"))
+    _LOWER[0] = not keeps_time and bool(os.environ.get("PYTEST_XDIST_WORKER"))
     try:
-        import fcntl
-    except ImportError:  # Windows: tests are not kept apart
         yield
-        return
-    if count < 2:
-        yield
-        return
-    run = _run()
-    drain = ALONE / f"{run}.drain-{os.getpid()}"
-    with contextlib.ExitStack() as held:
-        try:
-            slots = [held.enter_context((ALONE / f"{run}.{n}").open("a")) for n in range(count)]
-            gather = (ALONE / f"{run}.gather").open("a")
-            held.callback(gather.close)
-            if need > 1:
-                _wait(lambda: _locked(gather.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB))
-                drain.touch()
-                held.callback(drain.unlink, missing_ok=True)
-            else:
-                _wait(lambda: not _draining(run))
-        except OSError:  # another user's folder
-            yield
-            return
-        taken: set[int] = set()
-
-        def more() -> bool:
-            for n, slot in enumerate(slots):
-                if n not in taken and _locked(slot.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB):
-                    taken.add(n)
-                    if len(taken) == need:
-                        return True
-            return False
-
-        _wait(more)
-        drain.unlink(missing_ok=True)
-        gather.close()  # the next may gather from the slots left
-        yield
-    # closing the files let the locks go
+    finally:
+        _LOWER[0] = False
 
 
-def _draining(run: str) -> bool:
-    """Whether a test of `run` is gathering slots (its worker still running)."""
-    for path in ALONE.glob(f"{run}.drain-*"):
-        if _running(path.name.rpartition("-")[2], path):
-            return True
-    return False
+LOWERED = 10
+"""The nice value of the processes a test that does not keep time starts."""
+_LOWER = [False]
+_POPEN_INIT = subprocess.Popen.__init__
+
+
+def _lowered(self: subprocess.Popen[bytes], *args: Any, **kwargs: Any) -> None:
+    """`subprocess.Popen`, its process lowered while `_LOWER` says so (on POSIX)."""
+    _POPEN_INIT(self, *args, **kwargs)
+    if _LOWER[0] and hasattr(os, "setpriority"):
+        with contextlib.suppress(OSError):  # it ended already
+            os.setpriority(os.PRIO_PROCESS, self.pid, LOWERED)
+
+
+subprocess.Popen.__init__ = _lowered  # type: ignore[method-assign]
 
 
 @contextlib.contextmanager
@@ -204,10 +173,9 @@ def _wanted(run: str) -> bool:
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    """The run's lock and slot files go with it (its controller's)."""
+    """The run's lock file goes with it (its controller's)."""
     if not hasattr(config, "workerinput"):
-        for path in ALONE.glob(f"{os.getpid()}.*"):
-            path.unlink(missing_ok=True)
+        (ALONE / f"{os.getpid()}.lock").unlink(missing_ok=True)
 
 
 def _locked(fd: int, how: int) -> bool:
