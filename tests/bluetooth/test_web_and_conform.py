@@ -62,7 +62,7 @@ def test_the_page_drives_the_car_over_the_module(tmp_path: Path, which: str) -> 
     assert web.sent()[-1] == "Z"
 
 
-@pytest.mark.timing
+@pytest.mark.alone
 @pytest.mark.parametrize("which", ["ble", "spp"])
 def test_conform_passes_over_the_module(appmode_ble_board: ServedBoard, which: str) -> None:
     url = getattr(appmode_ble_board, which)

@@ -33,7 +33,7 @@ def test_s13_suite_passes_on_virtual_time(path: Path) -> None:
     assert result.passed, result.failure
 
 
-@pytest.mark.timing  # ±25 ms, and a read that a C record going out would lose
+@pytest.mark.alone  # ±25 ms and a read that a C record going out would lose: after the rest
 @pytest.mark.parametrize(
     "name",
     ["s13_set_value_arithmetic", "s13_telemetry_period", "s13_frame_stops_the_car"],

@@ -21,8 +21,7 @@ CARS = 20
 KEY = "room key"
 
 
-# Twenty simulated cars keep a core busy: started from a test that keeps no time, their
-# processes run at nice 10 (tests/conftest.py), and a timing test beside them comes first.
+@pytest.mark.alone  # twenty simulated cars keep a core busy: no timing test beside them
 def test_twenty_cars_on_one_host_are_found_by_scouting_and_stopped_together() -> None:
     with lan("cars", "laptop") as machines:
         host = subprocess.Popen(
