@@ -113,7 +113,7 @@ def test_monitor_counts_and_json() -> None:
     assert "monitor: 6 records, 0 errors" in done.stderr
 
 
-@pytest.mark.timing  # 8 to 14 records in 0.6 s: 7 beside five other tests
+@pytest.mark.timing  # 8 to 14 records in 0.6 s: 7 when starved
 def test_monitor_over_tcp_for_a_duration() -> None:
     with board_process("--listen", "0", "--quiet") as board:
         done = run("monitor", board.url, "--duration", "0.6")
@@ -158,6 +158,8 @@ def test_a_board_listens_on_an_ipv6_address() -> None:
         (["monitor", "nope://x"], "unknown URL scheme 'nope://'"),
         (["params", "/dev/ttyUSB97"], "no such port /dev/ttyUSB97"),
         (["board", "--listen", "nonsense"], "expected HOST:PORT or PORT"),
+        (["drive", "--foxglove", "nonsense"], "--foxglove 'nonsense': expected HOST:PORT"),
+        (["web", "--listen", "1.2.3.4:99999"], "--listen '1.2.3.4:99999': expected HOST:PORT"),
         (["board", "--port", "/dev/ttyUSB97"], "no such port /dev/ttyUSB97"),
         (["params", "loop://"], "what answers at loop:// is not a board"),
     ],
