@@ -10,12 +10,10 @@ from __future__ import annotations
 import compileall
 import contextlib
 import os
-import subprocess
 import tempfile
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
 import pytest
 
@@ -40,12 +38,13 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     one.
 
     Most tests wait on boards, ptys and processes in real time: three workers for two
-    cores used 0.6 of a core and took 7.5 minutes. Six took 4 min 24 s to 5 min 9 s with
-    the other tests' processes lowered (`pytest_runtest_call`), and one run of eight
+    cores used 0.6 of a core and took 7.5 minutes. Six took 4 min 24 s to 5 min 9 s
+    with the processes of tests that keep no time at nice 10, and one run of eight
     still failed a test that keeps time (a stop 0.34 s after it was asked, within 0.3);
-    without that, half the runs failed. So three, and, as `make -l` does, a run started
-    beside another run of this suite (RUNS), or on a machine whose cores are already
-    busy, takes one worker a core."""
+    at one priority, half the runs failed. Nice 10 is gone too: beside two busy
+    programs the lowered processes all but stopped (the run passed 25 minutes). So
+    three, and, as `make -l` does, a run started beside another run of this suite
+    (RUNS), or on a machine whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -86,49 +85,17 @@ ALONE_WAIT = 300.0
 def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
     """A test marked `alone` (the suite in real time, run last) has the machine to
     itself: it waits until the tests running in this run and in others beside it end,
-    and theirs wait until it has. One marked `timing` runs in its place, its processes
-    ahead of the rest's (`pytest_runtest_call`), and has the machine to itself across
-    runs of this suite side by side. In the real-time suite beside the run's last tests
-    a board's encoder report came 50 ms late (±25 ms); beside another run its boards
-    applied commands later than its ±0.3 s, and a console let go of stopped the car 0.45
-    s after, not within 0.35."""
+    and theirs wait until it has. One marked `timing` has it to itself across runs of
+    this suite side by side, its own run going on beside it (the load its bounds were
+    set for). In the real-time suite beside the run's last tests a board's encoder
+    report came 50 ms late (±25 ms); beside another run its boards applied commands
+    later than its ±0.3 s, and a console let go of stopped the car 0.45 s after, not
+    within 0.35."""
     others = _other_runs()
     alone = item.get_closest_marker("alone") is not None
     timing = item.get_closest_marker("timing") is not None and bool(others)
     with _machine(alone, timing, others):
         yield
-
-
-@pytest.hookimpl(hookwrapper=True)
-def pytest_runtest_call(item: pytest.Item) -> Iterator[None]:
-    """The processes a test starts in its body run at nice 10 (LOWERED), unless it keeps
-    time (`timing`, `alone`), so that those of a test that does come first: beside five
-    other workers, a test that keeps time was starved of the CPU by their processes (a
-    pty read 0.48 s late, 7 records in 0.6 s where 8 were due). A fixture's processes
-    are not lowered: a test that keeps time may use them (a shared car's host)."""
-    keeps_time = any(item.get_closest_marker(name) for name in ("timing", "alone"))
-    _LOWER[0] = not keeps_time and bool(os.environ.get("PYTEST_XDIST_WORKER"))
-    try:
-        yield
-    finally:
-        _LOWER[0] = False
-
-
-LOWERED = 10
-"""The nice value of the processes a test that does not keep time starts."""
-_LOWER = [False]
-_POPEN_INIT = subprocess.Popen.__init__
-
-
-def _lowered(self: subprocess.Popen[bytes], *args: Any, **kwargs: Any) -> None:
-    """`subprocess.Popen`, its process lowered while `_LOWER` says so (on POSIX)."""
-    _POPEN_INIT(self, *args, **kwargs)
-    if _LOWER[0] and hasattr(os, "setpriority"):
-        with contextlib.suppress(OSError):  # it ended already
-            os.setpriority(os.PRIO_PROCESS, self.pid, LOWERED)
-
-
-subprocess.Popen.__init__ = _lowered  # type: ignore[method-assign]
 
 
 @contextlib.contextmanager

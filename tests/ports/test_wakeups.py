@@ -84,7 +84,6 @@ def test_the_slice_is_short_inside_and_restored_after() -> None:
 
 
 @linux
-@pytest.mark.timing  # the nice value is what it reads: its process is never lowered
 def test_a_niced_thread_keeps_its_nice_value() -> None:
     code = (
         "import ctypes, os\n"
