@@ -8,7 +8,10 @@ is Ctrl-C. `install()` gives all three one handler, which:
 - waits while an `atomic()` step runs — a write and the bookkeeping of what it sent —
   so that what the session end knows is what really left;
 - calls the action of `diverted()` instead, where raising would land in the wrong place
-  (the console's event loop: the action asks it to quit).
+  (the console's event loop: the action asks it to quit);
+- does not raise inside `threading.Condition`'s `__enter__` or `__exit__` (queues and
+  events use them): there it would leave the lock held and the next hand on it (a
+  queue's, a writer's) waiting for good; the signal comes again RETRY seconds later.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from contextlib import contextmanager
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing: start-up stays short
 if TYPE_CHECKING:
+    from types import FrameType
     from typing import Any
 
 ENDING_SIGNALS: tuple[signal.Signals, ...] = tuple(
@@ -80,7 +84,15 @@ def left(budget: float) -> float:
     return budget if since is None else max(LAST_WAIT, since + budget - time.monotonic())
 
 
-def _handle(signum: int, frame: object) -> None:
+RETRY = 0.005
+"""Seconds after which a signal that came inside a Condition's lock step comes again."""
+
+_LOCK_STEPS = frozenset(
+    (threading.Condition.__enter__.__code__, threading.Condition.__exit__.__code__)
+)
+
+
+def _handle(signum: int, frame: FrameType | None) -> None:
     if _ending.since is None:
         _ending.since = time.monotonic()
     if _ending.ended:
@@ -88,11 +100,28 @@ def _handle(signum: int, frame: object) -> None:
     if _ending.depth:
         _ending.pending = True
         return
+    if frame is not None and frame.f_code in _LOCK_STEPS:
+        again = threading.Timer(RETRY, _again, (signum,))
+        again.daemon = True
+        again.start()
+        return
     _ending.ended = True
     if _ending.action is not None:
         _ending.action()
         return
     raise KeyboardInterrupt
+
+
+def _again(signum: int) -> None:
+    """A signal put off by `_handle`, sent again while its handler is still ours: to the
+    main thread, whose wait (a sleep, a read) it cuts short as the first one would."""
+    if signal.getsignal(signum) is not _handle:
+        return
+    main = threading.main_thread().ident
+    if hasattr(signal, "pthread_kill") and main is not None:
+        signal.pthread_kill(main, signum)
+    else:  # Windows: its one ending signal, SIGINT, wakes the main thread's waits
+        signal.raise_signal(signum)
 
 
 @contextmanager

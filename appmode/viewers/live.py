@@ -2,7 +2,8 @@
 through the official foxglove-sdk (the `foxglove` extra).
 
 Nothing here may slow the car's stop: the caller only appends to a bounded queue
-(`QUEUE` items; what does not fit is dropped and counted), and a worker thread decodes
+(`QUEUE` items; what does not fit is dropped and counted; a `SimpleQueue`, which takes
+no lock that a signal's KeyboardInterrupt could leave held), and a worker thread decodes
 the bytes (`PortsReader`) into the channels of `protocol.channels` and logs them. The
 SDK keeps each viewer's backlog bounded too (`BACKLOG` messages; the oldest dropped for
 a viewer that does not read), so a viewer that connects and never reads costs nothing
@@ -10,7 +11,6 @@ but its own messages."""
 
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
 import queue
@@ -101,7 +101,7 @@ class LiveView:
         self._log = foxglove.channels.LogChannel(LOG, context=self._context)
         self._layout = layout
         self._drive_type = drive_type
-        self._queue: queue.Queue[tuple[Any, ...] | None] = queue.Queue(QUEUE)
+        self._queue: queue.SimpleQueue[tuple[Any, ...] | None] = queue.SimpleQueue()
         self._thread = threading.Thread(target=self._run, name="foxglove", daemon=True)
         self._thread.start()
 
@@ -119,9 +119,9 @@ class LiveView:
         self._put(("note", time.time(), text))
 
     def _put(self, item: tuple[Any, ...]) -> None:
-        try:
-            self._queue.put_nowait(item)
-        except queue.Full:
+        if self._queue.qsize() < QUEUE:
+            self._queue.put(item)
+        else:
             self.dropped += 1
 
     def _publish_values(self, values: Values) -> None:
@@ -132,8 +132,7 @@ class LiveView:
 
     def close(self, wait: float = 1.0) -> None:
         """Log what is queued (at most `wait` seconds), then stop the server."""
-        with contextlib.suppress(queue.Full):
-            self._queue.put(None, timeout=wait)
+        self._queue.put(None)
         self._thread.join(wait)
         self._server.stop()
 

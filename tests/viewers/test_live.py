@@ -14,6 +14,8 @@ import sys
 import threading
 import time
 from pathlib import Path
+from types import FrameType
+from typing import Any
 
 import pytest
 
@@ -209,3 +211,46 @@ def test_a_board_whose_records_are_magnitudes_shows_the_pose_its_frames_sign() -
     poses = seen[0].json_on("/pose")
     assert len(poses) > 10
     assert poses[-1]["pose"]["position"]["x"] > 0.15  # forward, from magnitudes signed
+
+
+def _feed_interrupted_at(step: int) -> tuple[bool, int]:
+    """Feed a live view a record with a KeyboardInterrupt raised at its `step`th traced
+    step, then close it: whether the close ended within 5 s, and how many steps the
+    feed took."""
+    from appmode.viewers.live import LiveView
+
+    view = LiveView("127.0.0.1", 0)
+    steps = 0
+
+    def tracer(frame: FrameType, event: str, arg: object) -> Any:
+        nonlocal steps
+        steps += 1
+        if steps == step:
+            raise KeyboardInterrupt
+        return tracer
+
+    sys.settrace(tracer)
+    try:
+        view("in", 0.0, b"{A1:2:3:4}$")
+    except KeyboardInterrupt:
+        pass
+    finally:
+        sys.settrace(None)
+    closing = threading.Thread(target=view.close, daemon=True)
+    closing.start()
+    closing.join(5)
+    return not closing.is_alive(), steps
+
+
+def test_a_keyboard_interrupt_anywhere_in_feeding_the_view_leaves_its_close_prompt() -> None:
+    """The caller feeds the view from the main thread, where an ending signal raises
+    KeyboardInterrupt between any two steps: none of them may leave a lock held (a
+    queue's, which once hung the board's exit for good)."""
+    step = 0
+    while True:
+        step += 1
+        closed, steps = _feed_interrupted_at(step)
+        assert closed, f"close waits for good after an interrupt at step {step}"
+        if steps < step:  # the feed ran to its end before the interrupt was due
+            break
+    assert step > 3
