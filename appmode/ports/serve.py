@@ -219,20 +219,24 @@ class BoardServer:
                 wake = max(wake, math.ceil(wake / GATHER) * GATHER)
             timeout = max(0.0, wake - self.now())
             for key, _ in select_exactly(self._sel, timeout):
-                endpoint: Endpoint | None = key.data
-                if endpoint is None:
-                    self._woken()
-                    continue
-                with self.lock:
-                    index, name = self._by_endpoint[endpoint]
-                    one = self._served[index]
-                    room = INPUT_BACKLOG - len(one.wire.ports[name].to_board)
-                    data = endpoint.read(max(1, room), key.fileobj)
-                    if data:
-                        one.receive(data, self.now(), name)
-                        self._log_notes(one)
-                        one.throttle()
-                        self._reschedule(index)
+                self._receive(key)
+
+    def _receive(self, key: selectors.SelectorKey) -> None:
+        """Read what a ready port holds (at most the room its board has) and feed it."""
+        endpoint: Endpoint | None = key.data
+        if endpoint is None:
+            self._woken()
+            return
+        with self.lock:
+            index, name = self._by_endpoint[endpoint]
+            one = self._served[index]
+            room = INPUT_BACKLOG - len(one.wire.ports[name].to_board)
+            data = endpoint.read(max(1, room), key.fileobj)
+            if data:
+                one.receive(data, self.now(), name)
+                self._log_notes(one)
+                one.throttle()
+                self._reschedule(index)
 
     def _log_notes(self, one: Served) -> None:
         if not one.wire.board.notes:
@@ -285,7 +289,12 @@ class BoardServer:
         return queue[0][0] if queue else inf
 
     def close(self) -> None:
-        """Close every port, then the recording (what its decoders hold is written)."""
+        """Take in what the clients sent before the end (once, without waiting: the
+        recording holds every byte written to the board before it ended), close every
+        port, then the recording (what its decoders hold is written)."""
+        with contextlib.suppress(OSError, ValueError):
+            for key, _ in self._sel.select(0):
+                self._receive(key)
         for endpoint in self._endpoints:
             endpoint.close()
         self._sel.close()

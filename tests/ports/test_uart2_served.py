@@ -3,6 +3,7 @@ the APP port, a plain pyserial client, and sim:// opening both ports of one boar
 
 from __future__ import annotations
 
+import signal
 import time
 from pathlib import Path
 
@@ -109,3 +110,25 @@ def test_app_commands_refuse_the_control_port_of_a_sim_board() -> None:
     done = run("send", "sim://?port=uart2", "J", "A")
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "leave out port=uart2" in done.stderr
+
+
+def test_what_a_client_wrote_before_the_board_ended_is_in_its_recording(tmp_path: Path) -> None:
+    """A client's last frame (its stop) written just before the board ends is read and
+    recorded on the way out: the board's recording, the tests' judge, holds it. The board
+    is held still (SIGSTOP) while the frame is written and the end is asked for, so its
+    serving loop never sees the frame."""
+    record = tmp_path / "end.transcript"
+    with (
+        board_process("--pty", "--quiet", "--record", str(record)) as board,
+        serial.Serial(board.uart2, 115200, timeout=1) as u2,
+    ):
+        board.proc.send_signal(signal.SIGSTOP)
+        try:
+            u2.write(control.STOP)
+            u2.flush()
+            board.proc.send_signal(signal.SIGTERM)
+        finally:
+            board.proc.send_signal(signal.SIGCONT)
+        assert board.proc.wait(10) == 0
+    lines = record.read_text().splitlines()
+    assert lines[-1].endswith("2> " + control.STOP.hex(" ").upper()), lines[-3:]
