@@ -191,7 +191,7 @@ def _is_record(event: Event) -> bool:
 
 def _kind(event: Event) -> str:
     if isinstance(event, app.RECORDS):
-        return app.record_fields(event)[0]
+        return event.letter
     if isinstance(event, app.ERRORS):
         return "ERRORS"
     return "LINK"  # link changes always show

@@ -4,7 +4,6 @@ line of block characters, scaled to its own range."""
 from __future__ import annotations
 
 from appmode.host.app.state import TRACE_SECONDS, HostState, Trace
-from appmode.protocol import app
 
 LEVELS = "▁▂▃▄▅▆▇█"
 
@@ -49,7 +48,7 @@ def waveform_lines(state: HostState, now: float, width: int) -> list[str]:
     series += [(field.label, state.attitudes, i) for i, field in enumerate(layout.b_fields)]
     lines = []
     for label, trace, field in series:
-        points = [(t, app.record_fields(event)[1][field]) for t, event in trace.points]
+        points = [(t, event.values[field]) for t, event in trace.points]
         values = [v for _, v in points]
         span = f"{min(values)}…{max(values)}" if values else "—"
         lines.append(f" {label:<8}{sparkline(points, now, width - 24)}  {span:>13}")

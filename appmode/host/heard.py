@@ -137,7 +137,7 @@ class Heard:
                 self.record_times.append(at)
                 self.record_sizes.append(len(event.raw))
                 if len(self.shapes) < identify.SHOWN:
-                    self.shapes.append(app.record_fields(event))
+                    self.shapes.append((event.letter, event.values))
             elif not isinstance(event, app.RECORDS):
                 self.outside += len(event.raw)
                 printable = text_part(event.raw)

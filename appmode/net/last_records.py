@@ -39,4 +39,4 @@ class LastRecords:
         velocity = self.velocity
         if velocity is None or (now is not None and now - self.at > FRESH):
             return None
-        return layout.speed(app.record_fields(velocity)[1]) > STILL
+        return layout.speed(velocity.values) > STILL

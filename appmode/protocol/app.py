@@ -151,7 +151,8 @@ def _separator_warning(separator: int) -> str | None:
 # Records, and what a decoder reports of bytes that are none, are not frozen: a frozen
 # class costs three to four times as much to build, and the decoders build hundreds of
 # thousands a second (bench/decoder.py). Treat them as immutable all the same. A
-# record's `terminated` is False when its `$` was missing.
+# record's `letter` and `values` are its wire letter and fields; its `terminated` is False
+# when its `$` was missing.
 
 
 class Velocity(Slotted):
@@ -169,6 +170,13 @@ class Velocity(Slotted):
         self.extra = extra
         self.terminated = terminated
         self.raw = raw
+
+    letter = "A"
+
+    @property
+    def values(self) -> tuple[int, ...]:
+        """The record's fields in wire order."""
+        return (self.x, self.y, self.z, self.extra)
 
 
 class Attitude(Slotted):
@@ -193,6 +201,13 @@ class Attitude(Slotted):
         self.terminated = terminated
         self.raw = raw
 
+    letter = "B"
+
+    @property
+    def values(self) -> tuple[int, ...]:
+        """The record's fields in wire order."""
+        return (self.pitch, self.roll, self.yaw, self.battery)
+
 
 class ParamsRecord(Slotted):
     """`{C p0:…:p8}$`: the nine parameters in index order."""
@@ -204,6 +219,8 @@ class ParamsRecord(Slotted):
         self.values = values
         self.terminated = terminated
         self.raw = raw
+
+    letter = "C"
 
 
 class OtherRecord(Slotted):
@@ -250,17 +267,6 @@ ERRORS = (Noise, BadFrame, Malformed, Garbage)
 """Event types that carry bytes which decoded to nothing."""
 
 # ---------------------------------------------------------------- encoding
-
-
-def record_fields(record: Record) -> tuple[str, tuple[int, ...]]:
-    """A record as (letter, field values)."""
-    if isinstance(record, Velocity):
-        return "A", (record.x, record.y, record.z, record.extra)
-    if isinstance(record, Attitude):
-        return "B", (record.pitch, record.roll, record.yaw, record.battery)
-    if isinstance(record, ParamsRecord):
-        return "C", record.values
-    return record.letter, record.values
 
 
 def set_frame(index: int, value: int) -> bytes:

@@ -200,7 +200,7 @@ class Decoded:
             return [("/uart2/encoders" if encoders else "/uart2/replies", body)]
         if direction != RECEIVED or not isinstance(event, app.RECORDS):
             return [("/app/other", body)]
-        letter, values = app.record_fields(event)
+        letter, values = event.letter, event.values
         if letter not in "ABC":
             return [("/app/other", body)]
         found = [(f"/app/{letter}", self._scaled(letter, values, event.raw))]

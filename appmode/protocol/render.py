@@ -63,14 +63,13 @@ def to_json(event: p.Event, layout: Layout = VELOCITY) -> dict[str, Any]:
     """One JSON-ready object: `kind`, the integer values (an A record's named as `layout`
     reads them), and `raw` (escaped bytes)."""
     body: dict[str, Any]
-    named = isinstance(event, p.OtherRecord) and len(event.values) == len(
-        record_names(event.letter, layout)
-    )  # a B record of a profile whose B has other than four fields
-    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord)) or named:
-        letter, values = p.record_fields(event)  # type: ignore[arg-type]  # a record
-        names = record_names(letter, layout)
-        body = {"kind": KINDS[letter], **dict(zip(names, values, strict=True))}
-        odd = out_of_range(values, layout) if isinstance(event, p.ParamsRecord) else ()
+    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord, p.OtherRecord)) and (
+        not isinstance(event, p.OtherRecord)
+        or len(event.values) == len(record_names(event.letter, layout))
+    ):  # an other record named: a B record of a profile whose B has other than four fields
+        names = record_names(event.letter, layout)
+        body = {"kind": KINDS[event.letter], **dict(zip(names, event.values, strict=True))}
+        odd = out_of_range(event.values, layout) if isinstance(event, p.ParamsRecord) else ()
         if odd:
             body["out_of_range"] = list(odd)
     elif isinstance(event, p.OtherRecord):
@@ -176,9 +175,9 @@ def describe(event: p.Event, layout: Layout = VELOCITY) -> str:
             f"battery={event.battery}%"
         )
     if isinstance(event, (p.Attitude, p.OtherRecord)) and (
-        p.record_fields(event)[0] == "B" and len(p.record_fields(event)[1]) == len(layout.b_fields)
+        event.letter == "B" and len(event.values) == len(layout.b_fields)
     ):
-        values = p.record_fields(event)[1]
+        values = event.values
         pairs = zip(layout.b_fields, values, strict=True)
         shown = (f"{f.name}={v}{'%' if f.battery else ''}" for f, v in pairs)
         return "attitude " + " ".join(shown)

@@ -17,7 +17,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from appmode.protocol import app
 from appmode.protocol.odometry import Odometry, Pose2D
 from appmode.protocol.render import to_json
 from appmode.protocol.sensed import YAW_WINDOW, Inertial, yaw_rate
@@ -380,7 +379,7 @@ class RosNode:
     def _fields(self, event: Any, state: HostState, letter: str) -> dict[str, tuple[float, Any]]:
         """A record's values by field name, each divided by its scale, with its field."""
         fields = state.layout.a_fields if letter == "A" else state.layout.b_fields
-        values = app.record_fields(event)[1]
+        values = event.values
         return {f.name: (v / f.scale, f) for f, v in zip(fields, values, strict=False)}
 
     def _odometry(self, twist: Twist, at: float, stamp: int) -> None:

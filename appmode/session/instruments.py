@@ -11,7 +11,6 @@ from typing import Literal
 
 from appmode.host.app.state import HostState
 from appmode.host.stats import LinkStats
-from appmode.protocol import app
 
 LinkState = Literal["up", "late", "degraded", "lost", "opening", "silent"]
 """Up and fresh; up but the last record is over LATE old; errors in the last 5 s; the
@@ -88,14 +87,14 @@ def telemetry(state: HostState, now: float) -> Telemetry:
     motion, speed, battery = None, None, None
     battery_age = state.velocities.age(now)  # until a B record gives it
     if v is not None:
-        values, labels = app.record_fields(v)[1], layout.labels
+        values, labels = v.values, layout.labels
         shown = [*layout.motion, *(i for i in layout.extra_a)]
         motion = tuple((labels[i], values[i]) for i in shown)
         speed = layout.speed(values)
         battery = None if layout.battery is None else values[layout.battery]
     b = None
     if not layout.sheet_b and state.attitudes.points:
-        b_values = app.record_fields(state.attitudes.points[-1][1])[1]
+        b_values = state.attitudes.points[-1][1].values
         b = tuple((f.label, value) for f, value in zip(layout.b_fields, b_values, strict=False))
         held = [value for f, value in zip(layout.b_fields, b_values, strict=False) if f.battery]
         if held:

@@ -8,7 +8,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from appmode.host.app.state import HostState
-from appmode.protocol.app import record_fields
 from appmode.protocol.sensed import Sensing, yaw_rate
 from appmode.protocol.twist import Twist
 
@@ -43,15 +42,11 @@ def twists(state: HostState, signs: Signs, after: float) -> list[tuple[float, Tw
         index = sensing.yaw
         assert index is not None
         start = fresh[0][0] - YAW_HISTORY
-        yaws = [
-            (at, record_fields(event)[1][index])
-            for at, event in state.attitudes.points
-            if at >= start
-        ]
+        yaws = [(at, event.values[index]) for at, event in state.attitudes.points if at >= start]
     found = []
     for at, event in fresh:
         rate = yaw_rate(yaws, at) if sensing.turn_from_yaw else None
-        twist = sensing.twist(record_fields(event)[1], in_force, rate)
+        twist = sensing.twist(event.values, in_force, rate)
         if twist is not None:
             found.append((at, twist))
     return found

@@ -77,7 +77,7 @@ class Pattern:
     def matches(self, record: Unit) -> bool:
         if not isinstance(record, app.RECORDS):
             return False
-        letter, values = app.record_fields(record)
+        letter, values = record.letter, record.values
         return (
             letter == self.letter
             and len(values) == len(self.fields)
@@ -270,7 +270,7 @@ class Check:
         if port in BYTES_PORTS and isinstance(exp.pattern, BytesPattern):
             letter, shown = f"{exp.entry.direction}{raw[:1].hex()}", raw.hex(" ").upper()
         elif isinstance(record, app.RECORDS):
-            letter = app.record_fields(record)[0]
+            letter = record.letter
             shown = escape(raw) if raw else escape(app.encode(record))
         else:
             return

@@ -133,7 +133,7 @@ def run_plot(path: str, output: str, profile: str | None = None, chassis_only: b
         elif isinstance(event, chassis.Command) and direction == SENT_CHASSIS:
             status.frames.add(t, f"{event.vx / 1000:g},{event.vy / 1000:g},{event.wz / 1000:g}")
         elif isinstance(event, (app.Velocity, app.Attitude, app.OtherRecord)):
-            letter, values = app.record_fields(event)
+            letter, values = event.letter, event.values
             fields = seen.a if letter == "A" else seen.b if letter == "B" else []
             if len(values) == len(fields):
                 for envelope, value in zip(fields, values, strict=True):

@@ -18,7 +18,6 @@ from typing import Any
 
 from appmode.errors import AppmodeError
 from appmode.host.app.state import TRACE_SECONDS, HostState
-from appmode.protocol import app
 from appmode.session.base import BaseSession
 from appmode.session.command_line import Quit, ShowHelp, ShowStatus
 from appmode.session.hold import HoldToDrive
@@ -223,8 +222,8 @@ def _traces(state: HostState | None, now: float) -> dict[str, Any] | None:
     its points (seconds before now, value)."""
     if state is None:
         return None
-    velocity = [(now - t, app.record_fields(v)[1]) for t, v in state.velocities.points]
-    attitude = [(now - t, app.record_fields(a)[1]) for t, a in state.attitudes.points]
+    velocity = [(now - t, v.values) for t, v in state.velocities.points]
+    attitude = [(now - t, a.values) for t, a in state.attitudes.points]
     labels, units = state.layout.labels, [f.unit for f in state.layout.a_fields]
     series = [
         {

@@ -125,7 +125,7 @@ class HostState:
         stopped = self.stopped_at
         if stopped is None or self._warned or now - stopped < STILL_MOVING_AFTER:
             return None
-        if self.layout.speed(app.record_fields(velocity)[1]) <= STILL:
+        if self.layout.speed(velocity.values) <= STILL:
             return None
         self._warned = True
         return BoardWarning(
@@ -141,7 +141,7 @@ class HostState:
         if self.letters_ignored or since is None or now - since < FOLLOW_AFTER:
             return None
         stalled = self.params is not None and self.params.values[params.MAX_SPEED] == 0
-        if stalled or self.layout.speed(app.record_fields(velocity)[1]) > STILL:
+        if stalled or self.layout.speed(velocity.values) > STILL:
             return None
         self.letters_ignored = True
         return BoardWarning(

@@ -36,7 +36,7 @@ class StopCheck:
 
     def at_rest(self, record: app.Velocity) -> bool:
         """An A record after the stop: True when it shows the car at rest."""
-        if self.layout.speed(app.record_fields(record)[1]) <= STILL:
+        if self.layout.speed(record.values) <= STILL:
             return True
         self.moving = record
         return False

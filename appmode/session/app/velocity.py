@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from appmode.host.app.state import HostState
-from appmode.protocol import app, params
+from appmode.protocol import params
 from appmode.protocol.params import DriveType
 from appmode.protocol.twist import STILL, Twist
 
@@ -49,7 +49,7 @@ def speed_and_drive(state: HostState) -> tuple[int | None, DriveType]:
     layout = state.layout
     if state.params is None:
         return None, DriveType.OMNI
-    values = app.record_fields(state.params)[1]
+    values = state.params.values
     speed = None if layout.speed_index is None else int(values[layout.speed_index])
     names = [param.name for param in layout.params]
     if "system_mode" not in names:
