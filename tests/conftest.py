@@ -34,17 +34,15 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers for two cores on an idle machine, one a core on a busy
-    one.
+    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
 
-    Most tests wait on boards, ptys and processes in real time: three workers for two
-    cores used 0.6 of a core and took 7.5 minutes. Six took 4 min 24 s to 5 min 9 s
-    with the processes of tests that keep no time at nice 10, and one run of eight
-    still failed a test that keeps time (a stop 0.34 s after it was asked, within 0.3);
-    at one priority, half the runs failed. Nice 10 is gone too: beside two busy
-    programs the lowered processes all but stopped (the run passed 25 minutes). So
-    three, and, as `make -l` does, a run started beside another run of this suite
-    (RUNS), or on a machine whose cores are already busy, takes one worker a core."""
+    Most tests wait on boards, ptys and processes in real time: on two cores three
+    workers took 7 min 21 s and four 6 min 8 s, the tests' own durations adding up to
+    1,180 s and 1,199 s (four did not slow them). Six took 4 min 24 s to 5 min 25 s, but
+    half those runs failed a test that keeps time, even with the other tests' processes
+    at nice 10 (which, beside two busy programs, all but stopped them). So two a core,
+    and, as `make -l` does, a run started beside another run of this suite (RUNS), or
+    on a machine whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -54,7 +52,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
         others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
     except OSError:  # another user's folder: the load average alone tells
         others = []
-    return cores if others or busy_cores() >= 0.9 * cores else cores + cores // 2
+    return cores if others or busy_cores() >= 0.9 * cores else 2 * cores
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
