@@ -61,7 +61,7 @@ def show(session: BaseSession, step: Step) -> None:
         text = status_text(session)
         session.say(text)
     elif isinstance(step, ShowHelp):
-        for text in session.help_lines():
+        for text in session.help_lines:
             session.say(text)
 
 

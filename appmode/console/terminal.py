@@ -243,14 +243,14 @@ class Console:
             return
         info = self.status.render_info
         shown = info.window_height if info else MESSAGES
-        last = max(0, len(self.session.help_lines()) + 1 - shown)
+        last = max(0, len(self.session.help_lines) + 1 - shown)
         self.help_first = min(last, max(0, self.help_first - max(1, shown - 1) * pages))
 
     # ------------------------------------------------------------ what it shows
 
     def _top(self) -> Fragments:
         if self.top == "help":
-            lines = [HELP_TITLE, *self.session.help_lines()][self.help_first :]
+            lines = [HELP_TITLE, *self.session.help_lines][self.help_first :]
             return [("", "\n".join(lines))]
         fragments = status_fragments(self.session, waveforms=self.top == "waves")
         style, text, *_ = fragments[-1]

@@ -11,6 +11,7 @@ import time
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
+from functools import cached_property
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from appmode.board.profiles import board_line
@@ -340,9 +341,11 @@ class BaseSession(ABC):
         if self.on_message is not None:
             self.on_message(text)
 
-    def help_lines(self) -> list[str]:
-        """The commands, a line each, then the keys."""
-        return help_lines((*self.commands, *COMMON), self.keys_help)
+    @cached_property
+    def help_lines(self) -> tuple[str, ...]:
+        """The commands, a line each, then the keys (made once: the help view shows
+        them at every redraw)."""
+        return tuple(help_lines((*self.commands, *COMMON), self.keys_help))
 
     # ------------------------------------------------------------ recording
 

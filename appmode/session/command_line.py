@@ -45,7 +45,7 @@ SHOW_STATUS = ShowStatus()
 
 
 class ShowHelp:
-    """`help` was asked for: the view shows `help_lines()`."""
+    """`help` was asked for: the view shows `help_lines`."""
 
 
 SHOW_HELP = ShowHelp()

@@ -184,7 +184,7 @@ class Bridge:
         except Quit:
             return {"t": "error", "text": "close the page to leave; the car stops"}
         if isinstance(step, ShowHelp):
-            for text in self.session.help_lines():
+            for text in self.session.help_lines:
                 self.session.say(text)
         elif isinstance(step, ShowStatus) or step is not None:
             return {"t": "error", "text": "that command is for the terminal"}

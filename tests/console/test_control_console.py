@@ -98,10 +98,10 @@ def test_the_panel_fits_80_columns_with_both_ports() -> None:
             session.tick()
             time.sleep(0.02)
         lines = "".join(part[1] for part in status_fragments(session)).splitlines()
-        help_lines = session.help_lines()
+        help_lines = session.help_lines
     finally:
         session.close()
-    for line in lines + help_lines:
+    for line in [*lines, *help_lines]:
         assert sum(get_cwidth(ch) for ch in line) <= WIDTH, line
     assert len(lines) + 1 + 3 <= 24, lines  # + the rule and three message lines
     text = "\n".join(lines)

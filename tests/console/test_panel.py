@@ -57,7 +57,7 @@ def test_every_line_fits_80_columns_with_the_grid_the_waveforms_and_the_help() -
         views = {
             "grid": _lines(status_fragments(session)),
             "waves": _lines(status_fragments(session, waveforms=True)),
-            "help": session.help_lines(),
+            "help": session.help_lines,
         }
     finally:
         session.close()
