@@ -11,7 +11,6 @@ import time
 from abc import ABC, abstractmethod
 from collections import deque
 from collections.abc import Callable
-from functools import cached_property
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from appmode.board.profiles import board_line
@@ -94,6 +93,8 @@ class BaseSession(ABC):
         self._specs = {spec.name: spec for spec in specs}
         self.completions: dict[str, object] = {spec.name: spec.completes for spec in specs}
         """Every command's name, and what the command line completes after it."""
+        self.help_lines = tuple(help_lines(specs, self.keys_help))
+        """The commands, a line each, then the keys (made once: shown at every redraw)."""
         self.closing_notes: list[str] = []
         """What closing had to do beyond its stop, for people (shown after the console)."""
         self.undelivered: str | None = None
@@ -340,12 +341,6 @@ class BaseSession(ABC):
             viewer.note(text)
         if self.on_message is not None:
             self.on_message(text)
-
-    @cached_property
-    def help_lines(self) -> tuple[str, ...]:
-        """The commands, a line each, then the keys (made once: the help view shows
-        them at every redraw)."""
-        return tuple(help_lines((*self.commands, *COMMON), self.keys_help))
 
     # ------------------------------------------------------------ recording
 
