@@ -32,9 +32,10 @@ def run_drive(
     or (in either mode) if the recording stopped on its own or the final stop could not
     be sent to a car last told to move."""
     try:
+        # the console first: one that cannot be shown fails before the car is spoken to
+        console = Console(session, input, output, command_history()) if interactive else None
         session.start()
-        if interactive:
-            console = Console(session, input, output, command_history())
+        if console is not None:
             asyncio.run(console.run())
         else:
             run_script(session, script, out, keep_going)
