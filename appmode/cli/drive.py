@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.live_view import add_foxglove, live_view
+from appmode.cli.live_view import LiveViews, add_foxglove
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -117,14 +117,12 @@ def run(args: argparse.Namespace) -> int:
     from appmode.session.hold import HoldToDrive
     from appmode.session.opener import open_session
 
-    choice = board_choice(args)
-    interactive = sys.stdin.isatty() and sys.stdout.isatty()
-    driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
-    on_message = None if interactive else _print_message
-    with live_view(
-        args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
-    ) as view:
-        session = open_session(choice, driving, on_message, args.record, view)
+    with LiveViews(args.foxglove, args.foxglove_drive) as views:
+        choice = board_choice(args)
+        interactive = sys.stdin.isatty() and sys.stdout.isatty()
+        driving = HoldToDrive(args.hold_first, args.hold_repeat, args.latched or not interactive)
+        on_message = None if interactive else _print_message
+        session = open_session(choice, driving, on_message, args.record, views.make)
         script = command_lines(sys.stdin, MAX_COMMAND)
         return run_drive(session, interactive, script, sys.stdout, keep_going=args.keep_going)
 

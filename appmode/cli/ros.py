@@ -10,7 +10,7 @@ import sys
 from contextlib import ExitStack
 
 from appmode.cli.commands import COMMANDS
-from appmode.cli.live_view import add_foxglove, live_view
+from appmode.cli.live_view import LiveViews, add_foxglove
 from appmode.cli.options import (
     HOLDS,
     Subparsers,
@@ -145,15 +145,11 @@ def _serve(args: argparse.Namespace, domain: int, ns: str, node: str) -> int:
                 f"no Zenoh router at {', '.join(connect)}: start one (ros2 run rmw_zenoh_cpp "
                 "rmw_zenohd), or add --router to run it here"
             )
+        views = stack.enter_context(LiveViews(args.foxglove, args.foxglove_drive))
         choice = board_choice(args, both=True)  # a sim:// board's records give odom
         timeout = args.cmd_vel_timeout
-        view = stack.enter_context(
-            live_view(
-                args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
-            )
-        )
         held = HoldToDrive(first_timeout=timeout, repeat_timeout=timeout)
-        session = open_car(choice, held, view=view)
+        session = open_car(choice, held, view=views.make)
         session.lease, session.lease_source = timeout, "cmd_vel"
         graph = Node(domain, ns, node, str(zenoh.zid()), args.distro)
         topics = TOPIC_SETS[args.topics].placed(

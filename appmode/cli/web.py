@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from appmode.cli.commands import COMMANDS
 from appmode.cli.drive import add_board
-from appmode.cli.live_view import live_view
+from appmode.cli.live_view import LiveViews
 from appmode.cli.options import (
     Subparsers,
     add_host_id,
@@ -101,11 +101,9 @@ def run(args: argparse.Namespace) -> int:
         return _serve_fleet(args, host, port, tls, tuple(addresses), fingerprint)
     if args.connect or args.fleet_key is not None or args.host_id is not None:
         raise AppmodeError("--connect, --fleet-key and --fleet-id go with --fleet")
-    choice = board_choice(args)
-    with live_view(
-        args.foxglove, choice.profile.a_layout, args.foxglove_drive, choice.known_drive
-    ) as view:
-        session = open_session(choice, driving(), record=args.record, view=view)
+    with LiveViews(args.foxglove, args.foxglove_drive) as views:
+        choice = board_choice(args)
+        session = open_session(choice, driving(), record=args.record, view=views.make)
         return serve_web(session, host, port, tls, tuple(addresses), fingerprint)
 
 
