@@ -11,7 +11,8 @@ is Ctrl-C. `install()` gives all three one handler, which:
   (the console's event loop: the action asks it to quit);
 - does not raise inside `threading.Condition`'s `__enter__` or `__exit__` (queues and
   events use them): there it would leave the lock held and the next hand on it (a
-  queue's, a writer's) waiting for good; the signal comes again RETRY seconds later.
+  queue's, a writer's) waiting for good; the signal comes again RETRY seconds later,
+  and after PUT_OFF seconds of that (a lock that another thread never lets go) it raises.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ class _Ending:
         self.ended = False  # an ending signal has been acted on
         self.since: float | None = None  # when the first ending signal came (monotonic)
         self.depth = 0  # atomic steps under way
+        self.put_off = 0  # times a signal came again, having landed in a lock step
         self.pending = False  # a signal came during one
         self.action: Callable[[], None] | None = None
         self.before: dict[int, Any] = {}  # the handlers install() replaced
@@ -49,6 +51,7 @@ def install() -> None:
     """Handle SIGINT, SIGTERM and SIGHUP as above (in the main thread), from now: an
     ending acted on before is forgotten."""
     _ending.ended = _ending.pending = False
+    _ending.put_off = 0
     _ending.since = None
     for signum in (signal.SIGINT, *ENDING_SIGNALS):
         _ending.before[signum] = signal.signal(signum, _handle)
@@ -86,6 +89,9 @@ def left(budget: float) -> float:
 
 RETRY = 0.005
 """Seconds after which a signal that came inside a Condition's lock step comes again."""
+PUT_OFF = 0.5
+"""Seconds a signal is put off so at most: a step that long is waiting for the lock, not
+holding it, and raising there leaves nothing held."""
 
 _LOCK_STEPS = frozenset(
     (threading.Condition.__enter__.__code__, threading.Condition.__exit__.__code__)
@@ -100,7 +106,8 @@ def _handle(signum: int, frame: FrameType | None) -> None:
     if _ending.depth:
         _ending.pending = True
         return
-    if frame is not None and frame.f_code in _LOCK_STEPS:
+    if frame is not None and frame.f_code in _LOCK_STEPS and _ending.put_off * RETRY < PUT_OFF:
+        _ending.put_off += 1
         again = threading.Timer(RETRY, _again, (signum,))
         again.daemon = True
         again.start()

@@ -86,3 +86,27 @@ def test_an_ending_signal_elsewhere_raises_at_once(handled: None) -> None:
     with pytest.raises(KeyboardInterrupt):
         signals._handle(signal.SIGTERM, sys._getframe())
     assert signals._ending.ended
+
+
+def test_an_ending_signal_while_waiting_for_a_lock_held_for_good_still_raises(
+    handled: None,
+) -> None:
+    """A Condition's lock that another thread never lets go: the signal, put off while
+    the main thread waits in `__enter__`, raises within PUT_OFF (nothing is held)."""
+    lock = threading.Lock()
+    lock.acquire()  # held for good, as by a thread that hangs
+    ready = threading.Condition(lock)
+    started = time.monotonic()
+    threading.Timer(
+        0.2, signal.pthread_kill, (threading.main_thread().ident, signal.SIGTERM)
+    ).start()
+    watchdog = threading.Timer(5, lock.release)  # were the signal put off for good
+    watchdog.start()
+    try:
+        with pytest.raises(KeyboardInterrupt), ready:
+            time.sleep(10)  # reached only after the watchdog: the signal lands here
+    finally:
+        watchdog.cancel()
+    took = time.monotonic() - started
+    assert took >= 0.2 + signals.PUT_OFF - 0.1, f"raised at once ({took:.2f} s)"
+    assert took < 5, f"raised only after {took:.2f} s"
