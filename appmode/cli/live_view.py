@@ -84,7 +84,6 @@ class LiveViews:
                 f"another machine reach it through SSH (ssh -L {port}:localhost:{port} "
                 "THIS-MACHINE)"
             )
-        self.close()  # one view at a time
         view = self._view = LiveView(host, port, layout, drive=self._drive, drive_type=drive_type)
         print(
             f"foxglove: {view.url} (in Foxglove or Lichtblick: Open connection → Foxglove "

@@ -63,7 +63,7 @@ def to_json(event: p.Event, layout: Layout = VELOCITY) -> dict[str, Any]:
     """One JSON-ready object: `kind`, the integer values (an A record's named as `layout`
     reads them), and `raw` (escaped bytes)."""
     body: dict[str, Any]
-    if isinstance(event, (p.Velocity, p.Attitude, p.ParamsRecord, p.OtherRecord)) and (
+    if isinstance(event, p.RECORDS) and (
         not isinstance(event, p.OtherRecord)
         or len(event.values) == len(record_names(event.letter, layout))
     ):  # an other record named: a B record of a profile whose B has other than four fields
