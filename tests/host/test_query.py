@@ -61,9 +61,39 @@ def test_a_garbled_c_record_is_asked_for_again_at_once() -> None:
     state = HostState()
     state.start_query(ParamQuery(), 0.0)
     state.take_outbox()
-    state.feed(b"{C500:10000:20:0:1\x000:10:10:0:0}$", 0.1)
+    state.feed(GARBLED_C, 0.1)
     assert state.take_outbox() == b"{Q:P}"
     assert state.stats.errors == 1 and state.params is None
+
+
+GARBLED_C = b"{C500:10000:20:0:1\x000:10:10:0:0}$"
+
+
+def test_garbled_answers_give_their_requests_back_up_to_as_many_again() -> None:
+    """A garbled answer is no silence: with tries=2 a noisy read has 8 requests, and 6
+    garbled answers before 4 agreeing ones would have spent them (one set in about 400
+    under the suite's moderate faults did)."""
+    state = HostState()
+    state.start_query(ParamQuery(tries=2), 0.0)
+    for i in range(6):
+        assert outcomes(state.feed(GARBLED_C, 0.1 * i)) == []
+    for i in range(3):
+        assert outcomes(state.feed(c_record(), 1.0 + 0.1 * i)) == []
+    [done] = outcomes(state.feed(c_record(), 1.5))
+    assert isinstance(done, QueryDone) and done.values == params.DEFAULTS
+
+
+def test_a_link_that_only_garbles_still_ends_the_query() -> None:
+    state = HostState()
+    state.feed(c_record(), 0.0)  # a board, then a link that garbles all it carries
+    state.start_query(ParamQuery(tries=2), 0.0)
+    sent = state.take_outbox().count(b"{Q:P}")
+    failed: list[object] = []
+    while not failed:
+        failed = outcomes(state.feed(GARBLED_C, 0.1 * sent))
+        sent += state.take_outbox().count(b"{Q:P}")
+    assert sent == 16, "8 requests, and 8 given back by garbled answers"
+    assert isinstance(failed[0], QueryFailed) and "the link is noisy" in failed[0].text
 
 
 def test_read_resends_on_timeout_then_fails_with_a_clear_error() -> None:
