@@ -34,15 +34,16 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
+    """`-n auto`: five workers per two cores on an idle machine, one a core on a busy one.
 
-    Most tests wait on boards, ptys and processes in real time: on two cores three
-    workers took 7 min 21 s and four 6 min 8 s, the tests' own durations adding up to
-    1,180 s and 1,199 s (four did not slow them). Six took 4 min 24 s to 5 min 25 s, but
-    half those runs failed a test that keeps time, even with the other tests' processes
-    at nice 10 (which, beside two busy programs, all but stopped them). So two a core,
-    and, as `make -l` does, a run started beside another run of this suite (RUNS), or
-    on a machine whose cores are already busy, takes one worker a core."""
+    Most tests wait on boards, ptys and processes in real time: on two cores the suite's
+    processes kept 0.8 of them busy on average with four workers. Three workers took
+    7 min 21 s, four 5 min 43 s to 6 min 8 s, five 4 min 52 s (the tests' own durations
+    adding up to about 1,200 s each time). Six took 4 min 24 s to 5 min 25 s, but half
+    those runs failed a test that keeps time, even with the other tests' processes at
+    nice 10 (which, beside two busy programs, all but stopped them). So five per two
+    cores, and, as `make -l` does, a run started beside another run of this suite
+    (RUNS), or on a machine whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -52,7 +53,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
         others = [run for run in RUNS.iterdir() if run != mine and _running(run.name)]
     except OSError:  # another user's folder: the load average alone tells
         others = []
-    return cores if others or busy_cores() >= 0.9 * cores else 2 * cores
+    return cores if others or busy_cores() >= 0.9 * cores else max(2, 5 * cores // 2)
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
