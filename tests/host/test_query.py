@@ -18,6 +18,10 @@ def c_record(**changes: int) -> bytes:
     return encode(ParamsRecord(tuple(values)))
 
 
+GARBLED_C = b"{C500:10000:20:0:1\x000:10:10:0:0}$"
+"""A C record whose NUL in a value the decoder rejects."""
+
+
 def outcomes(events: list[object]) -> list[object]:
     return [e for e in events if isinstance(e, (QueryDone, QueryFailed))]
 
@@ -64,9 +68,6 @@ def test_a_garbled_c_record_is_asked_for_again_at_once() -> None:
     state.feed(GARBLED_C, 0.1)
     assert state.take_outbox() == b"{Q:P}"
     assert state.stats.errors == 1 and state.params is None
-
-
-GARBLED_C = b"{C500:10000:20:0:1\x000:10:10:0:0}$"
 
 
 def test_garbled_answers_give_their_requests_back_up_to_as_many_again() -> None:
