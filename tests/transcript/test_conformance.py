@@ -273,6 +273,7 @@ def test_conform_on_a_board_saves_only_when_a_transcript_saved(
         assert "nothing saved" in done.stdout or "not saved" in done.stdout, done.stdout
 
 
+@pytest.mark.timing  # a transcript in real time (±25 ms) against a board process
 def test_conform_on_a_board_shows_its_progress_on_a_terminal_only() -> None:
     """Issue 69.7: `conform --board` ran for minutes with nothing shown. On a terminal a
     line says which transcript runs and how far it is; in a pipe, nothing."""
