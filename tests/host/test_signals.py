@@ -96,17 +96,31 @@ def test_an_ending_signal_while_waiting_for_a_lock_held_for_good_still_raises(
     lock = threading.Lock()
     lock.acquire()  # held for good, as by a thread that hangs
     ready = threading.Condition(lock)
-    started = time.monotonic()
-    threading.Timer(
-        0.2, signal.pthread_kill, (threading.main_thread().ident, signal.SIGTERM)
-    ).start()
+    sent: list[float] = []
+
+    def signal_the_waiting_main_thread() -> None:
+        """SIGTERM once the main thread waits in `__enter__` (a timer could land before
+        it got there on a loaded machine, and the signal then rightly raised at once)."""
+        main = threading.main_thread().ident
+        assert main is not None
+        end = time.monotonic() + 5
+        while time.monotonic() < end:
+            frame = sys._current_frames().get(main)
+            if frame is not None and frame.f_code is threading.Condition.__enter__.__code__:
+                sent.append(time.monotonic())
+                signal.pthread_kill(main, signal.SIGTERM)
+                return
+            time.sleep(0.01)
+
     watchdog = threading.Timer(5, lock.release)  # were the signal put off for good
     watchdog.start()
+    threading.Thread(target=signal_the_waiting_main_thread, daemon=True).start()
     try:
         with pytest.raises(KeyboardInterrupt), ready:
             time.sleep(10)  # reached only after the watchdog: the signal lands here
     finally:
         watchdog.cancel()
-    took = time.monotonic() - started
-    assert took >= 0.2 + signals.PUT_OFF - 0.1, f"raised at once ({took:.2f} s)"
+    assert sent, "the main thread never waited in Condition.__enter__"
+    took = time.monotonic() - sent[0]
+    assert took >= signals.PUT_OFF - 0.1, f"raised at once ({took:.2f} s)"
     assert took < 5, f"raised only after {took:.2f} s"
