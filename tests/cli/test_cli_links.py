@@ -110,7 +110,10 @@ def test_monitor_counts_and_json() -> None:
     assert done.returncode == 0, done.stderr
     kinds = [json.loads(text)["kind"] for text in done.stdout.splitlines()]
     assert len(kinds) == 6 and set(kinds) == {"velocity", "attitude"}
-    assert "monitor: 6 records, 0 errors" in done.stderr
+    # the link's counters: a read on a loaded machine may bring the records after the
+    # sixth with it (8 seen beside a second run of the suite)
+    counted = re.search(r"monitor: (\d+) records, 0 errors", done.stderr)
+    assert counted is not None and int(counted[1]) >= 6, done.stderr
 
 
 @pytest.mark.timing  # 8 to 14 records in 0.6 s: 7 when starved
