@@ -156,9 +156,9 @@ class RemoteSerial(Modemless):
             )
         self.simulated = info.get("simulated") is True
         """The car shared is a simulated board (the views say so)."""
-        self.car_link_down = LINK_DOWN if info.get("links", {}).get(self._side) is False else None
-        """Why nothing can come from the car: the car's host has lost its link to this
-        port (None while it has it)."""
+        self.car_link_down: str | None = None
+        """Why nothing can come from the car (its host lost its link to this port)."""
+        self._links_said(info.get("links"))
         if self._side not in info.get("ports", ()):
             shared = ", ".join(info.get("ports", ()))
             raise SerialException(f"{name} shares no {self._side} port (it shares {shared})")
@@ -240,6 +240,14 @@ class RemoteSerial(Modemless):
         elif event.get("t") == "link" and event.get("port") == self._side:
             said = escaped(str(event.get("text", ""))[:200])
             self.car_link_down = None if event.get("up") else f"{LINK_DOWN} ({said})"
+        elif event.get("t") == "info":  # each second: a link event missed in opening
+            self._links_said(event.get("links"))
+
+    def _links_said(self, links: object) -> None:
+        """The car's host's info on its link to this port (a link event's words stay)."""
+        up = links.get(self._side) if isinstance(links, dict) else None
+        if isinstance(up, bool):
+            self.car_link_down = None if up else (self.car_link_down or LINK_DOWN)
 
     def _on_presence(self, sample: zenoh.Sample) -> None:
         import zenoh
@@ -335,8 +343,7 @@ class RemoteSerial(Modemless):
         return data
 
     def far_stops(self) -> list[tuple[str, bool]]:
-        """The stops the car's host made (or failed to) since the last look: (what it
-        said, whether the stop went out)."""
+        """The car's host's stops since the last look: (what it said, whether it went out)."""
         with self._ready:
             taken = list(self._far_stops)
             self._far_stops.clear()

@@ -8,11 +8,12 @@ import json
 import re
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from appmode.web.certificate import own_certificate
-from tests.support.processes import run, scripted
+from tests.support.processes import run, scripted, wait_for
 from tests.support.shares import KEY, routed, shared_board
 from tests.testing.test_plugin import pytest_in
 
@@ -177,6 +178,34 @@ def test_a_shared_car_whose_serial_link_is_down_is_said_so_remotely(tmp_path: Pa
     assert done.returncode == 2 and len(done.stderr.splitlines()) == 1, done.stderr
     assert "the car's host has lost its serial link to the car" in done.stderr
     assert "baud rate" not in done.stderr
+
+
+def test_a_link_lost_before_a_client_subscribed_is_said_by_the_share_s_info(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The car's host says a lost link once, as an event: a client opening between its
+    info and its subscribing missed it (beside a second run of the suite, `params` then
+    advised the baud rate). The info it publishes every second says it too."""
+    from appmode.net.remote_port import LINK_DOWN, RemoteSerial
+    from appmode.ports.urls import open_link
+
+    said = RemoteSerial._on_event
+
+    def missing_link_events(port: RemoteSerial, sample: Any) -> None:
+        if b'"t": "link"' not in sample.payload.to_bytes():
+            said(port, sample)
+
+    monkeypatch.setattr(RemoteSerial, "_on_event", missing_link_events)
+    with shared_board(tmp_path, "car") as car:
+        port = open_link(car.url)
+        try:
+            assert getattr(port, "car_link_down", "") is None
+            car.board.proc.kill()
+            car.board.proc.wait()
+            wait_for(lambda: getattr(port, "car_link_down", None) == LINK_DOWN, 5)
+        finally:
+            port.close()
+        car.stop()
 
 
 def _ended(proc: subprocess.Popen[str]) -> tuple[str, str]:
