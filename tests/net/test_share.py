@@ -273,12 +273,13 @@ def _raw_writes(car: SharedCar, size: int, count: int, *until: str) -> subproces
     )
 
 
-@pytest.mark.timing  # Z within 0.3 s: 0.30 s beside five other tests
+@pytest.mark.timing  # Z within 0.5 s of launching fleet stop: 0.17 s idle, 0.36 s loaded
 def test_no_write_holds_the_stop_up(shared: SharedCar) -> None:
     """Issue 80.3: a 3,000-byte write held the share's lock while it went out at 9600
     bps, and a fleet stop reached the board 2.6–3.0 s later. A write is at most a chunk,
-    and a stop pre-empts the writes under way: the board takes Z within 0.3 s of
-    `fleet stop`, and no `A` after it."""
+    and a stop pre-empts the writes under way: the board takes Z within 0.5 s of
+    launching `fleet stop` (its Python and Zenoh session start count: 0.17 s on an idle
+    machine, 0.36 s beside four other tests), and no `A` after it."""
     big = _raw_writes(shared, 3000, 1)
     out, err = big.communicate(timeout=30)
     assert out.strip().startswith("error") and "at most 64 at a time" in out, out + err
@@ -292,7 +293,7 @@ def test_no_write_holds_the_stop_up(shared: SharedCar) -> None:
     assert stopped.returncode == 0, stopped.stdout + stopped.stderr
     rest, _ = writer.communicate(timeout=30)
     z_at = shared.board_time(after="A")
-    assert z_at - asked < 0.3, f"Z reached the board {z_at - asked:.2f} s after fleet stop"
+    assert z_at - asked < 0.5, f"Z reached the board {z_at - asked:.2f} s after fleet stop"
     timed = timed_sent(shared.record)
     last_z = max(i for i, (_, unit) in enumerate(timed) if unit == "Z")
     assert "A" not in [unit for _, unit in timed[last_z:]], "a letter after the stop"
