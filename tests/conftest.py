@@ -38,8 +38,8 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
     Most tests wait on boards, ptys and processes in real time: on two cores the suite's
     processes kept 0.8 of them busy on average with four workers. Three workers took
-    7 min 21 s, four 5 min 43 s to 6 min 8 s, five 4 min 52 s (the tests' own durations
-    adding up to about 1,200 s each time). Six took 4 min 24 s to 5 min 25 s, but half
+    7 min 21 s, four 5 min 43 s to 6 min 8 s, five 4 min 51 s to 4 min 57 s (the tests'
+    own durations adding up to about 1,200 s each time). Six took 4 min 24 s to 5 min 25 s, but half
     those runs failed a test that keeps time, even with the other tests' processes at
     nice 10 (which, beside two busy programs, all but stopped them). So five per two
     cores, and, as `make -l` does, a run started beside another run of this suite
