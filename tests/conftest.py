@@ -34,16 +34,17 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: five workers per two cores on an idle machine, one a core on a busy one.
+    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
 
     Most tests wait on boards, ptys and processes in real time: on two cores the suite's
     processes kept 0.8 of them busy on average with four workers. Three workers took
-    7 min 21 s, four 5 min 43 s to 6 min 8 s, five 4 min 51 s to 4 min 57 s (the tests'
-    own durations adding up to about 1,200 s each time). Six took 4 min 24 s to 5 min 25 s, but half
-    those runs failed a test that keeps time, even with the other tests' processes at
-    nice 10 (which, beside two busy programs, all but stopped them). So five per two
-    cores, and, as `make -l` does, a run started beside another run of this suite
-    (RUNS), or on a machine whose cores are already busy, takes one worker a core."""
+    7 min 21 s, four 5 min 43 s to 6 min 8 s (the tests' own durations adding up to
+    about 1,200 s each time). Five took 4 min 51 s to 5 min 10 s, but one run in ten
+    failed a test that keeps time to ±25 ms, and six failed one in half their runs,
+    even with the other tests' processes at nice 10 (which, beside two busy programs,
+    all but stopped them). So two a core, and, as `make -l` does, a run started beside
+    another run of this suite (RUNS), or on a machine whose cores are already busy,
+    takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -57,9 +58,9 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
 
 def _slots() -> int:
-    """Tests of this suite that run at once on this machine, whatever the runs: five per
-    two cores (`pytest_xdist_auto_num_workers`)."""
-    return max(2, 5 * (os.cpu_count() or 1) // 2)
+    """Tests of this suite that run at once on this machine, whatever the runs: two a
+    core (`pytest_xdist_auto_num_workers`)."""
+    return 2 * (os.cpu_count() or 1)
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
@@ -141,8 +142,8 @@ def _machine(alone: bool, timing: bool, others: list[str]) -> Iterator[None]:
 SLOTS = RUNS / "slots"
 """`K.lock` for K below `_slots()`: a test of any run holds one while it runs (taken last,
 its run's locks held), so two runs side by side load the machine as one does. Beside a
-second run, the first run's five workers and the second's two starved boards and ptys
-in real time: a send 235 ms late, a re-sent frame missing, a transcript's record late."""
+second run (seven workers on two cores: five and two), boards and ptys starved in
+real time: a send 235 ms late, a re-sent frame missing, a transcript's record late."""
 
 
 def _wanted(run: str) -> bool:
