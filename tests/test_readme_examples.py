@@ -38,8 +38,8 @@ NOT_RUN = {
     "edited copy of a suite transcript, not shipped",
     "appmode conform --board /dev/pts/0 --board2 /dev/pts/1 --profile minibalance --yes": "the "
     "whole suite in real time (40 s) against a served board, whose ±0.3 s a machine loaded "
-    "by two test runs overruns; tests/cli/test_minibalance_wire.py runs three of its "
-    "transcripts so, and the example before this one runs all on virtual time",
+    "by two test runs overruns; tests/transcript/test_conformance.py runs three of "
+    "its transcripts so, and the example before this one runs all on virtual time",
     "appmode web": "a server until Ctrl-C: tests/web drives it, and its page in Chromium",
     "appmode drive /dev/pts/1 --uart2": "a full-screen console: tests/console drives it in tmux",
     "appmode drive /dev/pts/0 /dev/pts/1": "a full-screen console: tests/console drives it in tmux",

@@ -1,5 +1,7 @@
 """`appmode board --pty --profile minibalance` driven through the wire by appmode's own
-commands, in real time: what docs/protocol.md §13 says a host meets on a real board."""
+commands, in real time: what docs/protocol.md §13 says a host meets on a real board.
+Three of the profile's transcripts run in real time with the rest of the suite
+(tests/transcript/test_conformance.py)."""
 
 from __future__ import annotations
 
@@ -10,9 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from appmode.ports.target import parse_target
 from appmode.transcript.reading import read_transcript
-from appmode.transcript.runner import run_live, run_virtual
+from appmode.transcript.runner import run_virtual
 from tests.support.processes import ROOT, BoardProcess, board_process, run
 
 BOOT = 2.0
@@ -30,17 +31,6 @@ def board() -> Iterator[BoardProcess]:
 @pytest.mark.parametrize("path", MINIBALANCE_SUITE, ids=lambda p: p.name)
 def test_s13_suite_passes_on_virtual_time(path: Path) -> None:
     result = run_virtual(read_transcript(path))
-    assert result.passed, result.failure
-
-
-@pytest.mark.alone  # ±25 ms and a read that a C record going out would lose: after the rest
-@pytest.mark.parametrize(
-    "name",
-    ["s13_set_value_arithmetic", "s13_telemetry_period", "s13_frame_stops_the_car"],
-)
-def test_s13_suite_passes_in_real_time_over_a_pty(board: BoardProcess, name: str) -> None:
-    path = ROOT / "transcripts" / "suite" / "minibalance" / f"{name}.transcript"
-    result = run_live(read_transcript(path), parse_target(board.url))
     assert result.passed, result.failure
 
 

@@ -204,6 +204,11 @@ longest transcript is 18.4 s), each run in sequence against a board of its own (
 `conform --board` runs a suite), all at once: they mostly wait."""
 
 
+MINIBALANCE_LIVE = ("s13_set_value_arithmetic", "s13_telemetry_period", "s13_frame_stops_the_car")
+"""Three of the minibalance profile's transcripts (docs/protocol.md §13, 10 s), run beside
+the groups against a board of that profile, once it has booted (2 s)."""
+
+
 def _group(patterns: tuple[str, ...]) -> list[Path]:
     return sorted({path for pattern in patterns for path in SUITE_DIR.glob(pattern)})
 
@@ -211,6 +216,21 @@ def _group(patterns: tuple[str, ...]) -> list[Path]:
 def test_the_live_groups_hold_the_whole_suite_once() -> None:
     grouped = [path for patterns in LIVE_GROUPS.values() for path in _group(patterns)]
     assert sorted(grouped) == SUITE
+
+
+def _live_minibalance() -> str | None:
+    """MINIBALANCE_LIVE over two ptys against a minibalance board process: None when they
+    passed, else why not."""
+    paths = [SUITE_DIR / "minibalance" / f"{name}.transcript" for name in MINIBALANCE_LIVE]
+    with board_process("--pty", "--profile", "minibalance", "--quiet") as board:
+        time.sleep(2.0)  # records from 1.4 s, motors from 1.9 s (§13.1)
+        done = run(
+            "conform", "--board", board.url, "--board2", board.uart2, "--profile", "minibalance",
+            "--yes", *(str(path.relative_to(ROOT)) for path in paths), timeout=300,
+        )  # fmt: skip
+    if done.returncode == 0 and f"{len(paths)} passed, 0 failed" in done.stdout:
+        return None
+    return f"minibalance: exit status {done.returncode}\n{done.stdout}{done.stderr}"
 
 
 def _live(name: str) -> str | None:
@@ -291,15 +311,18 @@ def test_conform_on_a_board_shows_its_progress_on_a_terminal_only() -> None:
 @pytest.mark.slow
 @pytest.mark.alone
 def test_the_suite_passes_in_real_time_against_board_processes() -> None:
-    """Every group at once, each against its own board, after the rest of the suite: the
-    whole suite in the time of its longest group (about 24 s). On a machine another
+    """Every group at once, each against its own board, after the rest of the suite, and
+    three of the minibalance profile's transcripts beside them: the whole suite in the
+    time of its longest group (about 24 s). On a machine another
     program keeps busy, one group at a time (about 3 minutes): ten groups at once beside
     two busy processes on two cores put a record 0.3 s off its time. The machine is
     judged over two seconds: the last tests' processes ending took a single look's
     whole window, and the run then took 3 minutes on an idle machine."""
-    at_once = len(LIVE_GROUPS) if busy_cores(looks=8) < 0.5 else 1  # 2 s: not a blip
+    at_once = len(LIVE_GROUPS) + 1 if busy_cores(looks=8) < 0.5 else 1  # 2 s: not a blip
     with ThreadPoolExecutor(at_once) as pool:
+        minibalance = pool.submit(_live_minibalance)
         failures = [why for why in pool.map(_live, LIVE_GROUPS) if why is not None]
+        failures += [why for why in [minibalance.result()] if why is not None]
     assert not failures, "\n".join(failures)
 
 
