@@ -270,6 +270,7 @@ WITH_EXAMPLES = [
 """The documents with examples to run."""
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("document", WITH_EXAMPLES, ids=lambda d: str(d.relative_to(ROOT)))
 def test_every_example_runs_and_prints_what_its_document_shows(
     document: Path, tmp_path: Path

@@ -226,6 +226,7 @@ def test_without_bluez_each_command_says_so_in_one_line(
     assert os.environ.get("DBUS_SYSTEM_BUS_ADDRESS") != f"unix:path={tmp_path}/no-bus"
 
 
+@pytest.mark.slow
 def test_scan_probe_names_the_firmware_and_doctor_checks_the_modules(
     appmode_ble_board: ServedBoard,
 ) -> None:

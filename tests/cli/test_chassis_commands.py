@@ -93,6 +93,7 @@ def test_conform_chassis_passes_the_shipped_dialect_suite(profile: str) -> None:
     assert f"({profile} profile)" in counts
 
 
+@pytest.mark.slow
 def test_conform_chassis_runs_in_real_time_against_a_board(tmp_path: Path) -> None:
     suite = Path(__file__).parents[2] / "transcripts" / "suite" / "wheeltec"
     one = suite / "s15_3_bad_frames_dropped.transcript"

@@ -109,6 +109,7 @@ def test_it_sends_only_parameter_reads_and_nothing_to_a_silent_port(tmp_path: An
     assert sent and set(sent) == {"{Q:P}"}, sent  # no letter, nothing on UART2
 
 
+@pytest.mark.slow
 def test_text_is_not_a_board_and_params_says_so() -> None:
     master, slave = pty.openpty()
     tty.setraw(slave)

@@ -64,6 +64,7 @@ def test_monitor_follows_a_pty_board_that_dies_and_returns(tmp_path: Path) -> No
     assert "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_console_says_the_link_is_lost_and_drives_again_when_back(tmp_path: Path) -> None:
     """The board dies before `drive A` and comes back before `drive C`. Each step waits
     for what the console says, not for a clock: on a loaded machine the console may
