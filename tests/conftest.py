@@ -14,7 +14,6 @@ import tempfile
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import IO
 
 import pytest
 
@@ -35,16 +34,17 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: three workers a core on an idle machine, one a core on a busy one.
+    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
 
     Most tests wait on boards, ptys and processes in real time: on two cores the suite's
     processes kept 0.8 of them busy on average with four workers. Three workers took
-    7 min 21 s, four 5 min 43 s to 6 min 16 s (the tests' own durations adding up to
-    about 1,200 s each time). With five, one run in ten failed a test that keeps time to
-    ±25 ms, and with six half the runs failed one: beside a test marked `timing` now run
-    no more tests than with four workers, the load its bounds were set for (`_places`).
-    As `make -l` does, a run started beside another run of this suite (RUNS), or on a
-    machine whose cores are already busy, takes one worker a core."""
+    7 min 21 s, four 5 min 43 s to 6 min 8 s (the tests' own durations adding up to
+    about 1,200 s each time). Five took 4 min 51 s to 5 min 10 s, but one run in ten
+    failed a test that keeps time to ±25 ms, and six failed one in half their runs,
+    even with the other tests' processes at nice 10 (which, beside two busy programs,
+    all but stopped them). So two a core, and, as `make -l` does, a run started beside
+    another run of this suite (RUNS), or on a machine whose cores are already busy,
+    takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -58,9 +58,9 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
 
 def _slots() -> int:
-    """Places for the tests of this suite that run at once on this machine, whatever the
-    runs: three a core (`pytest_xdist_auto_num_workers`)."""
-    return 3 * (os.cpu_count() or 1)
+    """Tests of this suite that run at once on this machine, whatever the runs: two a
+    core (`pytest_xdist_auto_num_workers`)."""
+    return 2 * (os.cpu_count() or 1)
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
@@ -96,26 +96,22 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
     set for). In the real-time suite beside the run's last tests a board's encoder
     report came 50 ms late (±25 ms); beside another run its boards applied commands
     later than its ±0.3 s, and a console let go of stopped the car 0.45 s after, not
-    within 0.35. A test in Chromium takes two places: a browser drawing a page keeps a
-    core busy (with six workers, six of them kept both cores busy for a minute)."""
+    within 0.35."""
     others = _other_runs()
     alone = item.get_closest_marker("alone") is not None
-    timing = item.get_closest_marker("timing") is not None
-    places = 2 if "browser" in item.fixturenames else 1
-    with _machine(alone, timing, others, places):
+    timing = item.get_closest_marker("timing") is not None and bool(others)
+    with _machine(alone, timing, others):
         yield
 
 
 @contextlib.contextmanager
-def _machine(alone: bool, timing: bool, others: list[str], places: int) -> Iterator[None]:
+def _machine(alone: bool, timing: bool, others: list[str]) -> Iterator[None]:
     try:
         import fcntl
     except ImportError:  # Windows: tests are not kept apart
         yield
         return
     run = _run()
-    kept = timing
-    timing = timing and bool(others)  # beside other runs: the machine to itself
     with contextlib.ExitStack() as held:
         try:
             ALONE.mkdir(parents=True, exist_ok=True)
@@ -135,57 +131,19 @@ def _machine(alone: bool, timing: bool, others: list[str], places: int) -> Itera
             _wait(lambda lock=lock: _locked(lock.fileno(), kind | fcntl.LOCK_NB))
         with contextlib.suppress(OSError):  # another user's folder
             SLOTS.mkdir(exist_ok=True)
-            held.enter_context(_places(places, kept))
+            slots = [held.enter_context((SLOTS / f"{k}.lock").open("a")) for k in range(_slots())]
+            _wait(
+                lambda: any(_locked(slot.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB) for slot in slots)
+            )
         yield
     # closing the files let the locks go
 
 
 SLOTS = RUNS / "slots"
-"""`K.lock` for K below `_slots()`: a test of any run holds one while it runs (a test in
-Chromium two; taken last, its run's locks held), so two runs side by side load the
-machine as one does. Beside a second run (seven workers on two cores: five and two),
-boards and ptys starved in real time: a send 235 ms late, a re-sent frame missing, a
-transcript's record late. A `timing` test holds `timing.lock` shared while it waits and
-runs, and the last place a core shared with the other timing tests (`_places`).
-`gate.lock` is held by the test taking its places, so that two tests each holding some
-of the places they want never wait for each other."""
-
-
-@contextlib.contextmanager
-def _places(wanted: int, timing: bool) -> Iterator[None]:
-    """`wanted` of the places in SLOTS, held until the end of the block. While a `timing`
-    test runs or waits, the last place a core are kept from the other tests: it holds
-    them shared with the other timing tests, once the tests that had them have ended, so
-    that beside it run no more tests than two workers a core ran (three on two cores)."""
-    import fcntl
-
-    nb = fcntl.LOCK_NB
-    with contextlib.ExitStack() as files:
-        slots = [files.enter_context((SLOTS / f"{k}.lock").open("a")) for k in range(_slots())]
-        first, kept = slots[: 2 * (os.cpu_count() or 1)], slots[2 * (os.cpu_count() or 1) :]
-        timings = files.enter_context((SLOTS / "timing.lock").open("a"))
-        if timing:
-            _wait(lambda: _locked(timings.fileno(), fcntl.LOCK_SH | nb))
-            _wait(lambda: all(_locked(slot.fileno(), fcntl.LOCK_SH | nb) for slot in kept))
-        taken: list[IO[str]] = []
-
-        def enough() -> bool:
-            free = first if timing or not _locked(timings.fileno(), fcntl.LOCK_EX | nb) else slots
-            if free is slots:  # no timing test runs or waits: the kept places are free
-                fcntl.flock(timings.fileno(), fcntl.LOCK_UN)
-            for slot in free:
-                if (
-                    len(taken) < wanted
-                    and slot not in taken
-                    and _locked(slot.fileno(), fcntl.LOCK_EX | nb)
-                ):
-                    taken.append(slot)
-            return len(taken) >= wanted
-
-        with (SLOTS / "gate.lock").open("a") as gate:
-            _wait(lambda: _locked(gate.fileno(), fcntl.LOCK_EX | nb))
-            _wait(enough)
-        yield
+"""`K.lock` for K below `_slots()`: a test of any run holds one while it runs (taken last,
+its run's locks held), so two runs side by side load the machine as one does. Beside a
+second run (seven workers on two cores: five and two), boards and ptys starved in
+real time: a send 235 ms late, a re-sent frame missing, a transcript's record late."""
 
 
 def _wanted(run: str) -> bool:
