@@ -38,7 +38,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
     Most tests wait on boards, ptys and processes in real time: on two cores the suite's
     processes kept 0.8 of them busy on average with four workers. Three workers took
-    7 min 21 s, four 5 min 43 s to 6 min 8 s (the tests' own durations adding up to
+    7 min 21 s, four 5 min 43 s to 6 min 16 s (the tests' own durations adding up to
     about 1,200 s each time). Five took 4 min 51 s to 5 min 10 s, but one run in ten
     failed a test that keeps time to ±25 ms, and six failed one in half their runs,
     even with the other tests' processes at nice 10 (which, beside two busy programs,
