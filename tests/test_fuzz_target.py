@@ -7,13 +7,15 @@ import ast
 import importlib
 from pathlib import Path
 
+from tests.support.source import parsed
+
 TARGET = Path(__file__).parent.parent / "fuzz" / "fuzz_decoders.py"
 
 
 def test_the_fuzz_target_imports_what_appmode_has() -> None:
     names = [
         (node.module, alias.name)
-        for node in ast.walk(ast.parse(TARGET.read_text()))
+        for node in ast.walk(parsed(TARGET.read_text()))
         if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("appmode")
         for alias in node.names
     ]

@@ -8,6 +8,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+from tests.support.source import parsed
+
 PACKAGE = Path(__file__).resolve().parent.parent / "appmode"
 LAYERS = (
     "protocol",
@@ -48,7 +50,7 @@ def layer_of(name: str) -> int | None:
 def imported(path: Path) -> list[tuple[int, str]]:
     """(line, module) for every appmode module `path` imports, at run time or for types."""
     found = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(parsed(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("appmode"):
             found.append((node.lineno, node.module))
         elif isinstance(node, ast.Import):
@@ -69,7 +71,7 @@ def test_every_folder_is_a_package_that_says_what_it_holds() -> None:
     for folder in {p.parent for p in modules()}:
         init = folder / "__init__.py"
         assert init.exists(), f"{folder} has no __init__.py"
-        assert ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))), f"{init}: say"
+        assert ast.get_docstring(parsed(init.read_text(encoding="utf-8"))), f"{init}: say"
 
 
 def test_imports_point_down_the_layers() -> None:
@@ -92,7 +94,7 @@ def test_modules_and_functions_are_small() -> None:
         text = path.read_text(encoding="utf-8")
         if len(text.splitlines()) > MAX_MODULE:
             long.append(f"{name_of(path)}: {len(text.splitlines())} lines")
-        for node in ast.walk(ast.parse(text)):
+        for node in ast.walk(parsed(text)):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 size = (node.end_lineno or node.lineno) - node.lineno + 1
                 if size > MAX_FUNCTION:
@@ -125,7 +127,7 @@ def test_protocol_opens_no_file() -> None:
     streams it is handed; the shipped profiles are its data (`protocol.profiles`)."""
     found = []
     for path in (PACKAGE / "protocol").rglob("*.py"):
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(parsed(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Call):
                 func = node.func
                 name = func.id if isinstance(func, ast.Name) else getattr(func, "attr", "")
@@ -162,7 +164,7 @@ def test_the_command_line_uses_no_argparse_internals() -> None:
     }
     found = []
     for path in modules():
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+        tree = parsed(path.read_text(encoding="utf-8"))
         methods = [n for c in ast.walk(tree) if isinstance(c, ast.ClassDef) for n in c.body]
         for node in [*ast.walk(tree), *methods]:
             if isinstance(node, ast.Attribute) and node.attr in private:
@@ -187,7 +189,7 @@ def port_questions(path: Path) -> list[str]:
     class, a board choice's `control`, a comparison with a port's name or with a choice's
     `port` (a probe's `finding.kind`, what a port was heard to be, is no such question)."""
     found = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in ast.walk(parsed(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "isinstance":
             classes = node.args[1]
             names = classes.elts if isinstance(classes, ast.Tuple) else [classes]
@@ -235,7 +237,7 @@ def test_the_recording_formats_are_one_table_each_way() -> None:
     for path in modules():
         if path.name in ("formats.py", "transcript.py") and path.parent.name == "protocol":
             continue  # the tables, and the text format's own grammar (its SUFFIX)
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(parsed(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Constant) and isinstance(node.value, (str, bytes)):
                 value = node.value if isinstance(node.value, str) else node.value.decode("latin-1")
                 found += [f"{name_of(path)}:{node.lineno}: {value!r}" for n in named if n == value]

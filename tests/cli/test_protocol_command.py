@@ -7,6 +7,7 @@ import ast
 from pathlib import Path
 
 from tests.support.processes import ROOT, run
+from tests.support.source import parsed
 
 
 def test_a_section_is_printed_with_its_subsections_and_no_more() -> None:
@@ -41,7 +42,7 @@ def test_a_section_that_is_none_is_one_line() -> None:
 
 def _messages(path: Path) -> list[tuple[int, str]]:
     """The string constants of a module that are not docstrings: what a user may read."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = parsed(path.read_text(encoding="utf-8"))
     docstrings = {
         id(node.value)
         for node in ast.walk(tree)
