@@ -14,6 +14,7 @@ import tempfile
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import IO
 
 import pytest
 
@@ -34,17 +35,17 @@ RUNS = Path(tempfile.gettempdir()) / "appmode-test-runs"
 
 
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
-    """`-n auto`: two workers a core on an idle machine, one a core on a busy one.
+    """`-n auto`: four workers a core on an idle machine, one a core on a busy one.
 
-    Most tests wait on boards, ptys and processes in real time: on two cores the suite's
-    processes kept 0.8 of them busy on average with four workers. Three workers took
-    7 min 21 s, four 5 min 43 s to 6 min 16 s (the tests' own durations adding up to
-    about 1,200 s each time). Five took 4 min 51 s to 5 min 10 s, but one run in ten
-    failed a test that keeps time to ±25 ms, and six failed one in half their runs,
-    even with the other tests' processes at nice 10 (which, beside two busy programs,
-    all but stopped them). So two a core, and, as `make -l` does, a run started beside
-    another run of this suite (RUNS), or on a machine whose cores are already busy,
-    takes one worker a core."""
+    Most tests wait on boards, ptys and processes in real time (ROS's and the share's
+    take as long on an idle machine as in the suite): four workers on two cores kept
+    0.8 of them busy, and took 5 min 43 s to 6 min 16 s. Eight took 4 min 27 s to
+    4 min 39 s, their tests sharing places (`_places`): a test in Chromium takes two
+    (the page's tests keep both cores busy for a minute), and beside a test marked
+    `timing`, or another run, no more tests run than at two workers a core, the load
+    their bounds were set for (five workers had failed one run in ten by ±25 ms, six
+    half). As `make -l` does, a run started beside another run of this suite (RUNS), or
+    on a machine whose cores are already busy, takes one worker a core."""
     cores = os.cpu_count() or 1
     mine = RUNS / str(os.getpid())
     try:
@@ -58,9 +59,9 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
 
 def _slots() -> int:
-    """Tests of this suite that run at once on this machine, whatever the runs: two a
-    core (`pytest_xdist_auto_num_workers`)."""
-    return 2 * (os.cpu_count() or 1)
+    """Places for the tests of this suite that run at once on this machine, whatever the
+    runs: four a core (`pytest_xdist_auto_num_workers`)."""
+    return 4 * (os.cpu_count() or 1)
 
 
 def _running(pid: str, path: Path | None = None) -> bool:
@@ -96,22 +97,26 @@ def pytest_runtest_protocol(item: pytest.Item) -> Iterator[None]:
     set for). In the real-time suite beside the run's last tests a board's encoder
     report came 50 ms late (±25 ms); beside another run its boards applied commands
     later than its ±0.3 s, and a console let go of stopped the car 0.45 s after, not
-    within 0.35."""
+    within 0.35. A test in Chromium takes two places: a browser drawing a page keeps a
+    core busy (six of them kept both cores busy for a minute)."""
     others = _other_runs()
     alone = item.get_closest_marker("alone") is not None
-    timing = item.get_closest_marker("timing") is not None and bool(others)
-    with _machine(alone, timing, others):
+    timing = item.get_closest_marker("timing") is not None
+    places = 2 if "browser" in getattr(item, "fixturenames", ()) else 1
+    with _machine(alone, timing, others, places):
         yield
 
 
 @contextlib.contextmanager
-def _machine(alone: bool, timing: bool, others: list[str]) -> Iterator[None]:
+def _machine(alone: bool, timing: bool, others: list[str], places: int) -> Iterator[None]:
     try:
         import fcntl
     except ImportError:  # Windows: tests are not kept apart
         yield
         return
     run = _run()
+    kept = timing
+    timing = timing and bool(others)  # beside other runs: the machine to itself
     with contextlib.ExitStack() as held:
         try:
             ALONE.mkdir(parents=True, exist_ok=True)
@@ -131,29 +136,70 @@ def _machine(alone: bool, timing: bool, others: list[str]) -> Iterator[None]:
             _wait(lambda lock=lock: _locked(lock.fileno(), kind | fcntl.LOCK_NB))
         with contextlib.suppress(OSError):  # another user's folder
             SLOTS.mkdir(exist_ok=True)
-            slots = [held.enter_context((SLOTS / f"{k}.lock").open("a")) for k in range(_slots())]
-            _wait(
-                lambda: any(_locked(slot.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB) for slot in slots)
-            )
+            held.enter_context(_places(places, kept, bool(others)))
         yield
     # closing the files let the locks go
 
 
 SLOTS = RUNS / "slots"
-"""`K.lock` for K below `_slots()`: a test of any run holds one while it runs (taken last,
-its run's locks held), so two runs side by side load the machine as one does. Beside a
-second run (seven workers on two cores: five and two), boards and ptys starved in
-real time: a send 235 ms late, a re-sent frame missing, a transcript's record late."""
+"""`K.lock` for K below `_slots()`: a test of any run holds one while it runs (a test in
+Chromium two; taken last, its run's locks held), so two runs side by side load the
+machine as one does. Beside a second run (seven workers on two cores: five and two),
+boards and ptys starved in real time: a send 235 ms late, a re-sent frame missing, a
+transcript's record late. A `timing` test holds `timing.lock` shared while it waits and
+runs, and the last two places a core shared with the other timing tests (`_places`).
+`gate.lock` is held by the test taking its places, so that two tests each holding some
+of the places they want never wait for each other."""
+
+
+@contextlib.contextmanager
+def _places(wanted: int, timing: bool, crowded: bool) -> Iterator[None]:
+    """`wanted` of the places in SLOTS, held until the end of the block. While a `timing`
+    test runs or waits, or another run goes on beside this one (`crowded`), tests take
+    the first two places a core only: a timing test holds the others, shared with the
+    other timing tests, once the tests that had them have ended, so that beside it run
+    no more tests than two workers a core ran (four on two cores)."""
+    import fcntl
+
+    nb = fcntl.LOCK_NB
+    with contextlib.ExitStack() as files:
+        slots = [files.enter_context((SLOTS / f"{k}.lock").open("a")) for k in range(_slots())]
+        first, kept = slots[: 2 * (os.cpu_count() or 1)], slots[2 * (os.cpu_count() or 1) :]
+        timings = files.enter_context((SLOTS / "timing.lock").open("a"))
+        if timing:
+            _wait(lambda: _locked(timings.fileno(), fcntl.LOCK_SH | nb))
+            _wait(lambda: all(_locked(slot.fileno(), fcntl.LOCK_SH | nb) for slot in kept))
+        taken: list[IO[str]] = []
+
+        def enough() -> bool:
+            few = timing or crowded or not _locked(timings.fileno(), fcntl.LOCK_EX | nb)
+            if not few:  # no timing test runs or waits: the kept places are free
+                fcntl.flock(timings.fileno(), fcntl.LOCK_UN)
+            free = first if few else slots
+            for slot in free:
+                if (
+                    len(taken) < wanted
+                    and slot not in taken
+                    and _locked(slot.fileno(), fcntl.LOCK_EX | nb)
+                ):
+                    taken.append(slot)
+            return len(taken) >= wanted
+
+        with (SLOTS / "gate.lock").open("a") as gate:
+            _wait(lambda: _locked(gate.fileno(), fcntl.LOCK_EX | nb))
+            _wait(enough)
+        yield
 
 
 def _wanted(run: str) -> bool:
-    """Whether a test that wants the machine runs or waits to: an `alone` one of any
-    run, a `timing` one of another run than `run`."""
+    """Whether a test of another run than `run` that wants the machine (`alone` or
+    `timing`) runs or waits to: it goes before this run's next tests. This run's own
+    `alone` tests wait for its other tests instead, which workers still held (two each)
+    when they were handed out."""
     for path in ALONE.iterdir():
         owner, _, pid = path.stem.partition("-")
-        mine = pid == str(os.getpid())
-        wants = path.suffix == ".alone" or (path.suffix == ".wants" and owner != run)
-        if wants and not mine and _running(pid, path):
+        wants = owner != run and path.suffix in (".alone", ".wants")
+        if wants and _running(pid, path):
             return True
     return False
 
@@ -195,17 +241,19 @@ def _other_runs() -> list[str]:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The page's tests in Chromium go first and tests marked `alone` last: pytest-xdist
-    hands the last out while the other workers are finishing, so the few tests that
-    wait while one runs (pytest_runtest_protocol) are the run's last, and the browsers,
-    whose heartbeats a burst of boards starves past the page's 0.25-s lease (a held
-    direction then stops, as it must), are done long before (they came last by name).
-    Within each, the long ones (`slow`) first: a long test handed out last keeps the
-    run going after the rest."""
+    """The page's tests in Chromium go first, then the tests marked `timing`, and tests
+    marked `alone` last. The few tests that wait while an alone one runs
+    (pytest_runtest_protocol) are then the run's last; the browsers, whose heartbeats a
+    burst of boards starves past the page's 0.25-s lease (a held direction then stops,
+    as it must), are done long before (they came last by name); and the timing tests,
+    which keep half the places while they run (`_places`), run together (among the
+    others, they held a run at four tests for 100 s). Within each, the long ones (`slow`) first: a long test
+    handed out last keeps the run going after the rest."""
     items.sort(
         key=lambda item: (
             item.get_closest_marker("alone") is not None,
             not item.nodeid.startswith("tests/web/"),
+            item.get_closest_marker("timing") is None,
             item.get_closest_marker("slow") is None,
         )
     )
