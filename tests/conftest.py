@@ -241,19 +241,19 @@ def _other_runs() -> list[str]:
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The page's tests in Chromium go first, then the tests marked `timing`, and tests
-    marked `alone` last. The few tests that wait while an alone one runs
-    (pytest_runtest_protocol) are then the run's last; the browsers, whose heartbeats a
-    burst of boards starves past the page's 0.25-s lease (a held direction then stops,
-    as it must), are done long before (they came last by name); and the timing tests,
-    which keep half the places while they run (`_places`), run together (among the
-    others, they held a run at four tests for 100 s). Within each, the long ones (`slow`) first: a long test
-    handed out last keeps the run going after the rest."""
+    """The tests marked `timing` go first, then the page's tests in Chromium, and tests
+    marked `alone` last. The timing tests, which keep half the places while they run
+    (`_places`), then run together (among the others, they held a run at four tests for
+    100 s); the browsers, whose heartbeats a burst of boards starves past the page's
+    0.25-s lease (a held direction then stops, as it must), are done long before the
+    burst (they came last by name); and the few tests that wait while an alone one runs
+    (pytest_runtest_protocol) are the run's last. Within each, the long ones (`slow`)
+    first: a long test handed out last keeps the run going after the rest."""
     items.sort(
         key=lambda item: (
             item.get_closest_marker("alone") is not None,
-            not item.nodeid.startswith("tests/web/"),
             item.get_closest_marker("timing") is None,
+            item.get_closest_marker("timing") is None and not item.nodeid.startswith("tests/web/"),
             item.get_closest_marker("slow") is None,
         )
     )

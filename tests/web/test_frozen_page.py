@@ -22,8 +22,10 @@ from tests.support.processes import wait_for
 from tests.support.web import WebProcess, wait_frame, wait_frames, wait_sent, web_process
 from tests.web.test_server import beat_until_sent, page, ready, status
 
+pytestmark = pytest.mark.timing  # beside the page's tests in Chromium an A was read late
 QUIET_STOP = 1.0
-"""The lease is 0.25 s; the board's clock sees it within this on a loaded machine."""
+"""The lease is 0.25 s; the board's clock sees it within this on a loaded machine (its
+A, read 0.1 s late beside the page's tests in Chromium, came 0.12 s before its Z)."""
 
 
 def timed(web: WebProcess, port: str = ">") -> list[tuple[float, str]]:
