@@ -39,7 +39,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
 
     Most tests wait on boards, ptys and processes in real time (ROS's and the share's
     take as long on an idle machine as in the suite): four workers on two cores kept
-    0.8 of them busy, and took 5 min 43 s to 6 min 16 s. Eight took 4 min 27 s to
+    0.8 of them busy, and took 5 min 43 s to 6 min 16 s. Eight took 4 min 21 s to
     4 min 39 s, their tests sharing places (`_places`): a test in Chromium takes two
     (the page's tests keep both cores busy for a minute), and beside a test marked
     `timing`, or another run, no more tests run than at two workers a core, the load
