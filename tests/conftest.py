@@ -249,14 +249,16 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     burst (they came last by name); and the few tests that wait while an alone one runs
     (pytest_runtest_protocol) are the run's last. Within each, the long ones (`slow`)
     first: a long test handed out last keeps the run going after the rest."""
-    items.sort(
-        key=lambda item: (
-            item.get_closest_marker("alone") is not None,
-            item.get_closest_marker("timing") is None,
-            item.get_closest_marker("timing") is None and not item.nodeid.startswith("tests/web/"),
-            item.get_closest_marker("slow") is None,
-        )
+    items.sort(key=_order)
+
+
+def _order(item: pytest.Item) -> tuple[bool, bool, bool, bool]:
+    """pytest_collection_modifyitems' key: alone last; timing first; then the page's."""
+    alone, timing, slow = (
+        item.get_closest_marker(m) is not None for m in ("alone", "timing", "slow")
     )
+    page = item.nodeid.startswith("tests/web/")
+    return alone, not timing, not (timing or page), not slow
 
 
 @pytest.fixture(autouse=True)

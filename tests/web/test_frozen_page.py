@@ -22,7 +22,6 @@ from tests.support.processes import wait_for
 from tests.support.web import WebProcess, wait_frame, wait_frames, wait_sent, web_process
 from tests.web.test_server import beat_until_sent, page, ready, status
 
-pytestmark = pytest.mark.timing  # beside the page's tests in Chromium an A was read late
 QUIET_STOP = 1.0
 """The lease is 0.25 s; the board's clock sees it within this on a loaded machine (its
 A, read 0.1 s late beside the page's tests in Chromium, came 0.12 s before its Z)."""
@@ -42,6 +41,7 @@ def gap(received: list[tuple[float, str]], start: str, end: str) -> float:
     return stop - received[at][0]
 
 
+@pytest.mark.timing  # the stop timed to the lease (QUIET_STOP)
 @pytest.mark.parametrize(
     ("lines", "letter"),
     [
@@ -74,6 +74,7 @@ def test_a_frozen_page_stops_the_car_however_the_motion_began(
         assert 0.2 <= gap(timed(web), letter or "A", "Z") < QUIET_STOP
 
 
+@pytest.mark.timing
 def test_a_page_that_keeps_beating_keeps_a_latched_direction(tmp_path: Path) -> None:
     """The authority stops silence, not motion: heartbeats keep a latch going."""
 
@@ -96,6 +97,7 @@ def test_a_page_that_keeps_beating_keeps_a_latched_direction(tmp_path: Path) -> 
         assert sent[-1] == "A", sent[-5:]
 
 
+@pytest.mark.timing
 def test_a_frozen_page_stops_a_velocity_frame_over_uart2(tmp_path: Path) -> None:
     async def scenario(web: WebProcess) -> float:
         async with aiohttp.ClientSession() as session:
@@ -143,6 +145,7 @@ def test_the_page_names_no_file_and_records_into_appmode_s_folder(tmp_path: Path
     assert oct(folder.stat().st_mode & 0o777) == "0o700"
 
 
+@pytest.mark.timing
 def test_a_recording_fifo_nobody_reads_never_holds_the_page_s_stop(tmp_path: Path) -> None:
     """Issue 49.1: `web --record FIFO` whose reader stalls kept the car moving after the
     release, and signals did nothing."""
